@@ -1,0 +1,34 @@
+# mbsuite — set-up and entry points. `make demo` and `make test` work on a fresh machine.
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+export MPLBACKEND ?= Agg
+
+.PHONY: demo test test-slow lint bench clean
+
+$(BIN)/python:
+	$(PY) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(STAMP): $(BIN)/python pyproject.toml
+	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	touch $(STAMP)
+
+demo: $(STAMP)  ## pantograph frequency sweep 1-30 Hz, plots and CSV into out/
+	$(BIN)/mbsuite freqresp pantograph --out out/pantograph_freqresp
+
+test: $(STAMP)  ## default suite (slow studies excluded)
+	$(BIN)/python -m pytest -q
+
+test-slow: $(STAMP)  ## long studies only
+	$(BIN)/python -m pytest -q -m slow
+
+lint: $(STAMP)
+	$(BIN)/ruff check mbsuite tests scripts
+
+bench: $(STAMP)
+	$(BIN)/python scripts/bench_callbacks.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

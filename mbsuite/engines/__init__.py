@@ -1,0 +1,1 @@
+"""Model-agnostic engine plumbing: loading models with clear errors, callbacks, stepping, linear-algebra utilities."""

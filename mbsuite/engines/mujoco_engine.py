@@ -1,0 +1,112 @@
+"""MuJoCo plumbing shared by all models: loading with clear errors, scoped callbacks, stepping with divergence checks.
+
+MuJoCo's Python callbacks (`mujoco.set_mjcb_*`) are process-global and hold the GIL. `callbacks(...)` installs only the
+callbacks a scene needs for the duration of a `with` block and always removes them, so a scene without them runs at the
+bare engine's cost and `mujoco.rollout` can use its C threads.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from ..errors import ModelFileError, SceneError, SolverError
+
+INTEGRATOR = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE,
+}
+
+_CALLBACK_SETTERS = {
+    "act_dyn": mujoco.set_mjcb_act_dyn,
+    "act_gain": mujoco.set_mjcb_act_gain,
+    "act_bias": mujoco.set_mjcb_act_bias,
+    "passive": mujoco.set_mjcb_passive,
+    "control": mujoco.set_mjcb_control,
+}
+_active: dict[str, Callable] = {}
+
+
+def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False) -> mujoco.MjModel:
+    """Compile an MJCF file/string/MjSpec; any parse or compile error is re-raised as ModelFileError naming the source."""
+    try:
+        if isinstance(source, mujoco.MjSpec):
+            return source.compile()
+        if from_string:
+            return mujoco.MjModel.from_xml_string(str(source))
+        p = Path(source)
+        if not p.is_file():
+            raise ModelFileError(f"MJCF file not found: {p}")
+        return mujoco.MjModel.from_xml_path(str(p))
+    except ModelFileError:
+        raise
+    except Exception as exc:  # mujoco raises ValueError with the parser message
+        name = "<string>" if from_string else str(source)
+        raise ModelFileError(f"MuJoCo cannot load {name}: {exc}") from exc
+
+
+def set_integrator(model: mujoco.MjModel, integrator: str, timestep: float) -> None:
+    if integrator not in INTEGRATOR:
+        raise SceneError(f"unknown integrator {integrator!r}; valid: {list(INTEGRATOR)}")
+    model.opt.integrator = INTEGRATOR[integrator]
+    model.opt.timestep = float(timestep)
+
+
+def active_callbacks() -> dict[str, Callable]:
+    """The mbsuite callbacks currently installed (empty outside a `callbacks()` block)."""
+    return dict(_active)
+
+
+@contextlib.contextmanager
+def callbacks(**cbs: Callable | None) -> Iterator[None]:
+    """Install MuJoCo callbacks (`act_dyn`, `act_gain`, `act_bias`, `passive`, `control`) for a block; None = not installed.
+
+    Nesting the same callback is an error (they are process-global)."""
+    wanted = {k: v for k, v in cbs.items() if v is not None}
+    bad = sorted(set(wanted) - set(_CALLBACK_SETTERS))
+    if bad:
+        raise ValueError(f"unknown MuJoCo callback(s) {bad}; valid: {sorted(_CALLBACK_SETTERS)}")
+    clash = sorted(set(wanted) & set(_active))
+    if clash:
+        raise RuntimeError(f"MuJoCo callback(s) {clash} already installed by another simulation in this process")
+    try:
+        for k, fn in wanted.items():
+            _CALLBACK_SETTERS[k](fn)
+            _active[k] = fn
+        yield
+    finally:
+        for k in wanted:
+            _CALLBACK_SETTERS[k](None)
+            _active.pop(k, None)
+
+
+def check_finite(model: mujoco.MjModel, data: mujoco.MjData, what: str) -> None:
+    """Raise SolverError if the state is non-finite or MuJoCo flagged a bad acceleration/instability."""
+    bad_state = not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel)) and np.all(np.isfinite(data.act)))
+    w = data.warning
+    unstable = w[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
+    if bad_state or unstable:
+        raise SolverError(
+            f"{what}: MuJoCo diverged at t = {data.time:.6g} s (integrator "
+            f"{mujoco.mjtIntegrator(model.opt.integrator).name}, timestep {model.opt.timestep:g} s); "
+            "reduce solver.timestep or use an implicit integrator"
+        )
+
+
+def warnings_raised(data: mujoco.MjData) -> dict[str, int]:
+    """Non-zero MuJoCo warning counters by name."""
+    return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(data.warning) if w.number > 0}
+
+
+def full_inertia(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """Dense joint-space inertia M(q) (mujoco 4: `mj_fullM(m, d, dst)` reads `d.M`); call after mj_forward."""
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, M)
+    return M

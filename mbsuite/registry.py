@@ -1,0 +1,92 @@
+"""The model registry: every package under `mbsuite/models/` that exports `SPEC: ModelSpec` is a model.
+
+A model package declares what its scenes may contain (effects with their allowed values, parameter dataclass, input types,
+output signals, engines) and the analysis hooks it supports. Nothing else in mbsuite knows a model by name: the scene
+loader validates against the spec and the CLI dispatches through the hooks, so a new model is one new package.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import pkgutil
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SceneError
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One switchable effect of a model: `choices` are the allowed values (bools and/or strings)."""
+
+    choices: tuple[Any, ...]
+    default: Any
+    doc: str = ""
+
+    def check(self, name: str, value: Any) -> Any:
+        # bools are compared by identity so that 1/0 are not silently taken for true/false
+        ok = any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool)) for c in self.choices)
+        if not ok:
+            raise SceneError(f"effect '{name}' = {value!r} is not allowed; valid values: {list(self.choices)}")
+        return value
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """What a model offers. Hooks take a validated `Scene` and return plain results (dicts / result objects).
+
+    - `run(scene, engine) -> SimResult`
+    - `equilibrium(scene) -> dict`, `modes(scene) -> dict`, `freqresp(scene, freqs, progress) -> dict`
+    Any hook may be None: the CLI then says the model does not support that analysis.
+    """
+
+    name: str
+    summary: str
+    params_cls: type
+    effects: Mapping[str, Effect]
+    inputs: Mapping[str, Mapping[str, str]]  # input type -> {key: doc}
+    outputs: Mapping[str, str]  # signal -> SI unit
+    engines: tuple[str, ...]
+    scenes_dir: Path
+    default_scene: str
+    run: Callable[..., Any] | None = None
+    equilibrium: Callable[..., Any] | None = None
+    modes: Callable[..., Any] | None = None
+    freqresp: Callable[..., Any] | None = None
+    extra: Mapping[str, Any] = field(default_factory=dict)
+
+    def param_names(self) -> list[str]:
+        return [f.name for f in dataclasses.fields(self.params_cls)]
+
+    def scene_files(self) -> dict[str, Path]:
+        return {p.stem: p for p in sorted(self.scenes_dir.glob("*.toml"))}
+
+
+_MODELS: dict[str, ModelSpec] | None = None
+
+
+def models() -> dict[str, ModelSpec]:
+    """All registered models, discovered once from `mbsuite.models.*` packages exporting `SPEC`."""
+    global _MODELS
+    if _MODELS is None:
+        pkg = importlib.import_module(__package__ + ".models")
+        found: dict[str, ModelSpec] = {}
+        for info in pkgutil.iter_modules(pkg.__path__):
+            if not info.ispkg:
+                continue
+            mod = importlib.import_module(f"{pkg.__name__}.{info.name}")
+            spec = getattr(mod, "SPEC", None)
+            if isinstance(spec, ModelSpec):
+                found[spec.name] = spec
+        _MODELS = found
+    return _MODELS
+
+
+def get_model(name: str) -> ModelSpec:
+    ms = models()
+    if name not in ms:
+        raise SceneError(f"unknown model '{name}'; valid models: {sorted(ms)}")
+    return ms[name]

@@ -1,0 +1,172 @@
+"""Result containers and writers (CSV with SI units in the header, summary.json with versions and scene, tables).
+
+`SimResult` follows scipy's `solve_ivp` result: arrays plus metadata, nothing computed lazily.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import platform
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class SimResult:
+    """A time simulation. `signals[name]` is sampled at `t`; `units[name]` is its SI unit.
+    `events` lists discrete events (e.g. contact losses: {"kind", "t_start", "duration"}); `stats` solver counters."""
+
+    t: np.ndarray
+    signals: dict[str, np.ndarray]
+    units: dict[str, str]
+    engine: str
+    events: list[dict[str, Any]] = field(default_factory=list)
+    stats: dict[str, Any] = field(default_factory=dict)
+    scene: dict[str, Any] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.signals[name]
+
+    def summary(self) -> dict[str, Any]:
+        out = {"engine": self.engine, "n_samples": int(self.t.size), "t_end": float(self.t[-1]) if self.t.size else 0.0}
+        out["signals"] = {
+            k: {"unit": self.units.get(k, ""), "min": float(np.min(v)), "max": float(np.max(v)), "final": float(v[-1])}
+            for k, v in self.signals.items()
+        }
+        out["events"] = self.events
+        out["stats"] = self.stats
+        return out
+
+    def write_csv(self, path: str | Path) -> Path:
+        cols = [("t", "s", self.t)] + [(k, self.units.get(k, ""), v) for k, v in self.signals.items()]
+        return write_csv(path, cols)
+
+
+def write_csv(path: str | Path, columns: Sequence[tuple[str, str, Any]]) -> Path:
+    """Write columns `(name, unit, values)` as CSV; the header reads `name [unit]`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = [np.asarray(c[2]) for c in columns]
+    n = max(a.shape[0] for a in arrays)
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([f"{name} [{unit}]" if unit else name for name, unit, _ in columns])
+        for i in range(n):
+            w.writerow([_fmt(a[i]) if i < a.shape[0] else "" for a in arrays])
+    return path
+
+
+def _fmt(x: Any) -> str:
+    if isinstance(x, float | np.floating):
+        return repr(float(x))
+    return str(x)
+
+
+def versions() -> dict[str, str]:
+    import mujoco
+    import pinocchio
+    import scipy
+
+    from . import __version__
+
+    return {
+        "mbsuite": __version__,
+        "mujoco": mujoco.__version__,
+        "pinocchio": pinocchio.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "python": sys.version.split()[0],
+        "platform": platform.platform(),
+    }
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays and nested containers to JSON types; non-finite floats become null."""
+    if isinstance(obj, Mapping):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return to_jsonable(obj.item())
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def write_summary(out_dir: str | Path, scene: Mapping[str, Any] | None, results: Mapping[str, Any]) -> Path:
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    p = out / "summary.json"
+    p.write_text(json.dumps(to_jsonable({"versions": versions(), "scene": scene, "results": results}), indent=2))
+    return p
+
+
+def format_table(headers: Sequence[str], rows: Sequence[Sequence[Any]], floatfmt: str = ".6g") -> str:
+    """A plain-text table with right-aligned numbers."""
+
+    def cell(v: Any) -> str:
+        if isinstance(v, float | np.floating):
+            return format(float(v), floatfmt)
+        return str(v)
+
+    body = [[cell(v) for v in r] for r in rows]
+    widths = [max(len(str(h)), *(len(r[i]) for r in body)) if body else len(str(h)) for i, h in enumerate(headers)]
+    lines = ["  ".join(str(h).rjust(w) for h, w in zip(headers, widths, strict=True))]
+    lines.append("  ".join("-" * w for w in widths))
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in body]
+    return "\n".join(lines)
+
+
+class Progress:
+    """A minimal progress bar on stderr (only when stderr is a terminal, or `force=True`)."""
+
+    def __init__(self, total: int, desc: str = "", enabled: bool | None = None):
+        self.total = max(int(total), 1)
+        self.n = 0
+        self.desc = desc
+        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+
+    def update(self, k: int = 1) -> None:
+        self.n += k
+        if self.enabled:
+            frac = self.n / self.total
+            bar = "#" * int(30 * frac)
+            sys.stderr.write(f"\r{self.desc} [{bar:<30}] {self.n}/{self.total}")
+            if self.n >= self.total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.enabled and self.n < self.total:
+            sys.stderr.write("\n")
+
+
+@dataclass
+class Report:
+    """What an analysis returns to the CLI: JSON-able `data`, a human `table`, and an optional writer that puts
+    CSV/PNG files into a directory (called only with `--out`). Analyses never print; the CLI never does physics."""
+
+    data: dict[str, Any]
+    table: str
+    write: Any = None  # Callable[[Path], list[Path]] | None
+
+    def save(self, out_dir: str | Path, scene: Mapping[str, Any] | None) -> list[Path]:
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        files = list(self.write(out)) if self.write else []
+        files.append(write_summary(out, scene, self.data))
+        return files

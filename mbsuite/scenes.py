@@ -1,0 +1,235 @@
+"""Scenes: a TOML file naming a model, the effects it needs, parameter overrides, the input, outputs and solver settings.
+
+```toml
+model = "pantograph"
+description = "Eppinger's lab test: ram attached, linear cylinder"
+[effects]            # only what the scene asks for is built; omitted effects take the model's defaults
+cylinder = "linear"
+[params]             # overrides of the model's parameter dataclass (SI units)
+k_s = 180000.0
+[input]
+type = "sine"
+amplitude = 1.85e-3
+frequency = 4.25
+[outputs]
+signals = ["F1", "F2", "HD", "y_d"]
+[solver]
+engine = "mujoco"    # or "reference" (hand-derived numpy/scipy path)
+integrator = "implicitfast"
+timestep = 5e-4
+duration = 10.0
+```
+
+`load_scene(x)` accepts a path to a TOML file, a model name (its default scene) or `model/scene` (a shipped scene).
+Unknown keys, effects, parameters, input types and engines raise `SceneError` listing the valid ones.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SceneError
+from .registry import ModelSpec, get_model, models
+
+TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver")
+INTEGRATORS = ("euler", "implicit", "implicitfast", "rk4", "discrete")
+SCIPY_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Solver settings. MuJoCo uses `integrator` and `timestep`; the reference path uses `method`, `rtol`, `atol`,
+    `max_step`. `duration` is the simulated time (s); `t_settle` the part of it treated as start-up transient."""
+
+    engine: str = "mujoco"
+    integrator: str = "implicitfast"
+    timestep: float = 5e-4
+    method: str = "LSODA"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_step: float = 0.0  # 0 = unlimited
+    duration: float = 10.0
+    t_settle: float = 0.0
+    sample_dt: float = 0.0  # output sampling interval; 0 = every step (MuJoCo) / solver's dense output at timestep
+
+    def check(self, engines: tuple[str, ...]) -> None:
+        if self.engine not in engines:
+            raise SceneError(f"solver.engine = {self.engine!r} is not available; valid engines: {list(engines)}")
+        if self.integrator not in INTEGRATORS:
+            raise SceneError(f"solver.integrator = {self.integrator!r}; valid integrators: {list(INTEGRATORS)}")
+        if self.method not in SCIPY_METHODS:
+            raise SceneError(f"solver.method = {self.method!r}; valid methods: {list(SCIPY_METHODS)}")
+        for name in ("timestep", "rtol", "atol", "duration"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and v > 0):
+                raise SceneError(f"solver.{name} must be a positive number, got {v!r}")
+        for name in ("max_step", "t_settle", "sample_dt"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and v >= 0):
+                raise SceneError(f"solver.{name} must be a non-negative number, got {v!r}")
+        if self.t_settle >= self.duration:
+            raise SceneError(f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
+
+
+SOLVER_KEYS = tuple(f.name for f in dataclasses.fields(SolverSettings))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. `effects` is complete (defaults filled in); `params` holds only the overrides."""
+
+    model: str
+    name: str = ""
+    description: str = ""
+    effects: Mapping[str, Any] = field(default_factory=dict)
+    params: Mapping[str, Any] = field(default_factory=dict)
+    input: Mapping[str, Any] = field(default_factory=dict)
+    outputs: tuple[str, ...] = ()
+    solver: SolverSettings = field(default_factory=SolverSettings)
+    source: str | None = None
+
+    @property
+    def spec(self) -> ModelSpec:
+        return get_model(self.model)
+
+    def build_params(self):
+        """The model's parameter dataclass with this scene's overrides applied (and validated by the dataclass)."""
+        return self.spec.params_cls(**dict(self.params))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "model": self.model,
+            "name": self.name,
+            "description": self.description,
+            "effects": dict(self.effects),
+            "params": dict(self.params),
+            "input": dict(self.input),
+            "outputs": {"signals": list(self.outputs)},
+            "solver": dataclasses.asdict(self.solver),
+        }
+
+    def replace(self, **sections: Mapping[str, Any] | Any) -> Scene:
+        """A new validated scene with sections merged: `scene.replace(effects={"gravity": False}, solver={"timestep": 1e-4})`.
+        Scalars (`name`, `description`) replace; mappings are merged key by key."""
+        d = self.to_dict()
+        for key, val in sections.items():
+            if key not in TOP_KEYS or key == "model":
+                raise SceneError(f"cannot replace scene section {key!r}; valid sections: {list(TOP_KEYS[1:])}")
+            if key == "outputs" and not isinstance(val, Mapping):
+                val = {"signals": list(val)}
+            if isinstance(val, Mapping):
+                merged = dict(d.get(key) or {})
+                merged.update(val)
+                d[key] = merged
+            else:
+                d[key] = val
+        return scene_from_dict(d, source=self.source)
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
+    """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones."""
+    where = f" in {source}" if source else ""
+    data = copy.deepcopy(dict(data))
+    unknown = sorted(set(data) - set(TOP_KEYS))
+    if unknown:
+        raise SceneError(f"unknown scene key(s) {unknown}{where}; valid keys: {list(TOP_KEYS)}")
+    if "model" not in data:
+        raise SceneError(f"scene{where} does not name a model; valid models: {sorted(models())}")
+    spec = get_model(data["model"])
+
+    effects_in = data.get("effects") or {}
+    if not isinstance(effects_in, Mapping):
+        raise SceneError(f"[effects]{where} must be a table")
+    bad = sorted(set(effects_in) - set(spec.effects))
+    if bad:
+        raise SceneError(f"unknown effect(s) {bad} for model '{spec.name}'{where}; valid effects: {sorted(spec.effects)}")
+    effects = {}
+    for name, eff in spec.effects.items():
+        effects[name] = eff.check(name, effects_in.get(name, eff.default))
+
+    params = data.get("params") or {}
+    valid_params = spec.param_names()
+    bad = sorted(set(params) - set(valid_params))
+    if bad:
+        raise SceneError(f"unknown parameter(s) {bad} for model '{spec.name}'{where}; valid parameters: {valid_params}")
+    for k, v in params.items():
+        if isinstance(v, bool) or not isinstance(v, int | float | str | list):
+            raise SceneError(f"parameter {k!r}{where} must be a number (SI units), got {v!r}")
+
+    inp = dict(data.get("input") or {})
+    if spec.inputs:
+        itype = inp.get("type", next(iter(spec.inputs)))
+        if itype not in spec.inputs:
+            raise SceneError(f"input type {itype!r}{where} unknown for '{spec.name}'; valid types: {list(spec.inputs)}")
+        bad = sorted(set(inp) - set(spec.inputs[itype]) - {"type"})
+        if bad:
+            raise SceneError(
+                f"unknown input key(s) {bad} for input type {itype!r}{where}; valid keys: {sorted(spec.inputs[itype])}"
+            )
+        inp["type"] = itype
+
+    outputs = data.get("outputs") or {}
+    if isinstance(outputs, Mapping):
+        bad = sorted(set(outputs) - {"signals"})
+        if bad:
+            raise SceneError(f"unknown key(s) {bad} in [outputs]{where}; valid keys: ['signals']")
+        signals = tuple(outputs.get("signals", tuple(spec.outputs)))
+    else:
+        signals = tuple(outputs)
+    bad = [s for s in signals if s not in spec.outputs]
+    if bad:
+        raise SceneError(f"unknown output signal(s) {bad}{where}; valid signals: {list(spec.outputs)}")
+
+    solver_in = data.get("solver") or {}
+    bad = sorted(set(solver_in) - set(SOLVER_KEYS))
+    if bad:
+        raise SceneError(f"unknown solver key(s) {bad}{where}; valid keys: {list(SOLVER_KEYS)}")
+    defaults = spec.extra.get("solver_defaults", {})
+    solver = SolverSettings(**{**defaults, **solver_in})
+    solver.check(spec.engines)
+
+    scene = Scene(
+        model=spec.name,
+        name=str(data.get("name") or ""),
+        description=str(data.get("description") or ""),
+        effects=effects,
+        params=dict(params),
+        input=inp,
+        outputs=signals,
+        solver=solver,
+        source=source,
+    )
+    scene.build_params()  # parameter dataclasses validate themselves (negative mass etc.)
+    return scene
+
+
+def load_scene(ref: str | Path) -> Scene:
+    """Load a scene from a TOML path, a model name (its default scene) or `model/scene` (a shipped scene)."""
+    p = Path(ref)
+    if p.suffix == ".toml" or p.is_file():
+        if not p.is_file():
+            raise SceneError(f"scene file not found: {p}")
+        try:
+            data = tomllib.loads(p.read_text())
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(f"scene file {p} is not valid TOML: {exc}") from exc
+        data.setdefault("name", p.stem)
+        return scene_from_dict(data, source=str(p))
+    text = str(ref)
+    model, _, scene_name = text.partition("/")
+    spec = get_model(model)
+    files = spec.scene_files()
+    scene_name = scene_name or spec.default_scene
+    if scene_name not in files:
+        raise SceneError(f"model '{model}' has no scene '{scene_name}'; shipped scenes: {sorted(files)}")
+    return load_scene(files[scene_name])
+
+
+def shipped_scenes() -> dict[str, list[str]]:
+    return {name: sorted(spec.scene_files()) for name, spec in models().items()}

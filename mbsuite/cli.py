@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from . import registry
 from .errors import MbsuiteError
-from .results import Report, format_table, to_jsonable
+from .results import Report, SimResult, format_table, to_jsonable
 from .scenes import load_scene
 
 
@@ -61,6 +61,8 @@ def _hook_command(hook: str):
             kwargs = {"f_min": args.f_min, "f_max": args.f_max, "df": args.df, "methods": args.methods,
                       "workers": args.workers}
         report = fn(scene, **kwargs)
+        if isinstance(report, SimResult):
+            report = report.report()
         _emit(report, args, scene.to_dict())
 
     return run

@@ -48,6 +48,19 @@ class SimResult:
         cols = [("t", "s", self.t)] + [(k, self.units.get(k, ""), v) for k, v in self.signals.items()]
         return write_csv(path, cols)
 
+    def report(self) -> Report:
+        """A CLI report: per-signal min/max/final, events, solver stats; `--out` writes run.csv."""
+        rows = [[k, self.units.get(k, ""), float(np.min(v)), float(np.max(v)), float(v[-1])]
+                for k, v in self.signals.items()]
+        table = format_table(["signal", "unit", "min", "max", "final"], rows, ".6g")
+        if self.events:
+            kinds: dict[str, int] = {}
+            for e in self.events:
+                kinds[e.get("kind", "event")] = kinds.get(e.get("kind", "event"), 0) + 1
+            table += "\nevents: " + ", ".join(f"{k} x{n}" for k, n in sorted(kinds.items()))
+        table += f"\nengine {self.engine}; " + ", ".join(f"{k} = {v}" for k, v in self.stats.items())
+        return Report(self.summary(), table, lambda out: [self.write_csv(Path(out) / "run.csv")])
+
 
 def write_csv(path: str | Path, columns: Sequence[tuple[str, str, Any]]) -> Path:
     """Write columns `(name, unit, values)` as CSV; the header reads `name [unit]`."""

@@ -1,0 +1,1 @@
+"""Model-agnostic analyses: sweeps, fundamental projection, work-precision."""

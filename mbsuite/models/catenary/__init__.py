@@ -1,0 +1,42 @@
+"""Pantograph-catenary interaction: a 2-D finite-element catenary (EN 50318:2002 reference scene), the 2-mass reference
+pantograph, a consistent coupled integrator, the EN 50318 statistics, and an adapter for the Eppinger pantograph."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...registry import Effect, ModelSpec
+from .params import CatenaryParams
+
+
+def _run(scene, engine: str | None = None, **kw):
+    from .analysis import report, run_scene
+
+    if engine:
+        scene = scene.replace(solver={"engine": engine})
+    run = run_scene(scene, **kw)
+    return report(run, scene.to_dict())
+
+
+SPEC = ModelSpec(
+    name="catenary",
+    summary="FE catenary (EN 50318 reference) under a moving pantograph: contact force and uplift statistics",
+    params_cls=CatenaryParams,
+    effects={
+        "droppers": Effect(("slack", "linear"), "slack", "slack: tension-only droppers (status solved each step); "
+                                                          "linear: bilateral springs"),
+        "pantograph": Effect(("reference2mass", "eppinger"), "reference2mass",
+                             "reference2mass: EN 50318 2-mass pantograph; eppinger: Brecknell-Willis model of "
+                             "mbsuite.models.pantograph (engine reference = hand-derived ODE, mujoco = MuJoCo)"),
+        "contact": Effect(("unilateral", "bilateral"), "unilateral",
+                          "unilateral: penalty spring that only pushes; bilateral: attached (no contact loss)"),
+    },
+    inputs={"passage": {"speed": "train speed (km/h); --speed overrides it"}},
+    outputs={"contact_force": "N", "contact_force_filtered": "N", "position": "m", "head_height": "m",
+             "wire_height": "m", "slack_droppers": "-", "uplift": "m"},
+    engines=("reference", "mujoco"),
+    scenes_dir=Path(__file__).parent / "scenes",
+    default_scene="en50318",
+    run=_run,
+    extra={"solver_defaults": {"engine": "reference", "timestep": 1e-4, "duration": 6.1}},
+)

@@ -1,0 +1,44 @@
+"""Single and double 4-link (SS-link) couplers of low-floor tram drives (seed 001, Maniowski & Czauderna).
+
+Kinematics hand-derived (reference.py) and in Pinocchio (pinocchio.py), cross-checked; double-coupler dynamics in
+MuJoCo (mujoco.py). See README.md in this package.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...registry import Effect, ModelSpec
+from .mujoco import INPUT_KEYS, OUTPUTS, run
+from .params import CouplerParams
+
+_INPUT_DOCS = {
+    "omega": "input shaft speed after the ramp [rad/s]",
+    "load_torque": "load torque on the output shaft, opposing its rotation [N m]",
+    "alpha_cx": "output shaft inclination about x [rad]",
+    "alpha_cz": "output shaft inclination about z [rad]",
+    "x_c": "output shaft lateral offset along x [m]",
+    "z_c": "output shaft lateral offset along z [m]",
+    "t_ramp": "duration of the smooth speed and load ramp from rest [s]",
+}
+assert set(_INPUT_DOCS) == set(INPUT_KEYS)
+
+SPEC = ModelSpec(
+    name="coupler",
+    summary="single/double 4-link SS couplers: kinematics (rank, screws, criteria) and double-coupler dynamics",
+    params_cls=CouplerParams,
+    effects={
+        "gravity": Effect((True, False), True, "gravity along -z (shaft axis y horizontal)"),
+        "link_inertia": Effect(("real", "massless"), "real",
+                               "real link mass/inertia, or the massless limit (scaled by massless_factor)"),
+        "friction": Effect((False, True), False, "dry friction joint_friction in the S joints and output bearing"),
+    },
+    inputs={"constant_speed": _INPUT_DOCS},
+    outputs=OUTPUTS,
+    engines=("mujoco", "reference"),
+    scenes_dir=Path(__file__).resolve().parent / "scenes",
+    default_scene="double_lateral",
+    run=run,
+    extra={"solver_defaults": {"integrator": "implicitfast", "timestep": 5e-4, "duration": 2.0, "t_settle": 0.5,
+                               "sample_dt": 2e-3}},
+)

@@ -1,0 +1,254 @@
+"""Analyses of the coupler: Jacobian/mobility/screws (seed Sect. 2.3, 3.2, Table 2) and quality criteria c1-c5
+(seed Eqs 16-20, Figs 6-10), as `mbsuite.results.Report`s.
+
+Criteria definitions (README has the discussion):
+- c1 = max |(phi_a - phi_b) - mean| over a revolution (Eq 16 without the pi/2 mounting offset); c1_pp = peak-to-peak.
+- c2 = max(x_b) - min(x_b) (Eq 17); the z-range is also reported (the path of O_b is a closed curve).
+- beta1/beta2 (Fig 3c is not in the text): at each end of each link, with u = R_P^T l_hat the link direction in the
+  platform P's own frame (y = platform normal), beta2 = asin(u_y) is the elevation out of the platform plane and
+  beta1 = atan2(u_z, u_x) the azimuth in the platform plane. c3 = max |beta1 - beta1_0|, c4 = max |beta2 - beta2_0|
+  (deviations from the aligned pose, i.e. the bushing deflection), maxima over links, both ends and the revolution.
+- c5 = max |(phi_a - phi_c) - mean| (Eq 20 without the constant offset -phi_bc).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import GeometryError, SolverError
+from ...results import Report, format_table, write_csv
+from . import reference as ref
+from .params import GAMMAS_PAPER, CouplerParams
+
+TABLE2 = {  # seed l.233-241: e_y -> (S1 point y, S2 point y, |pitch|, chi)
+    0.0: (0.0, 0.0, 0.0, 3e5),
+    0.05: (0.0720, -0.0220, 0.0011, 87.0),
+    0.1: (0.1439, -0.0439, 0.0045, 85.0),
+}
+
+
+COND_WARN = 1e6  # condition numbers above this are reported with a SingularityWarning
+
+
+class SingularityWarning(UserWarning):
+    """The Jacobian is rank deficient (coplanar platforms): the condition number is infinite."""
+
+
+# --------------------------------------------------------------------------------------------------- Jacobian report
+def zero_pitch_pair(principal: list[ref.Screw]) -> list[ref.Screw] | None:
+    """For a 2-system of finite-pitch screws with principal pitches of opposite sign, the two zero-pitch members of the
+    cylindroid (the basis in which Table 2 lists its axes). None otherwise."""
+    fin = [s for s in principal if math.isfinite(s.pitch)]
+    if len(fin) != 2 or fin[0].pitch * fin[1].pitch >= 0:
+        return None
+
+    def tw(sc: ref.Screw) -> np.ndarray:
+        return np.concatenate([np.cross(sc.point, sc.axis) + sc.pitch * sc.axis, sc.axis])
+
+    t1, t2 = tw(fin[0]), tw(fin[1])  # unit omegas, orthogonal, zero cross-pitch
+    th = math.atan(math.sqrt(-fin[0].pitch / fin[1].pitch))
+    out = [ref.twist_to_screw(math.cos(th) * t1 + sgn * math.sin(th) * t2, np.zeros(3)) for sgn in (1, -1)]
+    out.sort(key=lambda sc: int(np.argmax(np.abs(sc.axis))))
+    return out
+
+
+def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0, alpha_bz: float = 0.0,
+                    engine: str = "reference") -> Report:
+    """Mechanism Jacobian of the single coupler at a solved pose: J, singular values, rank, chi, free motions."""
+    if engine not in ("reference", "pinocchio"):
+        from ...errors import SceneError
+
+        raise SceneError(f"unknown engine {engine!r}; valid: ['reference', 'pinocchio']")
+    if p.e_y == 0.0 and not (alpha_bx or alpha_bz):
+        pose = ref.SinglePose(phi_a, 0.0, 0.0, np.array([phi_a - math.pi / 2, 0.0, 0.0, 0.0]))
+    else:
+        pose = ref._ramp_single(p, phi_a, alpha_bx, alpha_bz)
+    _, _, ob, _ = ref.single_points(p, pose.phi_a, alpha_bx, alpha_bz, pose.u)
+    if engine == "pinocchio":
+        from .pinocchio import PinCoupler
+
+        pc = PinCoupler.build("single", p)
+        q = pc.q_of({"phi_a": phi_a, "alpha_bx": alpha_bx, "alpha_bz": alpha_bz,
+                     **dict(zip(("phi_b", "x_b", "y_b", "z_b"), pose.u, strict=True))})
+        J = pc.mechanism_jacobian(q)
+    else:
+        J = ref.single_jacobian(p, pose)
+    an = ref.analyse_jacobian(J, ob)
+    ratio = an.singular_values[-1] / an.singular_values[0]
+    if an.rank < 4:
+        warnings.warn(f"coupler Jacobian is rank {an.rank} < 4 at e_y = {p.e_y:g} (coplanar singularity): "
+                      f"condition number infinite (sigma_min/sigma_max = {ratio:.1e} <= rtol {ref.RANK_RTOL:g})",
+                      SingularityWarning, stacklevel=2)
+    elif an.cond > COND_WARN:
+        warnings.warn(f"coupler Jacobian is nearly singular at e_y = {p.e_y:g}: condition number {an.cond:.3g} > "
+                      f"{COND_WARN:g} (coplanar singularity approached)", SingularityWarning, stacklevel=2)
+    zp = zero_pitch_pair(an.principal_screws)
+    data = {
+        "params": p.geometry(), "pose": {"phi_a": phi_a, "alpha_bx": alpha_bx, "alpha_bz": alpha_bz,
+                                         "phi_b": pose.u[0], "x_b": pose.u[1], "y_b": pose.u[2], "z_b": pose.u[3]},
+        "engine": engine,
+        "J": J, "J_columns": ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"],
+        "J_paper_layout": ref.paper_eq15_layout(J),
+        "singular_values": an.singular_values, "rank": an.rank, "rank_rtol": ref.RANK_RTOL,
+        "cond": an.cond, "cond_closed_form": ref.cond_asymptotic(p),
+        "principal_screws": [s.as_dict() for s in an.principal_screws],
+        "zero_pitch_screws": [s.as_dict() for s in zp] if zp else None,
+        "svd_basis_screws": [s.as_dict() for s in an.svd_screws],
+    }
+    if zp is not None and not (alpha_bx or alpha_bz):
+        # Table 2's +-pitch: the zero-pitch pair turned by theta has pitches -+(d/2) sin(2 theta), d = axis distance
+        d = float(np.linalg.norm(zp[0].point - zp[1].point))
+        data["zero_pitch_axis_distance"] = d
+        if p.e_y in TABLE2 and p.e_y > 0:
+            h = TABLE2[p.e_y][2]
+            data["paper_basis_angle"] = 0.5 * math.asin(min(1.0, h / (d / 2)))
+    rows = []
+    for label, lst in (("principal", an.principal_screws), ("zero-pitch", zp or []), ("SVD basis", an.svd_screws)):
+        for i, s in enumerate(lst):
+            rows.append([label, f"S{i + 1}", np.array2string(s.axis, precision=4, suppress_small=True),
+                         np.array2string(s.point, precision=4, suppress_small=True), s.pitch])
+    table = (f"single coupler Jacobian (rows = links 1-4, columns v_x v_y v_z w_x w_y w_z; v at o^b):\n"
+             f"{np.array2string(J, precision=4, suppress_small=True)}\n"
+             f"singular values {np.array2string(an.singular_values, precision=6)}, rank {an.rank} "
+             f"(rtol {ref.RANK_RTOL:g}), cond {an.cond:.6g} (closed form R cos(2 gamma)/e_y = "
+             f"{ref.cond_asymptotic(p):.6g})\nfree motions (null space of J) as screws:\n"
+             + format_table(["basis", "screw", "axis", "point", "pitch"], rows, ".4g"))
+    return Report(data, table)
+
+
+# ---------------------------------------------------------------------------------------------------------- criteria
+def link_angles(R_P: np.ndarray, lhat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(beta1, beta2) of unit link vectors lhat (k, 3) at a platform with rotation R_P (module docstring)."""
+    u = lhat @ R_P
+    return np.arctan2(u[:, 2], u[:, 0]), np.arcsin(np.clip(u[:, 1], -1, 1))
+
+
+def single_angles(p: CouplerParams, rev: ref.SingleRevolution) -> tuple[np.ndarray, np.ndarray]:
+    """beta1, beta2 over the revolution: arrays (n, 8) = 4 links x (end A, end B)."""
+    b1, b2 = [], []
+    for phi, u in zip(rev.phi_a, rev.u, strict=True):
+        a, b, _, Rb = ref.single_points(p, phi, rev.alpha_bx, rev.alpha_bz, u)
+        lv = b[ref.NEXT] - a
+        lh = lv / np.linalg.norm(lv, axis=1)[:, None]
+        x1, x2 = link_angles(ref.rot_y(phi), lh)
+        y1, y2 = link_angles(Rb, lh)
+        b1.append(np.r_[x1, y1])
+        b2.append(np.r_[x2, y2])
+    return np.array(b1), np.array(b2)
+
+
+def _dev(x: np.ndarray, x0: np.ndarray) -> np.ndarray:
+    return (x - x0 + math.pi) % (2 * math.pi) - math.pi
+
+
+def single_criteria(p: CouplerParams, alpha_b: float, n: int = 181) -> dict:
+    """c1-c4 of the single coupler for inclination alpha_b (= alpha_bx) over one revolution."""
+    rev = ref.single_revolution(p, alpha_b, 0.0, n)
+    nom = ref.single_revolution(p, 0.0, 0.0, 3)
+    b10, b20 = single_angles(p, nom)
+    b1, b2 = single_angles(p, rev)
+    d = rev.phi_a - rev.u[:, 0]
+    db1, db2 = _dev(b1, b10[0]), b2 - b20[0]
+    return {
+        "c1": float(np.max(np.abs(d - d[:-1].mean()))), "c1_pp": float(np.ptp(d)), "mean_phi_a_minus_phi_b": float(
+            d[:-1].mean()),
+        "c2": float(np.ptp(rev.u[:, 1])), "c2_z": float(np.ptp(rev.u[:, 3])),
+        "c3": float(np.max(np.abs(db1))), "c4": float(np.max(np.abs(db2))),
+        "rev": rev, "dbeta1": db1, "dbeta2": db2,
+    }
+
+
+def double_c5(p: CouplerParams, z_c: float, alpha_cx: float = 0.0, alpha_cz: float = 0.0, x_c: float = 0.0,
+              n: int = 91) -> dict:
+    rev = ref.double_revolution(p, alpha_cx, alpha_cz, x_c, z_c, n)
+    d = rev.phi_a - rev.u[:, 0]
+    db = rev.phi_a - rev.u[:, 5]
+    return {"c5": float(np.max(np.abs(d - d[:-1].mean()))), "c5_pp": float(np.ptp(d)), "mean": float(d[:-1].mean()),
+            "c1_intermediate": float(np.max(np.abs(db - db[:-1].mean()))), "rev": rev}
+
+
+ALPHAS = tuple(np.round(np.linspace(0.0, 0.07, 8), 4))  # up to +-4 deg (seed conclusions)
+EYS = (0.1, 0.2, 0.3)
+ZCS = tuple(np.round(np.linspace(0.0, 0.1, 6), 3))
+LBS = (1.0, 2.0, 4.0)
+
+
+def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LBS, phibcs=(0.0, math.pi / 2),
+                    n: int = 121) -> Report:
+    """c1-c4 vs (alpha_b, gamma, e_y) and c5 vs (z_c, phi_bc, l_b); plots in the style of Figs 6-10 with --out."""
+    single_rows, single = [], []
+    for g in gammas:
+        for ey in eys:
+            p = CouplerParams(gamma=g, e_y=ey)
+            for a in alphas:
+                c = single_criteria(p, a, n)
+                single.append({"gamma": g, "e_y": ey, "alpha_b": a,
+                               **{k: c[k] for k in ("c1", "c1_pp", "c2", "c2_z", "c3", "c4")}})
+                single_rows.append([g, ey, a, c["c1"], c["c2"], c["c3"], c["c4"]])
+    double, double_rows = [], []
+    for lb in lbs:
+        for pbc in phibcs:
+            p = CouplerParams(l_b=lb, phi_bc=pbc)
+            for z in zcs:
+                try:
+                    c = double_c5(p, z, n=max(31, n // 2 + 1))
+                except (GeometryError, SolverError):  # shaft b too inclined for e_y: no physical pose
+                    c = {"c5": math.nan, "c5_pp": math.nan, "c1_intermediate": math.nan}
+                double.append({"l_b": lb, "phi_bc": pbc, "z_c": z, "c5": c["c5"], "c5_pp": c["c5_pp"],
+                               "c1_intermediate": c["c1_intermediate"]})
+                double_rows.append([lb, pbc, z, c["c5"], c["c1_intermediate"]])
+    data = {"single": single, "double": double,
+            "definitions": {"c1": "max|phi_a-phi_b-mean|", "c2": "max(x_b)-min(x_b)", "c3": "max|beta1-beta1_0|",
+                            "c4": "max|beta2-beta2_0|", "c5": "max|phi_a-phi_c-mean|"}}
+    table = ("single coupler criteria [rad, R]\n"
+             + format_table(["gamma", "e_y", "alpha_b", "c1", "c2", "c3", "c4"], single_rows, ".4g")
+             + "\n\ndouble coupler c5 [rad] (c1_b = intermediate shaft fluctuation)\n"
+             + format_table(["l_b", "phi_bc", "z_c", "c5", "c1_b"], double_rows, ".4g"))
+
+    def write(out: Path) -> list[Path]:
+        files = [write_csv(out / "criteria_single.csv",
+                           [(k, u, [r[k] for r in single]) for k, u in (("gamma", "rad"), ("e_y", "m"),
+                            ("alpha_b", "rad"), ("c1", "rad"), ("c1_pp", "rad"), ("c2", "m"), ("c2_z", "m"),
+                            ("c3", "rad"), ("c4", "rad"))]),
+                 write_csv(out / "criteria_double.csv",
+                           [(k, u, [r[k] for r in double]) for k, u in (("l_b", "m"), ("phi_bc", "rad"), ("z_c", "m"),
+                            ("c5", "rad"), ("c5_pp", "rad"), ("c1_intermediate", "rad"))])]
+        from . import plots
+
+        files += plots.fig9(single, out / "fig9_criteria_single.png")
+        files += plots.fig10(double, out / "fig10_c5_double.png")
+        files += plots.figs678(CouplerParams(gamma=0.297), out)
+        return files
+
+    return Report(data, table, write)
+
+
+def fpp_report(p: CouplerParams, alpha_bx: float, alpha_bz: float, n: int, engine: str = "reference") -> Report:
+    """Single-coupler pose over one revolution (continuation), optionally cross-checked with Pinocchio."""
+    rev = ref.single_revolution(p, alpha_bx, alpha_bz, n)
+    data = {"phi_a": rev.phi_a, "phi_b": rev.u[:, 0], "x_b": rev.u[:, 1], "y_b": rev.u[:, 2], "z_b": rev.u[:, 3],
+            "params": p.geometry(), "alpha_bx": alpha_bx, "alpha_bz": alpha_bz}
+    if engine == "pinocchio":
+        from .pinocchio import PinCoupler, single_revolution_pin
+
+        pr = single_revolution_pin(PinCoupler.build("single", p), alpha_bx, alpha_bz, rev.phi_a, rev.u[0])
+        data["max_abs_diff_pinocchio"] = float(np.max(np.abs(pr - rev.u)))
+    d = rev.phi_a - rev.u[:, 0]
+    data["c1"] = float(np.max(np.abs(d - d[:-1].mean())))
+    step = max(1, (n - 1) // 12)
+    rows = [[rev.phi_a[i], rev.u[i, 0], rev.u[i, 1], rev.u[i, 2], rev.u[i, 3], d[i] - math.pi / 2]
+            for i in range(0, n, step)]
+    table = format_table(["phi_a", "phi_b", "x_b", "y_b", "z_b", "phi_a-phi_b-pi/2"], rows, ".6g")
+    if "max_abs_diff_pinocchio" in data:
+        table += f"\nmax |reference - Pinocchio| over the revolution: {data['max_abs_diff_pinocchio']:.3e}"
+
+    def write(out: Path) -> list[Path]:
+        return [write_csv(out / "fpp_single.csv", [("phi_a", "rad", rev.phi_a), ("phi_b", "rad", rev.u[:, 0]),
+                                                   ("x_b", "m", rev.u[:, 1]), ("y_b", "m", rev.u[:, 2]),
+                                                   ("z_b", "m", rev.u[:, 3])])]
+
+    return Report(data, table, write)

@@ -1,0 +1,539 @@
+"""Hand-derived kinematics of the single and double 4-link coupler (plain numpy; seed 001, Sect. 2, Eqs 2-7, 12-13).
+
+Conventions (reference B1, README):
+- base frame: y is the input-shaft axis; platforms lie in y = const planes; A's centre is the origin.
+- local S-joint centres of every platform: p_k = R (cos psi_k, 0, sin psi_k), psi_k = pi/2+g, pi/2-g, -pi/2+g, -pi/2-g.
+- R^a = R_y(phi_a) (Eq 2); R^b = R_z(alpha_bz) R_x(alpha_bx) R_y(phi_b) (inclination fixed in space, then spin).
+- single coupler: link k joins a_k to b_{k+1} (k mod 4); nominal phi_b = phi_a - pi/2; o^b = (x_b, e_y + y_b, z_b).
+- double coupler: shaft b carries BA (local points p_k) and BC (local points R_y(phi_bc) p_k + (0, l_b, 0));
+  shaft c (points p_k) sits at o^c = (x_c, 2 e_y + l_b + y_c, z_c), R^c = R_z(a_cz) R_x(a_cx) R_y(phi_c).
+  Coupler 1: a_k -- ba_{k+1}; coupler 2 (mirror image of coupler 1 in shaft b's mid-plane): c_k -- bc_{k+1}.
+  Nominal: phi_b = phi_a - pi/2, phi_c = phi_a + phi_bc.
+- mechanism Jacobian (Eqs 12-13, physical sign): l_dot = J w, w = (v_o, omega) of platform B at o^b in base axes,
+  row k = [l_k^T, ((b_k - o^b) x l_k)^T] with l_k the unit link vector. The paper's printed Eq (15) is the transposed
+  matrix with the moment rows negated ((o - b) x l, Eq 13) and the rows ordered (x, z, -y | m_x, m_z, -m_y):
+  see `paper_eq15_layout`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import GeometryError, SolverError
+from .params import CouplerParams
+
+EY = np.array([0.0, 1.0, 0.0])
+
+
+# ----------------------------------------------------------------------------------------------------------- rotations
+def rot_x(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    """R_y as printed for R^a in Eq (2)."""
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+_SX, _SY, _SZ = skew(np.array([1.0, 0, 0])), skew(EY), skew(np.array([0, 0, 1.0]))
+
+
+def shaft_rotation(alpha_x: float, alpha_z: float, phi: float) -> np.ndarray:
+    """R = R_z(alpha_z) R_x(alpha_x) R_y(phi)."""
+    return rot_z(alpha_z) @ rot_x(alpha_x) @ rot_y(phi)
+
+
+def shaft_rotation_derivs(alpha_x: float, alpha_z: float, phi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(dR/dalpha_x, dR/dalpha_z, dR/dphi) of `shaft_rotation`."""
+    Rz, Rx, Ry = rot_z(alpha_z), rot_x(alpha_x), rot_y(phi)
+    return Rz @ _SX @ Rx @ Ry, _SZ @ Rz @ Rx @ Ry, Rz @ Rx @ Ry @ _SY
+
+
+# ------------------------------------------------------------------------------------------------------------ geometry
+def platform_points(gamma: float, R: float = 1.0) -> np.ndarray:
+    """Local S-joint centres (4, 3): R (cos psi, 0, sin psi), psi = pi/2+g, pi/2-g, -pi/2+g, -pi/2-g (reference B1)."""
+    s, c = math.sin(gamma), math.cos(gamma)
+    return R * np.array([[-s, 0.0, c], [s, 0.0, c], [s, 0.0, -c], [-s, 0.0, -c]])
+
+
+NEXT = np.array([1, 2, 3, 0])  # link k joins point k of the driving side to point k+1 of the driven side
+
+
+def bc_points(p: CouplerParams) -> np.ndarray:
+    """Local points of platform BC in shaft-b coordinates: R_y(phi_bc) p_k + (0, l_b, 0)."""
+    return platform_points(p.gamma, p.R) @ rot_y(p.phi_bc).T + np.array([0.0, p.l_b, 0.0])
+
+
+# --------------------------------------------------------------------------------------------------- Gauss-Newton FPP
+def gauss_newton(
+    fun: Callable[[np.ndarray], np.ndarray],
+    jac: Callable[[np.ndarray], np.ndarray],
+    u0: np.ndarray,
+    *,
+    tol: float = 1e-13,
+    max_iter: int = 50,
+    what: str = "FPP",
+) -> tuple[np.ndarray, int]:
+    """Gauss-Newton u <- u - lstsq(J, r) until |r|_inf <= tol (seed l.147). Raises SolverError with the residual."""
+    u = np.array(u0, dtype=float)
+    r = fun(u)
+    for it in range(max_iter):
+        if not np.all(np.isfinite(r)):
+            break
+        if np.max(np.abs(r)) <= tol:
+            return u, it
+        du = np.linalg.lstsq(jac(u), r, rcond=None)[0]
+        u = u - du
+        r = fun(u)
+    res = float(np.max(np.abs(r))) if np.all(np.isfinite(r)) else float("nan")
+    raise SolverError(f"{what}: Gauss-Newton did not converge in {max_iter} iterations (residual |r|_inf = {res:.3e}, "
+                      f"tolerance {tol:.1e})")
+
+
+# ------------------------------------------------------------------------------------------------------ single coupler
+@dataclass(frozen=True)
+class SinglePose:
+    """Solved pose of the single coupler: inputs (phi_a, alpha_bx, alpha_bz) and unknowns u = (phi_b, x_b, y_b, z_b)."""
+
+    phi_a: float
+    alpha_bx: float
+    alpha_bz: float
+    u: np.ndarray
+
+    @property
+    def phi_b(self) -> float:
+        return float(self.u[0])
+
+
+def single_points(p: CouplerParams, phi_a: float, alpha_bx: float, alpha_bz: float, u: np.ndarray):
+    """(a, b, o_b, R_b): base-frame joint centres of A (Eq 2) and B (Eq 3), B's centre and rotation."""
+    loc = platform_points(p.gamma, p.R)
+    a = loc @ rot_y(phi_a).T
+    Rb = shaft_rotation(alpha_bx, alpha_bz, u[0])
+    ob = np.array([u[1], p.e_y + u[2], u[3]])
+    b = loc @ Rb.T + ob
+    return a, b, ob, Rb
+
+
+def single_residual(p: CouplerParams, phi_a: float, alpha_bx: float, alpha_bz: float, u: np.ndarray) -> np.ndarray:
+    """Eq (4): l_k^T l_k - l^2 with l_k = b_{k+1} - a_k (Eq 5)."""
+    a, b, _, _ = single_points(p, phi_a, alpha_bx, alpha_bz, u)
+    lv = b[NEXT] - a
+    return np.einsum("ij,ij->i", lv, lv) - p.link_length**2
+
+
+def single_residual_jac(p: CouplerParams, phi_a: float, alpha_bx: float, alpha_bz: float, u: np.ndarray) -> np.ndarray:
+    """d(Eq 4)/du, u = (phi_b, x_b, y_b, z_b): 2 l_k^T [dR^b/dphi_b b_loc, I]."""
+    a, b, _, _ = single_points(p, phi_a, alpha_bx, alpha_bz, u)
+    lv = b[NEXT] - a
+    loc = platform_points(p.gamma, p.R)[NEXT]
+    dphi = loc @ shaft_rotation_derivs(alpha_bx, alpha_bz, u[0])[2].T
+    return 2.0 * np.column_stack([np.einsum("ij,ij->i", lv, dphi), lv])
+
+
+def _no_physical(p: CouplerParams, tilt: float, exc: SolverError) -> None:
+    """Re-raise a Gauss-Newton failure as GeometryError when the inclination makes the pose unphysical
+    (e_y < ~1.5 R tilt: platform B would reach platform A's plane), else re-raise the SolverError."""
+    if p.e_y < 1.5 * p.R * tilt:
+        raise GeometryError(f"no physical pose: e_y = {p.e_y:g} is too small for a relative inclination of {tilt:.4g} "
+                            f"rad (need e_y > ~R*alpha = {p.R * tilt:.4g}); platform B would cross platform A "
+                            f"[{exc}]") from exc
+    raise exc
+
+
+def check_physical(p: CouplerParams, links: np.ndarray, axes: list[np.ndarray], what: str) -> None:
+    """Every link must leave the driving platform and reach the driven one from the same side: l_k . s > 0 for both
+    shaft axes s. Otherwise platform B would have crossed platform A (e_y too small for the inclination)."""
+    for s in axes:
+        worst = float(np.min(links @ s) / p.link_length)
+        if worst <= 0.0:
+            raise GeometryError(
+                f"{what}: no physical pose - platform B would cross platform A (a link's axial component "
+                f"{worst:+.3g} l <= 0); e_y = {p.e_y:g} is too small for this misalignment (need e_y > ~R*alpha)")
+
+
+def solve_single(p: CouplerParams, phi_a: float, alpha_bx: float = 0.0, alpha_bz: float = 0.0,
+                 guess: np.ndarray | None = None, *, tol: float = 1e-13) -> SinglePose:
+    """Forward position problem of the single coupler (Gauss-Newton on Eq 4). Physical pose or GeometryError."""
+    if p.e_y == 0.0 and (alpha_bx or alpha_bz):
+        raise GeometryError("single coupler FPP: e_y = 0 (coplanar platforms) admits no inclined physical pose; "
+                            "platform B would cross platform A")
+    u0 = np.array([phi_a - math.pi / 2, 0.0, 0.0, 0.0]) if guess is None else np.asarray(guess, float)
+    try:
+        u, _ = gauss_newton(lambda u: single_residual(p, phi_a, alpha_bx, alpha_bz, u),
+                            lambda u: single_residual_jac(p, phi_a, alpha_bx, alpha_bz, u), u0,
+                            tol=tol * p.R**2, what=f"single coupler FPP at phi_a = {phi_a:.6g}")
+    except SolverError as exc:
+        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc)
+    a, b, _, Rb = single_points(p, phi_a, alpha_bx, alpha_bz, u)
+    if p.e_y > 0.0:
+        check_physical(p, b[NEXT] - a, [EY, Rb @ EY], "single coupler FPP")
+    return SinglePose(phi_a, alpha_bx, alpha_bz, u)
+
+
+def _ramp_single(p: CouplerParams, phi_a: float, alpha_bx: float, alpha_bz: float, n: int = 8) -> SinglePose:
+    """Continuation in the inclination from the aligned pose (exact there) to (alpha_bx, alpha_bz)."""
+    pose = solve_single(p, phi_a)
+    for s in np.linspace(0.0, 1.0, n + 1)[1:]:
+        pose = solve_single(p, phi_a, s * alpha_bx, s * alpha_bz, pose.u)
+    return pose
+
+
+def continuation(step: Callable[[float, np.ndarray], np.ndarray], u0: np.ndarray, phis: np.ndarray,
+                 jump: Callable[[np.ndarray, np.ndarray, float], float], what: str,
+                 max_halvings: int = 8) -> np.ndarray:
+    """Follow a solution branch along phis (first entry solved already as u0), predicting with the last increment and
+    halving the step whenever the corrector jumps (jump(u_prev, u_new, dphi) > 1). Raises SolverError on failure."""
+    out = np.empty((phis.size, u0.size))
+    out[0] = u0
+    u_prev, du_prev, phi_prev = u0.copy(), np.zeros_like(u0), phis[0]
+    for i in range(1, phis.size):
+        target = phis[i]
+        h = target - phi_prev
+        while phi_prev < target - 1e-15 or phi_prev > target + 1e-15:
+            for _ in range(max_halvings + 1):
+                hh = min(h, target - phi_prev) if h > 0 else max(h, target - phi_prev)
+                frac = hh / (phis[i] - phis[i - 1])
+                try:
+                    u_new = step(phi_prev + hh, u_prev + du_prev * frac)
+                    ok = jump(u_prev, u_new, hh) <= 1.0
+                except (SolverError, GeometryError):
+                    ok = False
+                    err = True
+                else:
+                    err = False
+                if ok:
+                    break
+                h = hh / 2
+            else:
+                kind = "did not converge" if err else "jumped to another branch"
+                raise SolverError(f"{what}: continuation {kind} at phi_a = {phi_prev:.6g} after {max_halvings} "
+                                  "step halvings")
+            du_prev = (u_new - u_prev) * ((phis[i] - phis[i - 1]) / hh)
+            u_prev, phi_prev = u_new, phi_prev + hh
+        out[i] = u_prev
+    return out
+
+
+@dataclass
+class SingleRevolution:
+    phi_a: np.ndarray
+    u: np.ndarray  # (n, 4): phi_b, x_b, y_b, z_b
+    alpha_bx: float
+    alpha_bz: float
+
+
+def single_revolution(p: CouplerParams, alpha_bx: float = 0.0, alpha_bz: float = 0.0, n: int = 181,
+                      phi_start: float = 0.0) -> SingleRevolution:
+    """FPP over one revolution of phi_a (n samples including both ends) by continuation; no branch jumps (checked)."""
+    phis = phi_start + np.linspace(0.0, 2 * math.pi, n)
+    u0 = _ramp_single(p, phis[0], alpha_bx, alpha_bz).u
+
+    def step(phi: float, guess: np.ndarray) -> np.ndarray:
+        return solve_single(p, phi, alpha_bx, alpha_bz, guess).u
+
+    def jump(u_prev: np.ndarray, u_new: np.ndarray, dphi: float) -> float:
+        # output angle must follow the input within 0.5 dphi + 0.05 rad; centre within 0.1 R per step
+        dang = abs((u_new[0] - u_prev[0]) - dphi) / (0.5 * abs(dphi) + 0.05)
+        dpos = np.max(np.abs(u_new[1:] - u_prev[1:])) / (0.1 * p.R)
+        return max(dang, dpos)
+
+    try:
+        u = continuation(step, u0, phis, jump, "single coupler FPP")
+    except SolverError as exc:
+        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc)
+    return SingleRevolution(phis, u, alpha_bx, alpha_bz)
+
+
+# -------------------------------------------------------------------------------------------------- mechanism Jacobian
+def mechanism_jacobian(links_from: np.ndarray, links_to: np.ndarray, o: np.ndarray) -> np.ndarray:
+    """Eqs (12)-(13), physical sign: row k = [l_k^T, ((b_k - o) x l_k)^T], l_k unit vector from a_k to b_k, so that
+    l_dot = J (v_o, omega) for a rigid motion of the platform carrying b_k."""
+    lv = links_to - links_from
+    lh = lv / np.linalg.norm(lv, axis=1)[:, None]
+    return np.hstack([lh, np.cross(links_to - o, lh)])
+
+
+def single_jacobian(p: CouplerParams, pose: SinglePose | None = None) -> np.ndarray:
+    """Mechanism Jacobian (4 x 6) of the single coupler at a solved pose (default: phi_a = 0, aligned, i.e. the
+    coplanar pose of Eq 15 when e_y = 0)."""
+    if pose is None:
+        pose = SinglePose(0.0, 0.0, 0.0, np.array([-math.pi / 2, 0.0, 0.0, 0.0]))
+    a, b, ob, _ = single_points(p, pose.phi_a, pose.alpha_bx, pose.alpha_bz, pose.u)
+    return mechanism_jacobian(a, b[NEXT], ob)
+
+
+EQ15 = np.array([
+    [-0.7071, 0.7071, 0.7071, -0.7071],
+    [-0.7071, -0.7071, 0.7071, 0.7071],
+    [0, 0, 0, 0],
+    [0, 0, 0, 0],
+    [0, 0, 0, 0],
+    [-0.8829, 0.8829, -0.8829, 0.8829],
+])  # seed l.245, printed 6 x 4 (one column per link)
+
+
+def paper_eq15_layout(J: np.ndarray) -> np.ndarray:
+    """Our 4 x 6 J (columns v_x, v_y, v_z, w_x, w_y, w_z; rows = links 1..4) in the paper's printed layout: the 6 x 4
+    transpose with Eq (13)'s moment sign ((o - b) x l = -our moment) and rows (x, z, -y | m_x, m_z, -m_y), i.e. a proper
+    frame (x, z, -y) whose third axis is the shaft (reference B1)."""
+    Jp = np.vstack([J[:, :3].T, -J[:, 3:].T])  # 6 x 4, Eq (13) sign
+    rows = [0, 2, 1, 3, 5, 4]
+    sign = np.array([1, 1, -1, 1, 1, -1])[:, None]
+    return sign * Jp[rows]
+
+
+# ---------------------------------------------------------------------------------------------- rank, SVD and screws
+RANK_RTOL = 1e-9  # singular values below RANK_RTOL * sigma_max count as zero (documented relative tolerance)
+
+
+@dataclass
+class Screw:
+    """Instantaneous screw of a twist (v at o, omega): unit axis, the point of the axis nearest to o, pitch
+    h = omega.v / |omega|^2 (inf for a pure translation, whose axis is v/|v| through o), magnitude |omega| (or |v|)."""
+
+    axis: np.ndarray
+    point: np.ndarray
+    pitch: float
+    magnitude: float
+
+    def as_dict(self) -> dict:
+        return {"axis": self.axis, "point": self.point, "pitch": self.pitch, "magnitude": self.magnitude}
+
+
+def twist_to_screw(t: np.ndarray, o: np.ndarray, eps: float = 1e-12) -> Screw:
+    v, w = t[:3], t[3:]
+    nw = float(np.linalg.norm(w))
+    if nw <= eps * max(1.0, float(np.linalg.norm(v))):
+        nv = float(np.linalg.norm(v))
+        return Screw(v / nv, o.copy(), math.inf, nv)
+    return Screw(w / nw, o + np.cross(w, v) / nw**2, float(w @ v) / nw**2, nw)
+
+
+@dataclass
+class JacobianAnalysis:
+    J: np.ndarray
+    singular_values: np.ndarray
+    rank: int
+    cond: float
+    null_space: np.ndarray  # (6, 6 - rank): orthonormal basis from the SVD
+    svd_screws: list[Screw]  # screws of the SVD basis vectors (basis-dependent pitches)
+    principal_screws: list[Screw]  # basis-independent principal screws of the null space
+
+
+def principal_twists(N: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Principal basis of a screw system spanned by the columns of N (6 x k): pure translations (omega = 0) first, then
+    the remaining twists diagonalising the pitch form omega.v against omega.omega (generalised eigenproblem)."""
+    k = N.shape[1]
+    W = N[3:]
+    _, s, Vt = np.linalg.svd(W)
+    r = int(np.sum(s > tol * max(1.0, s[0] if s.size else 0.0)))
+    trans = N @ Vt[r:].T  # omega = 0
+    rot = N @ Vt[:r].T
+    out = []
+    if trans.shape[1]:
+        out.append(trans)
+    if r:
+        Wr, Vr = rot[3:], rot[:3]
+        Qw = Wr.T @ Wr
+        Qh = 0.5 * (Wr.T @ Vr + Vr.T @ Wr)
+        # generalised symmetric eigenproblem via Cholesky of Qw (positive definite on the rotational part)
+        Lc = np.linalg.cholesky(Qw)
+        Li = np.linalg.inv(Lc)
+        _, vecs = np.linalg.eigh(Li @ Qh @ Li.T)
+        out.append(rot @ (Li.T @ vecs))
+    T = np.hstack(out) if out else np.zeros((6, 0))
+    assert T.shape[1] == k
+    return T
+
+
+def analyse_jacobian(J: np.ndarray, o: np.ndarray, rtol: float = RANK_RTOL) -> JacobianAnalysis:
+    """Rank (SVD, relative tolerance rtol), condition number sigma_max/sigma_min of the 4 singular values (Eq 14;
+    inf when sigma_min == 0), null space -> free motions of the platform as screws (seed Sect. 2.3)."""
+    _, s, Vt = np.linalg.svd(J)
+    rank = int(np.sum(s > rtol * s[0]))
+    smin = s[min(J.shape) - 1]
+    cond = math.inf if smin <= rtol * s[0] * 1e-6 else float(s[0] / smin)
+    N = Vt[rank:].T
+    svd_screws = [twist_to_screw(N[:, i], o) for i in range(N.shape[1])]
+    P = principal_twists(N)
+    principal = [twist_to_screw(P[:, i], o) for i in range(P.shape[1])]
+    # order: translations first, then by the dominant axis component x, y, z
+    principal.sort(key=lambda sc: (math.isfinite(sc.pitch), int(np.argmax(np.abs(sc.axis)))))
+    return JacobianAnalysis(J, s, rank, cond, N, svd_screws, principal)
+
+
+def cond_asymptotic(p: CouplerParams) -> float:
+    """Leading-order condition number of the single coupler's J at the aligned pose for small e_y (README):
+    sigma_max = 2 R cos(pi/4 - g) l0 / l, sigma_min = 2 e_y / l  =>  chi ~ R cos(2 g) / e_y."""
+    return math.inf if p.e_y == 0 else p.R * math.cos(2 * p.gamma) / p.e_y
+
+
+def pitch_of_mixed_basis(s1: Screw, s2: Screw, theta: float) -> tuple[float, float]:
+    """Pitches of the orthonormal basis rotated by theta from two zero-pitch principal rotations (unit omegas):
+    t1' = cos t1 + sin t2, t2' = -sin t1 + cos t2 (used to show Table 2's pitches are basis artefacts)."""
+    def tw(sc: Screw) -> np.ndarray:
+        return np.concatenate([np.cross(sc.point, sc.axis), sc.axis])
+
+    t1, t2 = tw(s1), tw(s2)
+    c, s = math.cos(theta), math.sin(theta)
+    return twist_to_screw(c * t1 + s * t2, np.zeros(3)).pitch, twist_to_screw(-s * t1 + c * t2, np.zeros(3)).pitch
+
+
+# ------------------------------------------------------------------------------------------------------ double coupler
+DOUBLE_UNKNOWNS = ("phi_c", "y_c", "x_b", "y_b", "z_b", "phi_b", "alpha_bx", "alpha_bz")  # Table 1 (errata l.90)
+DOUBLE_INPUTS = ("phi_a", "alpha_cx", "alpha_cz", "x_c", "z_c")
+
+
+def double_points(p: CouplerParams, inp: np.ndarray, u: np.ndarray):
+    """(a, ba, bc, c, o_b, R_b, o_c, R_c) in the base frame (Eqs 2, 3, 6); inp = (phi_a, a_cx, a_cz, x_c, z_c)."""
+    phi_a, acx, acz, xc, zc = inp
+    phi_c, yc, xb, yb, zb, phi_b, abx, abz = u
+    loc = platform_points(p.gamma, p.R)
+    a = loc @ rot_y(phi_a).T
+    Rb = shaft_rotation(abx, abz, phi_b)
+    ob = np.array([xb, p.e_y + yb, zb])
+    ba = loc @ Rb.T + ob
+    bc = bc_points(p) @ Rb.T + ob
+    Rc = shaft_rotation(acx, acz, phi_c)
+    oc = np.array([xc, 2 * p.e_y + p.l_b + yc, zc])
+    c = loc @ Rc.T + oc
+    return a, ba, bc, c, ob, Rb, oc, Rc
+
+
+def double_residual(p: CouplerParams, inp: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Eq (4) with Eq (7): 8 residuals |ba_{k+1} - a_k|^2 - l^2 and |bc_{k+1} - c_k|^2 - l^2."""
+    a, ba, bc, c, *_ = double_points(p, inp, u)
+    l1, l2 = ba[NEXT] - a, bc[NEXT] - c
+    return np.concatenate([np.einsum("ij,ij->i", l1, l1), np.einsum("ij,ij->i", l2, l2)]) - p.link_length**2
+
+
+def double_residual_jac(p: CouplerParams, inp: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Analytic d(residual)/du (8 x 8), u ordered as DOUBLE_UNKNOWNS."""
+    phi_a, acx, acz, xc, zc = inp
+    phi_c, yc, xb, yb, zb, phi_b, abx, abz = u
+    a, ba, bc, c, ob, Rb, oc, Rc = double_points(p, inp, u)
+    l1, l2 = ba[NEXT] - a, bc[NEXT] - c
+    loc = platform_points(p.gamma, p.R)
+    dbx, dbz, dbp = shaft_rotation_derivs(abx, abz, phi_b)
+    dcp = shaft_rotation_derivs(acx, acz, phi_c)[2]
+    J = np.zeros((8, 8))
+    pa, pc = loc[NEXT], bc_points(p)[NEXT]
+    # coupler 1 depends on shaft b only
+    J[:4, 2:5] = l1
+    J[:4, 5] = np.einsum("ij,ij->i", l1, pa @ dbp.T)
+    J[:4, 6] = np.einsum("ij,ij->i", l1, pa @ dbx.T)
+    J[:4, 7] = np.einsum("ij,ij->i", l1, pa @ dbz.T)
+    # coupler 2: l = bc_{k+1} - c_k
+    J[4:, 2:5] = l2
+    J[4:, 5] = np.einsum("ij,ij->i", l2, pc @ dbp.T)
+    J[4:, 6] = np.einsum("ij,ij->i", l2, pc @ dbx.T)
+    J[4:, 7] = np.einsum("ij,ij->i", l2, pc @ dbz.T)
+    J[4:, 0] = -np.einsum("ij,ij->i", l2, loc @ dcp.T)
+    J[4:, 1] = -l2[:, 1]
+    return 2.0 * J
+
+
+def double_nominal(p: CouplerParams, inp: np.ndarray) -> np.ndarray:
+    """Exact solution for zero misalignment (a_cx = a_cz = x_c = z_c = 0)."""
+    return np.array([inp[0] + p.phi_bc, 0.0, 0.0, 0.0, 0.0, inp[0] - math.pi / 2, 0.0, 0.0])
+
+
+def solve_double(p: CouplerParams, inp, guess: np.ndarray | None = None, *, tol: float = 1e-13) -> np.ndarray:
+    """FPP of the double coupler: 8 unknowns (DOUBLE_UNKNOWNS) from 5 inputs (DOUBLE_INPUTS), Gauss-Newton on Eq 4."""
+    inp = np.asarray(inp, float)
+    if p.e_y == 0.0 and np.any(inp[1:] != 0.0):
+        raise GeometryError("double coupler FPP: e_y = 0 (coplanar platforms) admits no misaligned physical pose")
+    u0 = double_nominal(p, inp) if guess is None else np.asarray(guess, float)
+    try:
+        u, _ = gauss_newton(lambda u: double_residual(p, inp, u), lambda u: double_residual_jac(p, inp, u), u0,
+                            tol=tol * p.R**2, what=f"double coupler FPP at phi_a = {inp[0]:.6g}")
+    except SolverError as exc:
+        _no_physical(p, _double_tilt(p, inp), exc)
+    if p.e_y > 0.0:
+        a, ba, bc, c, _, Rb, _, Rc = double_points(p, inp, u)
+        check_physical(p, ba[NEXT] - a, [EY, Rb @ EY], "double coupler FPP (coupler A-BA)")
+        check_physical(p, c - bc[NEXT], [Rb @ EY, Rc @ EY], "double coupler FPP (coupler BC-C)")
+    return u
+
+
+def _double_tilt(p: CouplerParams, inp: np.ndarray) -> float:
+    """Rough relative inclination of shaft b against a or c: output inclination plus lateral offset over the span."""
+    return float(math.hypot(inp[1], inp[2]) + math.hypot(inp[3], inp[4]) / (p.l_b + 2 * p.e_y))
+
+
+def _ramp_double(p: CouplerParams, inp: np.ndarray, n: int = 8) -> np.ndarray:
+    base = inp.copy()
+    base[1:] = 0.0
+    u = double_nominal(p, base)
+    for s in np.linspace(0.0, 1.0, n + 1)[1:]:
+        x = inp.copy()
+        x[1:] *= s
+        u = solve_double(p, x, u)
+    return u
+
+
+@dataclass
+class DoubleRevolution:
+    phi_a: np.ndarray
+    u: np.ndarray  # (n, 8) ordered as DOUBLE_UNKNOWNS
+    inputs: np.ndarray  # (alpha_cx, alpha_cz, x_c, z_c)
+
+
+def double_revolution(p: CouplerParams, alpha_cx: float = 0.0, alpha_cz: float = 0.0, x_c: float = 0.0,
+                      z_c: float = 0.0, n: int = 181, phi_start: float = 0.0) -> DoubleRevolution:
+    """FPP of the double coupler over one revolution of phi_a by continuation (branch jumps detected)."""
+    rest = np.array([alpha_cx, alpha_cz, x_c, z_c], float)
+    phis = phi_start + np.linspace(0.0, 2 * math.pi, n)
+    u0 = _ramp_double(p, np.concatenate([[phis[0]], rest]))
+
+    def step(phi: float, guess: np.ndarray) -> np.ndarray:
+        return solve_double(p, np.concatenate([[phi], rest]), guess)
+
+    def jump(u_prev: np.ndarray, u_new: np.ndarray, dphi: float) -> float:
+        dang = max(abs((u_new[0] - u_prev[0]) - dphi), abs((u_new[5] - u_prev[5]) - dphi)) / (0.5 * abs(dphi) + 0.05)
+        dpos = np.max(np.abs(np.r_[u_new[1:5], u_new[6:]] - np.r_[u_prev[1:5], u_prev[6:]])) / 0.1
+        return max(dang, dpos)
+
+    try:
+        u = continuation(step, u0, phis, jump, "double coupler FPP")
+    except SolverError as exc:
+        _no_physical(p, _double_tilt(p, np.r_[0.0, rest]), exc)
+    return DoubleRevolution(phis, u, rest)
+
+
+def double_output_angle(p: CouplerParams, inp: np.ndarray, guess: np.ndarray | None = None) -> float:
+    return float(solve_double(p, inp, guess)[0])
+
+
+def double_quasi_static(p: CouplerParams, inp, u: np.ndarray, load_torque: float) -> tuple[np.ndarray, float]:
+    """Quasi-static link tensions f (8, tension > 0) and input torque of the double coupler with massless links, no
+    gravity and a load torque opposing phi_c, by virtual work: K_u^T f = Q with K_u = d|l|/du (square, 8 x 8) and
+    Q = (-T_load, 0, ..., 0) on (phi_c, ...); T_in = f . d|l|/dphi_a (= T_load dphi_c/dphi_a)."""
+    inp = np.asarray(inp, float)
+    K = double_residual_jac(p, inp, u) / (2.0 * p.link_length)
+    Q = np.zeros(8)
+    Q[0] = -load_torque
+    f = np.linalg.solve(K.T, Q)
+    a, ba, *_ = double_points(p, inp, u)
+    l1 = ba[NEXT] - a
+    lh = l1 / np.linalg.norm(l1, axis=1)[:, None]
+    loc = platform_points(p.gamma, p.R)
+    da = loc @ (rot_y(inp[0]) @ _SY).T  # d a_k / d phi_a
+    dl = np.concatenate([-np.einsum("ij,ij->i", lh, da), np.zeros(4)])
+    return f, float(f @ dl)

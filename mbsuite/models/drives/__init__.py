@@ -1,0 +1,46 @@
+"""Switched-mode mechanical drives (Oldaker 1997): step-up and step-up/step-down three-mass models with event-exact
+clutches, switching controllers, losses and Chapter 5 design tools; plus Modelica's CoupledClutches as an outside check.
+
+Two independent paths: the hand-derived event-exact stick/slip simulation (`friction.simulate_reference`) and MuJoCo
+(`mujoco_path.MujocoRotorSim`, hinge rotors with real equality locks). See README.md.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...registry import Effect, ModelSpec
+from .model import SIGNALS, run
+from .params import PARAM_SETS, DriveParams
+
+SPEC = ModelSpec(
+    name="drives",
+    summary="switched-mode mechanical drives (step-up, step-up/step-down) with exact clutches; CoupledClutches",
+    params_cls=DriveParams,
+    effects={
+        "mechanism": Effect(("step_up", "step_up_down", "coupled_clutches"), "step_up",
+                            "which rotor system: Fig 3.3, Fig 3.4 or Modelica's CoupledClutches"),
+        "param_set": Effect(tuple(PARAM_SETS), "table_4_2", "parameter set (Table 4.2, 100 W design/prototype, App. J)"),
+        "controller": Effect(("none", "pwm", "resonant", "motor_resonant", "energy_packet"), "pwm",
+                             "switching algorithm (App. E / App. F)"),
+        "clutch_matching": Effect((True, False), False, "step-up: delay clutch engagement to the velocity match (Eq 2.1)"),
+        "closed_loop": Effect((True, False), False, "PI on t_k (step-up) / energy-packet PI (step-up/step-down)"),
+        "anti_windup": Effect((True, False), False, "store the clamped PI state (step-up: printed code has none; "
+                              "step-up/step-down energy-packet PI always clamps to the spring capacity)"),
+        "clutch_delays": Effect((True, False), True, "pure actuation delays quantised to controller samples"),
+        "bearing_friction": Effect((True, False), True, "viscous + Coulomb bearings (with stiction)"),
+        "added_motor_inertia": Effect((True, False), False, "add J_add to the motor (L959, L1987)"),
+    },
+    inputs={
+        "reference": {"value": "constant speed reference (rad/s)",
+                      "profile": "[[t, r], ...] piecewise-linear reference (rad/s)"},
+        "none": {},
+    },
+    outputs=SIGNALS,
+    engines=("reference", "mujoco"),
+    scenes_dir=Path(__file__).parent / "scenes",
+    default_scene="step_up_pwm",
+    run=run,
+    extra={"solver_defaults": {"engine": "reference", "integrator": "rk4", "timestep": 1e-4, "rtol": 1e-9,
+                               "atol": 1e-11, "duration": 2.0}},
+)

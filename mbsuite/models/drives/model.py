@@ -1,0 +1,138 @@
+"""Scene -> simulation for the drives model (the `run` hook) and the CoupledClutches comparison."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ...errors import SceneError
+from ...paths import mjcf_path
+from ...results import SimResult
+from ...scenes import Scene
+from . import coupled_clutches as cc
+from . import drive
+from .friction import RefResult, simulate_reference
+
+SIGNALS = {
+    "w_motor": "rad/s", "w_spring": "rad/s", "w_load": "rad/s",
+    "theta_motor": "rad", "theta_spring": "rad", "theta_load": "rad", "extension": "rad",
+    "w1": "rad/s", "w2": "rad/s", "w3": "rad/s", "w4": "rad/s",
+    "E_in": "J", "E_out": "J", "E_loss": "J", "u_brake": "1", "u_clutch": "1", "u_clutch_a": "1", "u_clutch_b": "1",
+}
+
+
+def reference_signal(inp: dict[str, Any], default: float):
+    """The speed reference: `value` (rad/s) or `profile` = [[t, r], ...] (piecewise linear, as App. J `ref_signal`)."""
+    if "profile" in inp:
+        prof = np.asarray(inp["profile"], float)
+        if prof.ndim != 2 or prof.shape[1] != 2 or prof.shape[0] < 1 or np.any(np.diff(prof[:, 0]) < 0):
+            raise SceneError(f"input.profile must be a list of [t, r] pairs with increasing t, got {inp['profile']!r}")
+        return lambda t: float(np.interp(t, prof[:, 0], prof[:, 1]))
+    return float(inp.get("value", default))
+
+
+def simulate_scene(scene: Scene) -> tuple[RefResult, Any, Any]:
+    """Run a scene on its engine; returns (result, controller, rotor system)."""
+    eff = dict(scene.effects)
+    mech = eff["mechanism"]
+    sv = scene.solver
+    if mech == "coupled_clutches":
+        system = cc.build_system()
+        if sv.engine == "reference":
+            res = simulate_reference(system, cc.Q0, cc.W0, sv.duration, sample_dt=sv.sample_dt or 5e-4,
+                                     rtol=sv.rtol, atol=sv.atol)
+        else:
+            from .mujoco_path import MujocoRotorSim
+
+            sim = MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=sv.timestep,
+                                 integrator=sv.integrator)
+            res = sim.run(cc.Q0, cc.W0, sv.duration, sample_dt=sv.sample_dt or 5e-4)
+        return res, None, system
+    p = scene.build_params().resolved(eff["param_set"])
+    system = drive.build_system(mech, p, eff)
+    ref = reference_signal(dict(scene.input), p["ref"] or 0.0)
+    kind = eff["controller"]
+    if kind == "none":
+        raise SceneError(f"mechanism {mech!r} needs a controller; valid: pwm, resonant, motor_resonant, energy_packet")
+    ctrl = drive.build_controller(mech, kind, p, eff, ref=ref)
+    if mech == "step_up" and callable(ref):
+        raise SceneError("the step-up drive takes a constant reference (input.value)")
+    if mech == "step_up" and not callable(ref):
+        ctrl.ref = ref
+    dt_c = 1.0 / p["fs"]
+    if sv.engine == "reference":
+        res = simulate_reference(system, np.zeros(3), np.zeros(3), sv.duration, controller=ctrl,
+                                 sample_dt=sv.sample_dt or dt_c, rtol=sv.rtol, atol=sv.atol)
+    else:
+        from .mujoco_path import MujocoRotorSim
+
+        if abs(dt_c / sv.timestep - round(dt_c / sv.timestep)) > 1e-9:
+            raise SceneError(f"solver.timestep {sv.timestep} must divide the controller period {dt_c}")
+        sim = MujocoRotorSim(system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep, integrator=sv.integrator)
+        res = sim.run(np.zeros(3), np.zeros(3), sv.duration, controller=ctrl, sample_dt=sv.sample_dt or dt_c)
+    return res, ctrl, system
+
+
+def run(scene: Scene) -> SimResult:
+    res, ctrl, system = simulate_scene(scene)
+    mech = scene.effects["mechanism"]
+    sig: dict[str, np.ndarray] = {}
+    if mech == "coupled_clutches":
+        for i in range(4):
+            sig[f"w{i + 1}"] = res.w[i]
+    else:
+        for i, nm in enumerate(("motor", "spring", "load")):
+            sig[f"w_{nm}"] = res.w[i]
+            sig[f"theta_{nm}"] = res.q[i]
+        sig["extension"] = res.q[0] - res.q[1] if mech == "step_up" else res.q[1]
+        names = {"brake": "u_brake", "clutch": "u_clutch", "ca": "u_clutch_a", "cb": "u_clutch_b"}
+        for c, v in res.u.items():
+            sig[names[c]] = v
+    outputs = {p.label for f in system.frictions for p in f.parts if p.output}
+    sig["E_in"] = res.energy["source"]
+    sig["E_out"] = sum((res.energy[k] for k in outputs), np.zeros_like(res.t))
+    sig["E_loss"] = sum((v for k, v in res.energy.items() if k != "source" and k not in outputs),
+                        np.zeros_like(res.t))
+    wanted = [s for s in scene.outputs if s in sig]
+    bal = drive.energy_balance(system, res)
+    stats: dict[str, Any] = dict(res.stats)
+    stats["energy_balance"] = {"input": bal.input, "output": bal.output, "stored": bal.stored,
+                               "losses": bal.losses, "residual": bal.residual, "relative": bal.relative}
+    if ctrl is not None:
+        cs = drive.cycle_stats(res, ctrl, t0=scene.solver.t_settle)
+        cs.pop("packets", None)
+        stats["cycles"] = cs
+    return SimResult(t=res.t, signals={k: sig[k] for k in wanted}, units={k: SIGNALS[k] for k in wanted},
+                     engine=scene.solver.engine, events=res.events, stats=stats, scene=scene.to_dict())
+
+
+def coupled_clutches_table(engines=("reference", "mujoco"), timestep: float = 1e-4) -> dict[str, Any]:
+    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s."""
+    ref = cc.load_reference()
+    rev = cc.reference_events(ref)
+    out: dict[str, Any] = {"reference_events": rev}
+    system = cc.build_system()
+    grid = np.round(np.arange(0.0, cc.T_END + 1e-9, 0.1), 10)
+    j_ref = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
+    out["grid"] = grid.tolist()
+    out["w_ref"] = ref["w"][:, j_ref].T.tolist()
+    for eng in engines:
+        if eng == "reference":
+            res = simulate_reference(system, cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)
+        else:
+            from .mujoco_path import MujocoRotorSim
+
+            res = MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=timestep).run(
+                cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)
+        ev = cc.events_as_codes(res.events)
+        rows = cc.match_events(ev, rev)
+        idx = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
+        w = res.w[:, idx].T
+        dts = [r["t"] - r["t_ref"] for r in rows if r["t"] is not None and r["t_ref"] is not None]
+        out[eng] = {"events": rows, "w": w.tolist(),
+                    "same_sequence": all(r["t"] is not None and r["t_ref"] is not None for r in rows),
+                    "max_event_dt": float(max(abs(x) for x in dts)) if dts else math.nan,
+                    "max_w_err": float(np.max(np.abs(w - np.asarray(out["w_ref"]))))}
+    return out

@@ -1,0 +1,152 @@
+"""Parameters of the switched-mode drives (Oldaker 1997, seed 004) and of Modelica's CoupledClutches.
+
+`DriveParams` holds scene overrides (SI units); every field left at None takes the value of the scene's parameter set
+(`PARAM_SETS`, chosen by the `param_set` effect). Line numbers `Lnnn` refer to `shared/seeds/004_2c13465951241a5f.txt`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from ...errors import ParameterError
+
+# ---- parameter sets -------------------------------------------------------------------------------------------------
+# Step-up prototype, Table 4.2 (L1155-1176). J_l printed 6.76e-5 is a typo: load disk A is 6.76e-4 (L1090); the clutch
+# parts J_c = 1.81e-5 (L1102) ride on the load. B units are N m s/rad (printed "kg m^2"), delays 0.006 s ("0.006 ms").
+TABLE_4_2: dict[str, float] = dict(
+    K_t=0.1101, K_e=0.1043, R=1.1, V_s=12.0,  # L1156-1160, 12 V supply (L915)
+    J_m=1.4e-4, C_m=0.0246, B_m=7.95e-5,  # L1158, L1161-1162
+    K=0.26, J_s=6.04e-5, C_s=0.0075, B_s=3.33e-5,  # L1163-1166
+    J_l=6.76e-4 + 1.81e-5, C_l=0.0075, B_l=3.33e-5,  # L1167-1170 (J_l typo fixed, + J_c)
+    tau_b=1.1, tau_c=1.1, d_on=0.006, d_off=0.006,  # L1171-1174, L1134-1140
+    fs=500.0, tau_l=0.0, J_add=0.0,  # L905
+    t_l=0.2, duty=0.5, t_n=0.048, twist_tol=0.15, Kp=0.12, Ki=4.4e-5, ref=287.0,  # L915, L931; t_n = pi/Omega (derived)
+    min_vel=40.0, max_vel=60.0,
+)
+# 100 W step-up/step-down, design-stage simulation (L1983-1987, Table 6.2 Sr=10 row L1972-1981): same motor at 21 V,
+# added motor inertia 1.6e-3, bearing friction = step-up values x2, 5 N m clutches, 4 ms delays, J_l = 0.0023.
+DESIGN_100W: dict[str, float] = dict(
+    K_t=0.1101, K_e=0.1043, R=1.1, V_s=21.0,
+    J_m=1.4e-4, J_add=1.6e-3, C_m=0.0246, B_m=7.95e-5,
+    K=0.98, J_s=7.3e-5, C_s=0.015, B_s=6.66e-5,
+    J_l=0.0023, C_l=0.015, B_l=6.66e-5, tau_l=0.15,
+    tau_c1=5.0, tau_c2=5.0, d_on=0.004, d_off=0.004, fs=1000.0,
+    Kp=0.00112, Ki=0.0161, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0,  # L2014; fs not stated (1 kHz assumed)
+)
+# 100 W prototype as fitted to the 100 W open-loop test (L2200: B_s = 107e-5, K = 1.2; J_s = 7.76e-5 from K/J = 18038,
+# L2040-2042; output bearing Cl = 0.0025, Bl = 8.9e-5 (App. J "from MSD data", L3762-3764); spring bearings = spring+output
+# pair minus output (L2119); input bearing = spring+input minus spring (L2121-2123)).
+PROTO_100W: dict[str, float] = dict(
+    DESIGN_100W,
+    K=1.2, J_s=7.76e-5, B_s=107e-5, C_s=0.0078 - 0.0025, C_l=0.0025, B_l=8.9e-5,
+    C_m=0.0246 + (0.009 - 0.0053), B_m=7.95e-5 + (14.05e-5 - 7.2e-5), tau_l=0.0,
+    K_ctrl=1.32, Omega_ctrl=132.0,  # controller values on the prototype (L2072-2074)
+)
+# 500 W example design, App. J parameter file (L3735-3809) and Sec. 5.4 (L1848-1895).
+EXAMPLE_500W: dict[str, float] = dict(
+    tau_0=10.0, tau_slope=-0.05, J_m=0.005, J_add=0.0, C_m=0.0025, B_m=8.9e-5,  # T_m = 10 - 0.05 w (L3744-3748)
+    K=7.07, J_s=1e-4, C_s=0.005, B_s=1.78e-4,
+    J_l=0.005, C_l=0.0025, B_l=8.9e-5, tau_l=0.8,
+    tau_c1=20.0, tau_c2=20.0, d_on=0.004, d_off=0.004, fs=1000.0,
+    Kp=0.00222, Ki=0.075, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0, spring_max=2.86,
+)
+MODELICA: dict[str, float] = dict(J_m=1.0)
+
+PARAM_SETS: dict[str, dict[str, float]] = {
+    "table_4_2": TABLE_4_2,
+    "design_100w": DESIGN_100W,
+    "proto_100w": PROTO_100W,
+    "example_500w": EXAMPLE_500W,
+    "modelica": MODELICA,
+}
+
+
+@dataclass(frozen=True)
+class DriveParams:
+    """Scene overrides; None = value of the parameter set. Units SI (kg m^2, N m, N m s/rad, N m/rad, s, Hz, rad/s)."""
+
+    # motor (Eq 4.1: tau = K_t (V_s - K_e w) / R, or tau = tau_0 + tau_slope w)
+    K_t: float | None = None
+    K_e: float | None = None
+    R: float | None = None
+    V_s: float | None = None
+    tau_0: float | None = None
+    tau_slope: float | None = None
+    J_m: float | None = None
+    J_add: float | None = None  # added motor inertia (L959: 1.42e-3; L1987: 1.6e-3)
+    C_m: float | None = None
+    B_m: float | None = None
+    # spring system and load
+    K: float | None = None
+    J_s: float | None = None
+    C_s: float | None = None
+    B_s: float | None = None
+    J_l: float | None = None
+    C_l: float | None = None
+    B_l: float | None = None
+    tau_l: float | None = None
+    # clutches / brake (rated dynamic torques) and actuation delays
+    tau_b: float | None = None
+    tau_c: float | None = None
+    tau_c1: float | None = None
+    tau_c2: float | None = None
+    peak: float | None = None  # breakaway / sliding torque ratio (thesis: 1)
+    d_on: float | None = None
+    d_off: float | None = None
+    # controller
+    fs: float | None = None
+    t_l: float | None = None
+    duty: float | None = None
+    t_n: float | None = None
+    twist_tol: float | None = None
+    min_vel: float | None = None
+    max_vel: float | None = None
+    Kp: float | None = None
+    Ki: float | None = None
+    ref: float | None = None
+    max_tk: float | None = None
+    min_motor_vel: float | None = None
+    min_load_vel: float | None = None
+    K_ctrl: float | None = None
+    Omega_ctrl: float | None = None
+    spring_max: float | None = None
+
+    def __post_init__(self) -> None:
+        positive = ("J_m", "J_s", "J_l", "K", "R", "K_t", "fs", "t_l")
+        nonneg = ("J_add", "C_m", "B_m", "C_s", "B_s", "C_l", "B_l", "tau_l", "tau_b", "tau_c", "tau_c1", "tau_c2",
+                  "d_on", "d_off", "K_e", "t_n", "twist_tol", "Kp", "Ki", "min_motor_vel", "min_load_vel")
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if v is None:
+                continue
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ParameterError(f"parameter {f.name} must be a finite number, got {v!r}")
+            if f.name in positive and v <= 0:
+                raise ParameterError(f"parameter {f.name} must be positive, got {v!r}")
+            if f.name in nonneg and v < 0:
+                raise ParameterError(f"parameter {f.name} must be >= 0, got {v!r}")
+        if self.duty is not None and not 0 < self.duty < 1:
+            raise ParameterError(f"parameter duty must be in (0, 1), got {self.duty!r}")
+        if self.peak is not None and self.peak < 1:
+            raise ParameterError(f"parameter peak (breakaway/sliding) must be >= 1, got {self.peak!r}")
+
+    def resolved(self, param_set: str) -> dict[str, Any]:
+        """The parameter set with the overrides applied; validates combinations (delay vs controller period)."""
+        if param_set not in PARAM_SETS:
+            raise ParameterError(f"unknown parameter set {param_set!r}; valid: {sorted(PARAM_SETS)}")
+        p: dict[str, Any] = {f.name: None for f in dataclasses.fields(self)}
+        p.update(PARAM_SETS[param_set])
+        p.update({k: v for k, v in dataclasses.asdict(self).items() if v is not None})
+        p["peak"] = p["peak"] if p["peak"] is not None else 1.0
+        DriveParams(**p)  # validate the merged set too
+        return p
+
+
+def motor_line(p: dict[str, Any]) -> tuple[float, float]:
+    """Motor torque tau = c0 + c1 w: Eq 4.1 (armature inductance neglected, N = 1), or the App. J straight line."""
+    if p.get("tau_0") is not None:
+        return float(p["tau_0"]), float(p.get("tau_slope") or 0.0)
+    return p["K_t"] * p["V_s"] / p["R"], -p["K_t"] * p["K_e"] / p["R"]

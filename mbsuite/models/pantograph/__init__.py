@@ -1,0 +1,47 @@
+"""Brecknell-Willis asymmetric pantograph (Eppinger 1984, seed 000): three cross-checked paths.
+
+- `reference`: hand-derived equations (numpy/scipy), event-exact stick/slip;
+- `pinocchio`: M(q), gravity, frame Jacobians from the URDF/MJCF;
+- `mujoco`: time-domain dynamics with custom actuator callbacks (cylinder) and the elbow torque.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...registry import Effect, ModelSpec
+from . import analysis
+from .params import PantographParams
+
+SPEC = ModelSpec(
+    name="pantograph",
+    summary="Brecknell-Willis pantograph (Eppinger 1984): 3 links, compliant elbow, pneumatic cylinder, contact spring",
+    params_cls=PantographParams,
+    effects={
+        "gravity": Effect((True, False), True, "gravity on the links"),
+        "elbow": Effect(("compliant", "rigid"), "compliant", "elbow spring ke (3 DOF) or theta_2 = theta_e(theta_1)"),
+        "elbow_kinematics": Effect(("B6", "exact"), "B6", "thesis B.6 or exact chain wrap (erratum 22)"),
+        "cylinder": Effect(("linear", "nonlinear", "constant"), "linear",
+                           "linear spring+damper (3.24-3.26), corrected orifice/ideal gas (3.15-3.22), constant Pg Ap"),
+        "viscous": Effect((True, False), True, "joint viscous damping b1, b2, bh"),
+        "coulomb": Effect((True, False, "smooth"), True,
+                          "joint Coulomb friction: event-exact stick/slip (reference) / frictionloss (MuJoCo)"),
+        "contact": Effect(("bilateral", "unilateral"), "bilateral", "ram attached (both ways) or push-only wire"),
+    },
+    inputs={
+        "sine": {"amplitude": "half peak-to-peak (m); y_w = y_op + A (1 - cos 2 pi f t)", "frequency": "Hz",
+                 "initial": "'equilibrium' (default) or 'fortran' (thesis IC)"},
+        "static": {"initial": "'equilibrium' or 'fortran'"},
+        "step": {"height": "step of the ram height (m)", "t_step": "time of the step (s)", "initial": "..."},
+    },
+    outputs=analysis.UNITS,
+    engines=("mujoco", "reference"),
+    scenes_dir=Path(__file__).parent / "scenes",
+    default_scene="lab",
+    run=analysis.run,
+    equilibrium=analysis.equilibrium_report,
+    modes=analysis.modes_report,
+    freqresp=analysis.freqresp,
+    extra={"solver_defaults": {"engine": "mujoco", "integrator": "implicitfast", "timestep": 5e-4,
+                               "method": "LSODA", "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "t_settle": 5.0}},
+)

@@ -1,0 +1,402 @@
+"""Pantograph analyses: time runs (both engines), equilibrium (three paths), linearised modes, frequency response.
+
+Outputs follow the thesis (Ch. 5.1): F1 = l1 sin t1, F2 = l2 sin t2, HD = lh sin th, y_d = F1 + F2 + HD, against the input
+y_w = y_op + A (1 - cos w t) (EQSIM's YW). Amplitudes are ratios to the input amplitude A; phases are relative to the
+input's fundamental (degrees, negative = lag).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ...analysis.harmonic import fundamental
+from ...analysis.sweep import run_sweep
+from ...errors import SceneError
+from ...results import Report, SimResult, format_table, write_csv
+from ...scenes import Scene, scene_from_dict
+from .modelfiles import q_to_theta, theta_to_q
+from .mujoco import MujocoPantograph
+from .params import PantographParams
+from .reference import PantographConfig, PantographODE, simulate
+
+UNITS = {
+    "F1": "m", "F2": "m", "HD": "m", "y_d": "m", "y_w": "m", "theta1": "rad", "theta2": "rad", "thetah": "rad",
+    "theta_e": "rad", "elbow_windup": "rad", "contact_force": "N", "cylinder_force": "N", "cylinder_state": "m or Pa",
+}
+FR_SIGNALS = ("F1", "F2", "HD", "y_d")
+THESIS_RESONANCES_SIM = (4.25, 8.75, 19.5)
+THESIS_RESONANCES_MEAS = (4.0, 8.25)
+
+
+def config_of(scene: Scene) -> PantographConfig:
+    return PantographConfig(**dict(scene.effects))
+
+
+@dataclass(frozen=True)
+class InputSignal:
+    kind: str
+    y_op: float
+    amplitude: float = 0.0
+    frequency: float = 0.0
+    t_step: float = 0.0
+
+    def __call__(self, t: float) -> float:
+        if self.kind == "sine":
+            return self.y_op + self.amplitude * (1.0 - math.cos(2.0 * math.pi * self.frequency * t))
+        if self.kind == "step":
+            return self.y_op + (self.amplitude if t >= self.t_step else 0.0)
+        return self.y_op
+
+
+def input_of(scene: Scene, p: PantographParams) -> InputSignal:
+    inp = scene.input
+    kind = inp.get("type", "sine")
+    if kind == "sine":
+        A, f = float(inp.get("amplitude", 1.85e-3)), float(inp.get("frequency", 2.0))
+        if A < 0 or f <= 0:
+            raise SceneError(f"sine input needs amplitude >= 0 and frequency > 0 (got {A}, {f})")
+        return InputSignal("sine", p.y_op, A, f)
+    if kind == "step":
+        return InputSignal("step", p.y_op, float(inp.get("height", 1e-3)), 0.0, float(inp.get("t_step", 0.1)))
+    return InputSignal("static", p.y_op)
+
+
+def initial_theta(scene: Scene, ode: PantographODE, u: InputSignal) -> np.ndarray:
+    """Initial state: the static equilibrium (default) or the thesis' FORTRAN start (erratum 18; not an equilibrium)."""
+    x0 = ode.equilibrium(u(0.0))
+    if scene.input.get("initial", "equilibrium") == "fortran":
+        if ode.nq != 3:
+            raise SceneError("initial = 'fortran' needs the compliant elbow")
+        p = ode.p
+        t1 = math.asin((p.y_op + u.amplitude) / (2.0 * p.l1))
+        x0[:3] = [t1, t1, 0.0]
+        if ode.cfg.cylinder == "linear":
+            x0[-1] = ode.cylinder_lever(t1)[0]
+    return x0
+
+
+def signals(ode: PantographODE, theta: np.ndarray, y_w: np.ndarray, P: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Output signals from absolute angles theta (N, 3), ram height and cylinder state (shared by both engines)."""
+    p = ode.p
+    F1, F2, HD = p.l1 * np.sin(theta[:, 0]), p.l2 * np.sin(theta[:, 1]), p.lh * np.sin(theta[:, 2])
+    y_d = F1 + F2 + HD
+    fc = p.ks * (y_d - y_w)
+    if ode.cfg.contact == "unilateral":
+        fc = np.maximum(fc, 0.0)
+    te = np.array([ode.elbow(a).theta_e for a in theta[:, 0]])
+    cyl = np.array([ode.cylinder_force(a, None if P is None else Pk)
+                    for a, Pk in zip(theta[:, 0], P if P is not None else [None] * len(theta), strict=True)])
+    out = {"F1": F1, "F2": F2, "HD": HD, "y_d": y_d, "y_w": y_w, "theta1": theta[:, 0], "theta2": theta[:, 1],
+           "thetah": theta[:, 2], "theta_e": te, "elbow_windup": te - theta[:, 1], "contact_force": fc,
+           "cylinder_force": cyl}
+    if P is not None:
+        out["cylinder_state"] = P
+    return out
+
+
+def _contact_losses(t: np.ndarray, fc: np.ndarray) -> list[dict]:
+    """Contact-loss intervals from a sampled contact force (MuJoCo path)."""
+    lost = fc <= 0.0
+    ev, start = [], None
+    for k in range(len(t)):
+        if lost[k] and start is None:
+            start = t[k]
+        elif not lost[k] and start is not None:
+            ev.append({"kind": "contact_loss", "t_start": float(start), "duration": float(t[k] - start)})
+            start = None
+    if start is not None:
+        ev.append({"kind": "contact_loss", "t_start": float(start), "duration": None})
+    return ev
+
+
+def run(scene: Scene) -> SimResult:
+    """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference")."""
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    u = input_of(scene, p)
+    s = scene.solver
+    x0 = initial_theta(scene, ode, u)
+    if s.engine == "reference":
+        dt_out = s.sample_dt or s.timestep
+        t_eval = np.arange(0.0, s.duration + 0.5 * dt_out, dt_out)
+        max_step = s.max_step or (1.0 / (16.0 * u.frequency) if u.kind == "sine" else 0.0)
+        sol = simulate(ode, u, s.duration, x0, method=s.method, rtol=s.rtol, atol=s.atol, max_step=max_step,
+                       t_eval=t_eval)
+        th = np.array([ode.theta(sol.x[: ode.nq, k]) for k in range(sol.t.size)])
+        P = sol.x[-1] if ode.has_P else None
+        sig = signals(ode, th, np.array([u(t) for t in sol.t]), P)
+        res = SimResult(sol.t, sig, {k: UNITS[k] for k in sig}, "reference", events=sol.events,
+                        stats={"nfev": sol.nfev, "segments": sol.nsegments, "method": s.method, "rtol": s.rtol})
+    else:
+        mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
+        q0 = None if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
+        r = mp.simulate(u, s.duration, q0)
+        th = mp.thetas(r.qpos)
+        P = r.act[:, 0] if mp.model.na else None
+        sig = signals(ode, th, r.y_w, P)
+        every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
+        t = r.t[::every]
+        sig = {k: v[::every] for k, v in sig.items()}
+        ev = _contact_losses(r.t, signals(ode, th, r.y_w, P)["contact_force"]) if cfg.contact == "unilateral" else []
+        res = SimResult(t, sig, {k: UNITS[k] for k in sig}, "mujoco", events=ev,
+                        stats={"steps": int(r.t.size - 1), "integrator": s.integrator, "timestep": s.timestep,
+                               "warnings": r.warnings})
+    res.signals = {k: v for k, v in res.signals.items() if k in scene.outputs or not scene.outputs}
+    res.scene = scene.to_dict()
+    return res
+
+
+# ------------------------------------------------------------------------------------------------ linearisation
+def linearize(ode: PantographODE, x0: np.ndarray, y_w0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A = df/dx, B = df/dy_w at the equilibrium (central differences), C for (F1, F2, HD, y_d).
+
+    Coulomb friction is not linearisable and is left out (the modes are those of the viscous model); the contact is
+    taken as closed (bilateral)."""
+    lin = PantographODE(ode.p, PantographConfig(**{**ode.cfg.__dict__, "coulomb": False, "contact": "bilateral"}))
+    n = lin.n
+    A = np.zeros((n, n))
+    for i in range(n):
+        h = 1e-6 * max(1.0, abs(x0[i]))
+        e = np.zeros(n)
+        e[i] = h
+        A[:, i] = (lin.rhs(0.0, x0 + e, y_w0) - lin.rhs(0.0, x0 - e, y_w0)) / (2 * h)
+    h = 1e-7
+    B = (lin.rhs(0.0, x0, y_w0 + h) - lin.rhs(0.0, x0, y_w0 - h)) / (2 * h)
+    p = ode.p
+    J, _ = lin.theta_jacobian(x0[: lin.nq])
+    th = lin.theta(x0[: lin.nq])
+    Ct = np.diag([p.l1 * math.cos(th[0]), p.l2 * math.cos(th[1]), p.lh * math.cos(th[2])]) @ J
+    C = np.zeros((4, n))
+    C[:3, : lin.nq] = Ct
+    C[3, : lin.nq] = Ct.sum(axis=0)
+    return A, B, C
+
+
+def modes_from_eigs(lam: np.ndarray) -> list[dict]:
+    """Natural frequency (Hz) and damping ratio of each complex pair; time constant of each real pole."""
+    out = []
+    for v in sorted(lam, key=lambda z: abs(z)):
+        if v.imag < -1e-9:
+            continue
+        wn = abs(v)
+        if abs(v.imag) > 1e-9:
+            out.append({"kind": "oscillatory", "f_n": wn / (2 * math.pi), "zeta": -v.real / wn,
+                        "f_d": v.imag / (2 * math.pi)})
+        elif wn > 0:
+            out.append({"kind": "first-order", "f_n": wn / (2 * math.pi), "tau": -1.0 / v.real, "zeta": 1.0})
+    return out
+
+
+def linear_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, freqs: np.ndarray) -> np.ndarray:
+    """H(j w) = C (j w I - A)^-1 B per frequency, (nf, 4) complex, relative to the input y_w."""
+    n = A.shape[0]
+    return np.array([C @ np.linalg.solve(1j * 2 * math.pi * f * np.eye(n) - A, B) for f in freqs])
+
+
+def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
+    """Modes from MuJoCo's own finite-difference linearisation (mjd_transitionFD), mapped to continuous time."""
+    import mujoco
+
+    from ...engines import mujoco_engine as mje
+
+    m, d = mp.model, mp.data
+    if m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:  # mjd_transitionFD does not support RK4
+        raise SceneError("MuJoCo modes: mjd_transitionFD does not support the rk4 integrator; use another integrator")
+    nx = 2 * m.nv + m.na
+    A = np.zeros((nx, nx))
+    saved = m.dof_frictionloss.copy()
+    m.dof_frictionloss[:] = 0.0  # Coulomb friction is not linearisable: excluded, as in the reference linearisation
+    try:
+        with mje.callbacks(**mp.callback_set()):
+            mp._set_static(q0, mp.p.y_op)
+            mujoco.mjd_transitionFD(m, d, 1e-7, True, A, None, None, None)
+    finally:
+        m.dof_frictionloss[:] = saved
+    mu = np.linalg.eigvals(A)
+    lam = np.log(mu.astype(complex)) / m.opt.timestep
+    return modes_from_eigs(lam)
+
+
+# ------------------------------------------------------------------------------------------------ frequency response
+def _point(job: tuple[dict, float, str]) -> dict:
+    """One frequency with one method (module-level so that it can run in a worker process)."""
+    scene_d, f, method = job
+    scene = scene_from_dict(scene_d)
+    scene = scene.replace(input={"type": "sine", "frequency": f})
+    if method == "reference":
+        scene = scene.replace(solver={"engine": "reference", "sample_dt": 1.0 / (64.0 * f)})
+    else:
+        scene = scene.replace(solver={"engine": "mujoco"})
+    res = run(scene.replace(outputs=[*FR_SIGNALS, "y_w", "contact_force"]))
+    ts = scene.solver.t_settle or 0.5 * scene.solver.duration
+    cin = fundamental(res.t, res["y_w"], f, ts)
+    out = {"f": f, "method": method}
+    for s in FR_SIGNALS:
+        H = fundamental(res.t, res[s], f, ts) / cin
+        out[s] = (abs(H), math.degrees(math.atan2(H.imag, H.real)))
+    fc = res["contact_force"]
+    out["contact_force_min"] = float(np.min(fc[res.t >= ts]))
+    out["contact_force_max"] = float(np.max(fc[res.t >= ts]))
+    out["cost"] = res.stats
+    return out
+
+
+def peaks(freqs: np.ndarray, amp: np.ndarray) -> list[float]:
+    """Local maxima of an amplitude curve, refined by a parabola through the three points around each."""
+    out = []
+    for i in range(1, len(freqs) - 1):
+        if amp[i] > amp[i - 1] and amp[i] >= amp[i + 1]:
+            y0, y1, y2 = amp[i - 1], amp[i], amp[i + 1]
+            den = y0 - 2 * y1 + y2
+            off = 0.5 * (y0 - y2) / den if den != 0 else 0.0
+            out.append(float(freqs[i] + off * (freqs[i + 1] - freqs[i])))
+    return out
+
+
+def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 0.5,
+             methods: str | tuple[str, ...] = ("linear", "mujoco", "reference"), workers: int = 0,
+             progress: bool | None = None) -> Report:
+    """Frequency response from (i) the linearisation, (ii) the reference time simulation, (iii) MuJoCo."""
+    if isinstance(methods, str):
+        methods = tuple(m.strip() for m in methods.split(",") if m.strip())
+    bad = sorted(set(methods) - {"linear", "mujoco", "reference"})
+    if bad:
+        raise SceneError(f"unknown frequency-response method(s) {bad}; valid: ['linear', 'mujoco', 'reference']")
+    if not (0 < f_min <= f_max and df > 0):
+        raise SceneError(f"need 0 < f_min <= f_max and df > 0 (got {f_min}, {f_max}, {df})")
+    freqs = np.round(np.arange(f_min, f_max + 0.5 * df, df), 10)
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    x0 = ode.equilibrium()
+    A, B, C = linearize(ode, x0, p.y_op)
+    curves: dict[str, dict[str, np.ndarray]] = {}
+    if "linear" in methods:
+        H = linear_response(A, B, C, freqs)
+        curves["linear"] = {s: H[:, i] for i, s in enumerate(FR_SIGNALS)}
+    sim_methods = [m for m in methods if m != "linear"]
+    jobs = [(scene.to_dict(), float(f), m) for m in sim_methods for f in freqs]
+    results = run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp")
+    for m in sim_methods:
+        rows = [r for r in results if r["method"] == m]
+        curves[m] = {s: np.array([r[s][0] * np.exp(1j * math.radians(r[s][1])) for r in rows]) for s in FR_SIGNALS}
+        curves[m]["contact_force_min"] = np.array([r["contact_force_min"] for r in rows])
+    modes = modes_from_eigs(np.linalg.eigvals(A))
+    res_peaks = {m: {s: peaks(freqs, np.abs(c[s])) for s in ("F1", "HD")} for m, c in curves.items()}
+    data = {
+        "frequencies_hz": freqs,
+        "amplitude_input_m": input_of(scene.replace(input={"type": "sine"}), p).amplitude,
+        "modes_linear": modes,
+        "peaks_hz": res_peaks,
+        "thesis_resonances_simulated_hz": THESIS_RESONANCES_SIM,
+        "thesis_resonances_measured_hz": THESIS_RESONANCES_MEAS,
+        "response": {m: {s: {"amplitude": np.abs(c[s]), "phase_deg": np.degrees(np.angle(c[s]))}
+                         for s in FR_SIGNALS} for m, c in curves.items()},
+    }
+    if "mujoco" in curves and "reference" in curves:
+        data["mujoco_vs_reference"] = _agreement(freqs, curves["mujoco"], curves["reference"])
+    rows = []
+    for i, f in enumerate(freqs):
+        row = [f]
+        for m in curves:
+            row += [abs(curves[m]["F1"][i]), abs(curves[m]["HD"][i])]
+        rows.append(row)
+    headers = ["f (Hz)"] + [f"{m} {s}" for m in curves for s in ("|F1|/A", "|HD|/A")]
+    lines = [format_table(headers, rows, ".4g"), "", "linearised modes (Coulomb friction excluded):"]
+    for md in modes:
+        lines.append(f"  {md['kind']:12s} f_n = {md['f_n']:8.4f} Hz  zeta = {md['zeta']:.4f}")
+    for m, pk in res_peaks.items():
+        lines.append(f"peaks {m:9s} F1: {', '.join(f'{v:.3f}' for v in pk['F1'])} Hz;"
+                     f"  HD: {', '.join(f'{v:.3f}' for v in pk['HD'])} Hz")
+    lines.append(f"thesis: simulated {THESIS_RESONANCES_SIM} Hz, measured {THESIS_RESONANCES_MEAS} Hz")
+
+    def write(out: Path) -> list[Path]:
+        cols = [("f", "Hz", freqs)]
+        for m, c in curves.items():
+            for s in FR_SIGNALS:
+                cols.append((f"{m}_{s}_amplitude_ratio", "m/m", np.abs(c[s])))
+                cols.append((f"{m}_{s}_phase", "deg", np.degrees(np.angle(c[s]))))
+        files = [write_csv(out / "freqresp.csv", cols)]
+        from .plots import plot_freqresp, plot_time_histories
+
+        files.append(plot_freqresp(out / "freqresp.png", freqs, curves))
+        files += plot_time_histories(out, scene)
+        return files
+
+    return Report(data, "\n".join(lines), write)
+
+
+def _agreement(freqs: np.ndarray, a: dict, b: dict) -> dict:
+    """Max amplitude relative difference and phase difference (deg) per signal, over all frequencies."""
+    out = {}
+    for s in FR_SIGNALS:
+        ra = np.abs(np.abs(a[s]) / np.abs(b[s]) - 1.0)
+        dph = np.abs(np.degrees(np.angle(a[s] / b[s])))
+        out[s] = {"max_amplitude_rel": float(np.max(ra)), "max_phase_deg": float(np.max(dph)),
+                  "at_f_amp": float(freqs[int(np.argmax(ra))]), "at_f_phase": float(freqs[int(np.argmax(dph))])}
+    return out
+
+
+# ------------------------------------------------------------------------------------------------ equilibrium, modes
+def equilibrium_all_paths(scene: Scene) -> dict:
+    """Equilibrium at y_op from the hand-derived path, Pinocchio and MuJoCo."""
+    from .pinocchio import PinocchioPantograph
+
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    x0 = ode.equilibrium()
+    th_ref = ode.theta(x0[: ode.nq])
+    out = {"reference": th_ref}
+    mp = MujocoPantograph(p, cfg, scene.solver.integrator, scene.solver.timestep)
+    out["mujoco"] = q_to_theta(mp.equilibrium())
+    if cfg.elbow == "compliant" and p == PantographParams():
+        out["pinocchio"] = q_to_theta(PinocchioPantograph(p, cfg).equilibrium())
+    return out
+
+
+def equilibrium_report(scene: Scene) -> Report:
+    p = scene.build_params()
+    ode = PantographODE(p, config_of(scene))
+    paths = equilibrium_all_paths(scene)
+    rows, data = [], {}
+    for name, th in paths.items():
+        y_d = p.l1 * math.sin(th[0]) + p.l2 * math.sin(th[1]) + p.lh * math.sin(th[2])
+        te = ode.elbow(th[0]).theta_e
+        d = {"theta1": th[0], "theta2": th[1], "thetah": th[2], "y_d": y_d, "contact_force": p.ks * (y_d - p.y_op),
+             "elbow_windup": te - th[1], "theta_e": te, "dtheta_e_dtheta1": ode.elbow(th[0]).dtheta_e}
+        data[name] = d
+        rows.append([name, *[d[k] for k in ("theta1", "theta2", "thetah", "contact_force", "elbow_windup")]])
+    ref = paths["reference"]
+    data["max_difference_rad"] = {k: float(np.max(np.abs(v - ref))) for k, v in paths.items() if k != "reference"}
+    table = format_table(["path", "theta1 (rad)", "theta2 (rad)", "thetah (rad)", "contact force (N)",
+                          "elbow wind-up (rad)"], rows, ".10g")
+    table += "\nmax |theta - theta_ref| (rad): " + ", ".join(f"{k} {v:.2e}" for k, v in
+                                                               data["max_difference_rad"].items())
+    return Report(data, table)
+
+
+def modes_report(scene: Scene) -> Report:
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    x0 = ode.equilibrium()
+    A, _, _ = linearize(ode, x0, p.y_op)
+    ref = modes_from_eigs(np.linalg.eigvals(A))
+    mp = MujocoPantograph(p, cfg, scene.solver.integrator, scene.solver.timestep)
+    mj = mujoco_modes(mp, mp.equilibrium())
+    rows = []
+    for i, md in enumerate(ref):
+        m2 = mj[i] if i < len(mj) else {"f_n": float("nan"), "zeta": float("nan")}
+        rows.append([md["kind"], md["f_n"], md["zeta"], m2["f_n"], m2["zeta"]])
+    table = format_table(["mode", "f_n ref (Hz)", "zeta ref", "f_n MuJoCo (Hz)", "zeta MuJoCo"], rows, ".5g")
+    table += ("\nreference: central-difference Jacobian of the hand-derived ODE; MuJoCo: mjd_transitionFD at "
+              f"timestep {scene.solver.timestep:g} s ({scene.solver.integrator}), log(mu)/h. Coulomb friction excluded.")
+    return Report({"reference": ref, "mujoco": mj}, table)
+
+

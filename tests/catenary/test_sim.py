@@ -1,0 +1,141 @@
+"""Coupled integrator: independent ODE reference, exact per-step contact and dropper laws (no lag), hard cases."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from mbsuite.errors import ParameterError
+from mbsuite.models.catenary.analysis import ContactLostWarning, CriticalSpeedWarning, simulate, speed_regime
+from mbsuite.models.catenary.fe import CW_T, CW_W, NDOF_NODE, assemble, hermite
+from mbsuite.models.catenary.params import CatenaryParams
+from mbsuite.models.catenary.pantographs import TwoMassPantograph
+from mbsuite.models.catenary.sim import CoupledSimulation
+
+
+def _panto(p):
+    return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
+
+
+def test_trapezoidal_coupling_converges_to_independent_ode_solution():
+    """Linear droppers + attached (bilateral) contact make the coupled system a linear time-varying ODE: integrate it
+    with DOP853 (rtol 1e-10), the contact force evaluated continuously with the Hermite interpolation, and compare."""
+    p = CatenaryParams(n_spans=1, element_length=1.0, x_end=30.0, window_start=10.0, window_end=20.0)
+    fe = assemble(p)
+    n, V = fe.n, 250 / 3.6
+    M = fe.M.toarray()
+    K = (fe.K0 + fe.Kd).toarray()
+    a, b = p.rayleigh()
+    C = a * M + b * fe.K0.toarray()
+    Mi = np.linalg.inv(M)
+
+    def geo(t):
+        e, xi, h = fe.element_at(V * t)
+        full = [NDOF_NODE * e + CW_W, NDOF_NODE * e + CW_T, NDOF_NODE * (e + 1) + CW_W, NDOF_NODE * (e + 1) + CW_T]
+        d = fe.full_to_free[full]
+        Nl = np.where(d >= 0, hermite(xi, h), 0.0)
+        return Nl, np.where(d >= 0, d, 0), float(Nl @ fe.w0_full[full])
+
+    def force(t, y):
+        Nl, d, w0 = geo(t)
+        return p.k_contact * (y[2 * n] - (w0 + Nl @ y[:n][d])), Nl, d
+
+    def rhs(t, y):
+        u, v = y[:n], y[n:2 * n]
+        x1, x2, v1, v2 = y[2 * n:]
+        f, Nl, d = force(t, y)
+        F = np.zeros(n)
+        np.add.at(F, d, Nl * f)
+        a1 = (-p.k1 * (x1 - x2) - p.c1 * (v1 - v2) - f) / p.m1
+        a2 = (p.k1 * (x1 - x2) + p.c1 * (v1 - v2) - p.k2 * x2 - p.c2 * v2 + p.F0) / p.m2
+        return np.concatenate([v, Mi @ (F - K @ u - C @ v), [v1, v2, a1, a2]])
+
+    pan = _panto(p)
+    pan.static(0.0, p.k_contact)
+    T = 30.0 / V
+    t_eval = 0.004 * np.arange(int(T / 0.004) + 1)  # on both time grids
+    sol = solve_ivp(rhs, (0, T), np.concatenate([np.zeros(2 * n), pan.x, [0, 0]]), method="DOP853", rtol=1e-10,
+                    atol=1e-12, t_eval=t_eval)
+    f_ref = np.array([force(t, y)[0] for t, y in zip(sol.t, sol.y.T, strict=True)])
+    errs = []
+    for dt in (2e-4, 1e-4):
+        res = CoupledSimulation(fe, _panto(p), V, dt, "linear", "bilateral").run(0.0, 30.0)
+        idx = np.rint(t_eval / dt).astype(int)
+        assert np.allclose(res.t[idx], t_eval, atol=1e-12)
+        errs.append(np.max(np.abs(res.force[idx] - f_ref)))
+    assert errs[1] < 0.05  # N, on a force of ~180 N peak
+    assert 3.0 < errs[0] / errs[1] < 5.0  # second order
+
+
+def test_contact_and_dropper_laws_hold_exactly_at_every_step():
+    """No one-step lag: f_{n+1} = k_c max(head - wire, 0) with both heights from the end-of-step state, and each dropper
+    is slack exactly when its elastic tension T0 + k delta (end-of-step state) is not positive."""
+    p = CatenaryParams(n_spans=2, element_length=0.5, x_end=100.0, window_start=40.0, window_end=80.0)
+    fe = assemble(p)
+    res = CoupledSimulation(fe, _panto(p), 300 / 3.6, 1e-4, "slack").run(0.0, 100.0, record_droppers=True)
+    gap = res.head - res.wire
+    expect = p.k_contact * np.maximum(gap, 0.0)
+    assert np.max(np.abs(res.force - expect)) < 1e-8 * np.max(res.force)
+    assert res.dropper_slack.any(), "the passage must slacken droppers for this test to mean anything"
+    tol = 1e-8 * p.k_dropper
+    assert np.all(res.dropper_elastic[res.dropper_slack] <= tol)
+    assert np.all(res.dropper_elastic[~res.dropper_slack] >= -tol)
+
+
+def test_speed_regime_warns_and_refuses_supercritical():
+    p = CatenaryParams()
+    c = p.cw_wave_speed
+    assert 3.6 * c == pytest.approx(438.2, abs=0.1)  # sqrt(20000 / 1.35) m/s
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert speed_regime(p, 300 / 3.6)["regime"] == "subcritical"
+    with pytest.warns(CriticalSpeedWarning, match="EN 50119"):
+        r = speed_regime(p, 320 / 3.6)
+    assert r["regime"] == "above EN 50119 limit"
+    with pytest.warns(CriticalSpeedWarning, match="Near-critical"):
+        assert speed_regime(p, 420 / 3.6)["regime"] == "near-critical"
+    with pytest.raises(ParameterError, match="wave speed"):
+        speed_regime(p, 450 / 3.6)
+
+
+def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
+    """420 km/h (96 % of the wave speed) with a light uplift: warned, contact lost and regained many times, all
+    finite, the wire and pantograph stay within physical bounds and the catenary energy does not grow."""
+    p = CatenaryParams(n_spans=3, element_length=0.5, x_end=170.0, window_start=60.0, window_end=120.0, F0=60.0)
+    fe = assemble(p)
+    with pytest.warns(CriticalSpeedWarning):
+        run = simulate(p, 420.0, 1e-4, fe=fe)
+    r = run.result
+    assert np.all(np.isfinite(r.force)) and np.all(np.isfinite(r.uplift))
+    ev = run.stats["loss_events"]
+    assert len(ev) >= 3 and run.stats["loss_pct"] > 0
+    assert np.max(np.abs(r.wire)) < 0.3 and np.max(np.abs(r.head)) < 0.3
+    # pantograph force does positive work on the wire; with damping the energy stays bounded by the work input
+    work = np.sum(0.5 * (r.force[1:] + r.force[:-1]) * np.diff(r.wire))
+    assert math.isfinite(work)
+    assert np.max(r.force) < 20 * p.F0
+
+
+def test_pantograph_leaving_the_wire_is_reported_not_nan():
+    p = CatenaryParams(n_spans=2, element_length=0.5, x_end=100.0, window_start=40.0, window_end=80.0, F0=-50.0)
+    with pytest.warns(ContactLostWarning, match="off the wire"):
+        run = simulate(p, 250.0, 2e-4)
+    s = run.stats
+    assert s["contact_lost_entirely"] and s["loss_pct"] == 100.0
+    for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm"):
+        assert math.isfinite(s[k])
+    assert s["Fm"] == 0.0 and s["sigma"] == 0.0
+    assert len(s["loss_events"]) == 1 and s["loss_counts"]["power_loss_gt_20ms"] == 1
+
+
+def test_bad_speed_and_timestep():
+    p = CatenaryParams(n_spans=1, x_end=50.0, window_start=10.0, window_end=40.0)
+    for bad in (0.0, -10.0, float("nan")):
+        with pytest.raises(ParameterError, match="speed"):
+            simulate(p, bad, 1e-4)
+    with pytest.raises(ParameterError, match="time step"):
+        simulate(p, 200.0, -1e-4)

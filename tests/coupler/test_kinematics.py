@@ -1,0 +1,191 @@
+"""Hand-derived kinematics of the 4-link coupler against the paper (seed 001) and closed forms."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from mbsuite.errors import GeometryError, ParameterError, SolverError
+from mbsuite.models.coupler import analysis
+from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.params import GAMMA_17DEG, CouplerParams, geometry_params
+
+G = GAMMA_17DEG
+
+
+def test_eq1_link_length_is_the_chord_of_the_assembled_points():
+    """Eq (1): the distance between a_k and b_{k+1} at the coplanar pose equals sqrt(2(1 - sin 2g)) R."""
+    for g in (0.11, 0.297, 0.391):
+        p = CouplerParams(gamma=g, e_y=0.0, R=1.7)
+        a, b, _, _ = ref.single_points(p, 0.0, 0.0, 0.0, np.array([-math.pi / 2, 0, 0, 0]))
+        d = np.linalg.norm(b[ref.NEXT] - a, axis=1)
+        np.testing.assert_allclose(d, 1.7 * math.sqrt(2 * (1 - math.sin(2 * g))), rtol=0, atol=1e-14)
+
+
+def test_eq15_reproduced_with_documented_layout():
+    """Eq (15) (seed l.245) to 1e-4: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y)."""
+    J = ref.single_jacobian(CouplerParams(e_y=0.0))
+    assert np.max(np.abs(ref.paper_eq15_layout(J) - ref.EQ15)) <= 1e-4
+    # with gamma = 0.297 exactly the moment entry is 0.8831, not 0.8829 (reference B1): the paper used 17 deg
+    J297 = ref.single_jacobian(CouplerParams(gamma=0.297, e_y=0.0))
+    assert np.max(np.abs(ref.paper_eq15_layout(J297) - ref.EQ15)) > 1e-4
+
+
+def test_rank_three_at_coplanar_pose_and_free_axial_translation():
+    p = CouplerParams(e_y=0.0)
+    with pytest.warns(analysis.SingularityWarning):
+        rep = analysis.jacobian_report(p)
+    d = rep.data
+    assert d["rank"] == 3 and math.isinf(d["cond"])
+    np.testing.assert_allclose(d["singular_values"][:3], [2 * math.cos(math.pi / 4 - G), math.sqrt(2), math.sqrt(2)],
+                               atol=1e-12)
+    trans = [s for s in d["principal_screws"] if math.isinf(s["pitch"])]
+    assert len(trans) == 1 and abs(abs(trans[0]["axis"][1]) - 1) < 1e-12  # S3: translation along the shaft (y)
+    rots = [s for s in d["principal_screws"] if math.isfinite(s["pitch"])]
+    axes = sorted(int(np.argmax(np.abs(s["axis"]))) for s in rots)
+    assert axes == [0, 2] and all(abs(s["pitch"]) < 1e-12 for s in rots)  # Table 2, e_y = 0: S1 about x, S2 about z
+
+
+@pytest.mark.parametrize("ey", [1e-13, 1e-11])
+def test_near_coplanar_rank_drop_detected(ey):
+    with pytest.warns(analysis.SingularityWarning):
+        rep = analysis.jacobian_report(CouplerParams(e_y=ey))
+    assert rep.data["rank"] == 3
+
+
+@pytest.mark.parametrize("ey", [0.05, 0.1])
+def test_condition_number_closed_form_and_paper(ey):
+    """chi = R cos(2 gamma)/e_y (derived in README) - not Table 2's 87 / 85."""
+    p = CouplerParams(e_y=ey)
+    J = ref.single_jacobian(p)
+    s = np.linalg.svd(J, compute_uv=False)
+    l = math.hypot(2 * math.sin(math.pi / 4 - G), ey)
+    assert s[-1] == pytest.approx(2 * ey / l, rel=1e-12)
+    assert s[0] / s[-1] == pytest.approx(math.cos(2 * G) / ey, rel=1e-10)
+    assert abs(s[0] / s[-1] - analysis.TABLE2[ey][3]) > 50  # the paper's value is not reproducible (reference B2)
+
+
+@pytest.mark.parametrize("ey", [0.05, 0.1])
+def test_table2_axes_are_the_zero_pitch_screws(ey):
+    p = CouplerParams(e_y=ey)
+    an = ref.analyse_jacobian(ref.single_jacobian(p), np.array([0.0, ey, 0.0]))
+    assert an.rank == 4 - 0 and an.null_space.shape[1] == 2
+    zp = analysis.zero_pitch_pair(an.principal_screws)
+    y1, y2, h_paper, _ = analysis.TABLE2[ey]
+    assert abs(abs(zp[0].axis[0]) - 1) < 1e-12 and abs(abs(zp[1].axis[2]) - 1) < 1e-12
+    assert zp[0].point[1] == pytest.approx(y1, abs=1.5e-4)  # Table 2 prints 4 decimals
+    assert zp[1].point[1] == pytest.approx(y2, abs=1.5e-4)
+    # principal screws: axes at +-45 deg through (0, e_y/2, 0), pitches +-d/2 with d = distance of Table 2's axes
+    d = zp[0].point[1] - zp[1].point[1]
+    pit = sorted(s.pitch for s in an.principal_screws)
+    np.testing.assert_allclose(pit, [-d / 2, d / 2], rtol=1e-10)
+    for s in an.principal_screws:
+        assert s.point[1] == pytest.approx(ey / 2, abs=1e-12)
+        assert abs(abs(s.axis[0]) - math.sqrt(0.5)) < 1e-12
+    # Table 2's +-pitches come from a basis turned by theta away from the zero-pitch pair
+    th = 0.5 * math.asin(h_paper / (d / 2))
+    h1, h2 = ref.pitch_of_mixed_basis(zp[0], zp[1], th)
+    assert abs(h1) == pytest.approx(h_paper, rel=1e-9) and h1 == pytest.approx(-h2, rel=1e-9)
+    # null vectors really are free motions: J t = 0
+    assert np.max(np.abs(an.J @ an.null_space)) < 1e-12
+
+
+def test_single_fpp_full_revolution_continuation_largest_misalignment():
+    p = CouplerParams(e_y=0.1)
+    rev = ref.single_revolution(p, 0.07, 0.02, n=91)
+    for phi, u in zip(rev.phi_a, rev.u, strict=True):
+        assert np.max(np.abs(ref.single_residual(p, phi, 0.07, 0.02, u))) < 1e-12
+    # no branch jump: the pose after a full turn is the starting pose with phi_b advanced by exactly 2 pi
+    assert rev.u[-1, 0] - rev.u[0, 0] == pytest.approx(2 * math.pi, abs=1e-10)
+    np.testing.assert_allclose(rev.u[-1, 1:], rev.u[0, 1:], atol=1e-10)
+    assert np.all(np.diff(rev.u[:, 0]) > 0)
+
+
+def test_c1_quadratic_in_alpha_period_pi_independent_of_ey():
+    p = CouplerParams(e_y=0.1)
+    c = [analysis.single_criteria(p, a, 121) for a in (0.02, 0.04)]
+    assert c[1]["c1"] / c[0]["c1"] == pytest.approx(4.0, rel=0.02)
+    d = c[1]["rev"].phi_a[:-1] - c[1]["rev"].u[:-1, 0]
+    spec = np.abs(np.fft.rfft(d - d.mean()))
+    assert int(np.argmax(spec)) == 2  # two oscillations per revolution (not one, as l.275 says)
+    c3 = analysis.single_criteria(CouplerParams(e_y=0.3), 0.04, 121)
+    assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-3)
+    assert c[1]["c2"] > 1.9 * c[0]["c2"]  # c2 grows with alpha
+    assert c[1]["c4"] > 5 * c[1]["c3"]  # beta2 (out of plane) dominates beta1
+
+
+def test_c1_improves_with_slimmer_platform():
+    c = [analysis.single_criteria(CouplerParams(gamma=g), 0.05, 61)["c1"] for g in (0.11, 0.297, 0.391)]
+    assert c[0] < c[1] < c[2]
+
+
+def test_double_homokinetic_at_phibc_0_not_at_pi_2():
+    c0 = analysis.double_c5(CouplerParams(), 0.08, n=37)
+    c90 = analysis.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=37)
+    assert c0["c5"] < 1e-12 < 1e-4 < c0["c1_intermediate"]
+    assert c90["c5"] > 1e-4
+    # with an inclined output shaft the phi_bc = 0 double coupler is no longer exactly homokinetic
+    assert analysis.double_c5(CouplerParams(), 0.0, alpha_cx=0.03, n=37)["c5"] > 1e-6
+
+
+def test_double_fpp_revolution_phibc_90_no_jump():
+    p = CouplerParams(phi_bc=math.pi / 2)
+    rev = ref.double_revolution(p, 0.02, -0.01, 0.03, 0.05, n=61)
+    for phi, u in zip(rev.phi_a, rev.u, strict=True):
+        assert np.max(np.abs(ref.double_residual(p, np.r_[phi, rev.inputs], u))) < 1e-12
+    assert rev.u[-1, 0] - rev.u[0, 0] == pytest.approx(2 * math.pi, abs=1e-10)
+    np.testing.assert_allclose(rev.u[-1, 1:5], rev.u[0, 1:5], atol=1e-10)
+
+
+def test_quasi_static_forces_balance_the_load():
+    """Virtual work: T_in = T_load dphi_c/dphi_a; links of each coupler alternate tension/compression."""
+    p = CouplerParams(phi_bc=math.pi / 2)
+    inp = np.array([0.3, 0.0, 0.0, 0.0, 0.06])
+    u = ref._ramp_double(p, inp)
+    f, t_in = ref.double_quasi_static(p, inp, u, 1000.0)
+    h = 1e-6
+    up = ref.solve_double(p, inp + [h, 0, 0, 0, 0], u)
+    um = ref.solve_double(p, inp - [h, 0, 0, 0, 0], u)
+    assert t_in == pytest.approx(1000.0 * (up[0] - um[0]) / (2 * h), rel=1e-7)
+    assert np.all(np.sign(f[:4]) == [1, -1, 1, -1])
+
+
+def test_bad_input_errors():
+    with pytest.raises(ParameterError, match="gamma"):
+        CouplerParams(gamma=0.0)
+    with pytest.raises(ParameterError, match="gamma"):
+        CouplerParams(gamma=math.pi / 4)
+    with pytest.raises(ParameterError, match="e_y"):
+        CouplerParams(e_y=-0.01)
+    with pytest.raises(ParameterError, match="R"):
+        CouplerParams(R=-1.0)
+    with pytest.raises(ParameterError, match="l_b"):
+        CouplerParams(l_b=0.0)
+    with pytest.raises(ParameterError, match="unknown"):
+        geometry_params(gama=0.3)
+    # e_y smaller than ~R alpha: platform B would cross A -> GeometryError naming the cause, never a pose
+    with pytest.raises(GeometryError, match="cross"):
+        ref.solve_single(CouplerParams(e_y=0.02), 0.0, 0.05, 0.0)
+    with pytest.raises(GeometryError, match="cross"):
+        ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01, 0.0)
+    with pytest.raises((GeometryError, SolverError)):
+        ref.single_revolution(CouplerParams(e_y=0.03), 0.05, 0.0, n=31)
+    # Gauss-Newton non-convergence reported with the residual
+    with pytest.raises(SolverError, match=r"residual \|r\|_inf = [0-9.e+-]+"):
+        ref.gauss_newton(lambda u: np.array([u[0] ** 2 + 1.0]), lambda u: np.array([[2 * u[0]]]), np.array([0.3]))
+
+
+def test_jacobian_report_no_warning_when_regular():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rep = analysis.jacobian_report(CouplerParams(e_y=0.1), 0.4, 0.03, 0.01)
+    assert rep.data["rank"] == 4
+
+
+def test_huge_condition_number_warns():
+    with pytest.warns(analysis.SingularityWarning, match="nearly singular"):
+        rep = analysis.jacobian_report(CouplerParams(e_y=1e-8))
+    assert rep.data["rank"] == 4 and rep.data["cond"] > 1e7

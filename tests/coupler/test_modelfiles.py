@@ -1,0 +1,97 @@
+"""Shipped model files = generated baseline; MjSpec / Pinocchio edits = generated variants; variants are consistent."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from mbsuite.errors import ModelFileError
+from mbsuite.models.coupler import modelfiles as mf
+from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.params import CouplerParams
+from mbsuite.models.coupler.pinocchio import PinCoupler, load_model, pin_variant
+from mbsuite.paths import mjcf_path, urdf_path
+
+VARIANT = CouplerParams(gamma=0.11, e_y=0.2, l_b=3.0, phi_bc=math.pi / 2, R=1.3)
+KINDS = ["single", "double"]
+
+FIELDS = ("body_pos", "body_quat", "body_ipos", "body_iquat", "body_mass", "body_inertia", "body_parentid",
+          "jnt_type", "jnt_axis", "jnt_pos", "jnt_bodyid", "dof_damping", "site_pos", "site_bodyid", "geom_size",
+          "geom_pos", "eq_type", "eq_obj1id", "eq_obj2id", "eq_data")
+
+
+def _compare(m1: mujoco.MjModel, m2: mujoco.MjModel, atol: float = 1e-12) -> None:
+    assert (m1.nq, m1.nv, m1.nbody, m1.neq, m1.nsite) == (m2.nq, m2.nv, m2.nbody, m2.neq, m2.nsite)
+    for f in FIELDS:
+        a, b = getattr(m1, f), getattr(m2, f)
+        if f == "body_quat" or f == "body_iquat":  # q and -q are the same rotation
+            s = np.sign(np.sum(a * b, axis=1))[:, None]
+            b = b * np.where(s == 0, 1, s)
+        np.testing.assert_allclose(a, b, atol=atol, rtol=0, err_msg=f)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_shipped_files_equal_generated_baseline(kind):
+    p = CouplerParams()
+    assert urdf_path(f"coupler_{kind}").read_text() == mf.urdf_text(p, kind)
+    assert mjcf_path(f"coupler_{kind}").read_text() == mf.mjcf_text(p, kind)
+    _compare(mujoco.MjModel.from_xml_path(str(mjcf_path(f"coupler_{kind}"))), mf.mjspec_variant(p, kind).compile())
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_mjspec_edit_equals_generated_variant(kind):
+    edited = mf.mjspec_variant(VARIANT, kind).compile()
+    generated = mujoco.MjModel.from_xml_string(mf.mjcf_text(VARIANT, kind))
+    _compare(edited, generated)
+    # and the variant differs from the baseline (the edit did something)
+    base = mujoco.MjModel.from_xml_path(str(mjcf_path(f"coupler_{kind}")))
+    assert np.max(np.abs(base.site_pos - edited.site_pos)) > 0.05
+    # the edited variant is assembled at qpos0
+    d = mujoco.MjData(edited)
+    mujoco.mj_forward(edited, d)
+    assert np.max(np.abs(d.efc_pos)) < 1e-12
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_pinocchio_edit_equals_generated_variant(kind):
+    base, _ = load_model(kind)
+    edited, cl = pin_variant(base, VARIANT, kind)
+    generated, cl2 = load_model(kind, VARIANT)
+    assert cl == cl2
+    q = pin.randomConfiguration(generated, -np.ones(generated.nq), np.ones(generated.nq))
+    d1, d2 = edited.createData(), generated.createData()
+    pin.framesForwardKinematics(edited, d1, q)
+    pin.framesForwardKinematics(generated, d2, q)
+    for f in generated.frames:
+        i = edited.getFrameId(f.name)
+        assert np.allclose(d1.oMf[i].homogeneous, d2.oMf[generated.getFrameId(f.name)].homogeneous, atol=1e-12), f.name
+
+
+def test_variant_kinematics_pinocchio_matches_reference():
+    p = VARIANT
+    pc = PinCoupler.build("single", p, edit=True)
+    sp = ref._ramp_single(p, 1.1, 0.08, 0.05)
+    q = pc.q_of({"phi_a": 1.1, "alpha_bx": 0.08, "alpha_bz": 0.05,
+                 **dict(zip(("phi_b", "x_b", "y_b", "z_b"), sp.u, strict=True))})
+    assert np.max(np.abs(pc.residual(q))) < 1e-12
+    assert np.max(np.abs(pc.mechanism_jacobian(q) - ref.single_jacobian(p, sp))) < 1e-10
+
+
+def test_urdf_states_every_closure_by_named_frames():
+    cl = mf.closures_from_urdf(urdf_path("coupler_double"))
+    assert [c.name for c in cl] == [f"link{k}" for k in range(1, 9)]
+    assert cl[0].frame_a == "A_S1" and cl[0].frame_b == "BA_S2" and cl[7].frame_b == "BC_S1"
+    assert all(c.length == pytest.approx(CouplerParams().link_length, abs=1e-14) for c in cl)
+
+
+def test_malformed_files_raise(tmp_path):
+    bad = tmp_path / "x.urdf"
+    bad.write_text("<robot name='x'><link name='world'/></robot>")
+    with pytest.raises(ModelFileError, match="closure"):
+        mf.closures_from_urdf(bad)
+    with pytest.raises(ModelFileError, match="kind"):
+        mf.urdf_text(CouplerParams(), "triple")

@@ -1,6 +1,7 @@
 """Where the model files live.
 
-The repository keeps `mjcf/` and `models_urdf/` at its top level (the user's layout). With an editable install the package
+The repository keeps `mjcf/` and `models_urdf/` at its top level (the user's layout). With an editable install the
+package
 finds them next to itself; `MBSUITE_MODELS_DIR` overrides the root (a directory holding `mjcf/` and `models_urdf/`).
 """
 

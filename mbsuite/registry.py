@@ -1,6 +1,7 @@
 """The model registry: every package under `mbsuite/models/` that exports `SPEC: ModelSpec` is a model.
 
-A model package declares what its scenes may contain (effects with their allowed values, parameter dataclass, input types,
+A model package declares what its scenes may contain (effects with their allowed values, parameter dataclass, input
+types,
 output signals, engines) and the analysis hooks it supports. Nothing else in mbsuite knows a model by name: the scene
 loader validates against the spec and the CLI dispatches through the hooks, so a new model is one new package.
 """
@@ -28,7 +29,8 @@ class Effect:
 
     def check(self, name: str, value: Any) -> Any:
         # bools are compared by identity so that 1/0 are not silently taken for true/false
-        ok = any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool)) for c in self.choices)
+        ok = any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool))
+                 for c in self.choices)
         if not ok:
             raise SceneError(f"effect '{name}' = {value!r} is not allowed; valid values: {list(self.choices)}")
         return value

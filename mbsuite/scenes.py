@@ -1,4 +1,5 @@
-"""Scenes: a TOML file naming a model, the effects it needs, parameter overrides, the input, outputs and solver settings.
+"""Scenes: a TOML file naming a model, the effects it needs, parameter overrides, the input, outputs and solver
+settings.
 
 ```toml
 model = "pantograph"
@@ -74,7 +75,8 @@ class SolverSettings:
             if not (isinstance(v, int | float) and v >= 0):
                 raise SceneError(f"solver.{name} must be a non-negative number, got {v!r}")
         if self.t_settle >= self.duration:
-            raise SceneError(f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
+            raise SceneError(
+                f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
 
 
 SOLVER_KEYS = tuple(f.name for f in dataclasses.fields(SolverSettings))
@@ -115,7 +117,8 @@ class Scene:
         }
 
     def replace(self, **sections: Mapping[str, Any] | Any) -> Scene:
-        """A new validated scene with sections merged: `scene.replace(effects={"gravity": False}, solver={"timestep": 1e-4})`.
+        """A new validated scene with sections merged: `scene.replace(effects={"gravity": False}, solver={"timestep":
+        1e-4})`.
         Scalars (`name`, `description`) replace; mappings are merged key by key."""
         d = self.to_dict()
         for key, val in sections.items():
@@ -148,7 +151,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         raise SceneError(f"[effects]{where} must be a table")
     bad = sorted(set(effects_in) - set(spec.effects))
     if bad:
-        raise SceneError(f"unknown effect(s) {bad} for model '{spec.name}'{where}; valid effects: {sorted(spec.effects)}")
+        raise SceneError(
+            f"unknown effect(s) {bad} for model '{spec.name}'{where}; valid effects: {sorted(spec.effects)}")
     effects = {}
     for name, eff in spec.effects.items():
         effects[name] = eff.check(name, effects_in.get(name, eff.default))

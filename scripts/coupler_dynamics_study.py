@@ -52,7 +52,7 @@ def main() -> None:
         f = np.array(r.stats["link_force_mean"])
         rows.append([fac, r.stats["torque_in_ripple_pp"], float(np.mean(np.abs(f))), float(np.ptp(np.abs(f))),
                      r.stats["closure_residual_max"]])
-    print("\nmassless-link limit (link mass x factor, no gravity): |mean link force| spread -> 0, ripple -> shafts only")
+    print("\nmassless-link limit (link mass x factor, no gravity): |mean link force| spread -> 0")
     print(format_table(["factor", "ripple_pp", "mean|F|", "spread|F|", "closure_res"], rows, ".4g"))
 
     r = mbsuite.run(load_scene("coupler/double_lateral"))

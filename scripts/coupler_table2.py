@@ -20,7 +20,8 @@ def main() -> None:
     np.set_printoptions(precision=4, suppress=True)
     for g in (math.radians(17.0), 0.297):
         J = ref.single_jacobian(CouplerParams(gamma=g, e_y=0.0))
-        print(f"gamma = {g:.5f}: max |J(paper layout) - Eq 15| = {np.max(np.abs(ref.paper_eq15_layout(J) - ref.EQ15)):.2e}")
+        diff = np.max(np.abs(ref.paper_eq15_layout(J) - ref.EQ15))
+        print(f"gamma = {g:.5f}: max |J(paper layout) - Eq 15| = {diff:.2e}")
     rows, screws = [], []
     for ey in (0.0, 0.05, 0.1):
         with warnings.catch_warnings():

@@ -35,7 +35,8 @@ _active: dict[str, Callable] = {}
 
 
 def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False) -> mujoco.MjModel:
-    """Compile an MJCF file/string/MjSpec; any parse or compile error is re-raised as ModelFileError naming the source."""
+    """Compile an MJCF file/string/MjSpec; any parse or compile error is re-raised as ModelFileError naming the
+    source."""
     try:
         if isinstance(source, mujoco.MjSpec):
             return source.compile()
@@ -66,7 +67,8 @@ def active_callbacks() -> dict[str, Callable]:
 
 @contextlib.contextmanager
 def callbacks(**cbs: Callable | None) -> Iterator[None]:
-    """Install MuJoCo callbacks (`act_dyn`, `act_gain`, `act_bias`, `passive`, `control`) for a block; None = not installed.
+    """Install MuJoCo callbacks (`act_dyn`, `act_gain`, `act_bias`, `passive`, `control`) for a block; None = not
+    installed.
 
     Nesting the same callback is an error (they are process-global)."""
     wanted = {k: v for k, v in cbs.items() if v is not None}
@@ -89,7 +91,7 @@ def callbacks(**cbs: Callable | None) -> Iterator[None]:
 
 def check_finite(model: mujoco.MjModel, data: mujoco.MjData, what: str) -> None:
     """Raise SolverError if the state is non-finite or MuJoCo flagged a bad acceleration/instability."""
-    bad_state = not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel)) and np.all(np.isfinite(data.act)))
+    bad_state = not all(np.all(np.isfinite(a)) for a in (data.qpos, data.qvel, data.act))
     w = data.warning
     unstable = w[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
     if bad_state or unstable:

@@ -12,8 +12,8 @@ from scipy.integrate import solve_ivp
 from mbsuite.errors import ParameterError
 from mbsuite.models.catenary.analysis import ContactLostWarning, CriticalSpeedWarning, simulate, speed_regime
 from mbsuite.models.catenary.fe import CW_T, CW_W, NDOF_NODE, assemble, hermite
-from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
+from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.sim import CoupledSimulation
 
 

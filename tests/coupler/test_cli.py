@@ -47,3 +47,14 @@ def test_bad_input_exit_code_2(argv, msg, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("mbsuite: error:") and msg in err
+
+
+def test_dynamics_command_json_and_csv(tmp_path, capsys):
+    scene = tmp_path / "short.toml"
+    scene.write_text('model = "coupler"\n[input]\ntype = "constant_speed"\nz_c = 0.05\nt_ramp = 0.25\n'
+                     '[solver]\nduration = 0.45\nt_settle = 0.3\n')
+    assert main(["coupler", "dynamics", str(scene), "--json", "--out", str(tmp_path / "o")]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["stats"]["warnings"] == {} and d["stats"]["closure_residual_max"] < 2e-4
+    header = (tmp_path / "o" / "timeseries.csv").read_text().splitlines()[0]
+    assert "torque_in [N m]" in header and "link_force_8 [N]" in header

@@ -189,3 +189,12 @@ def test_huge_condition_number_warns():
     with pytest.warns(analysis.SingularityWarning, match="nearly singular"):
         rep = analysis.jacobian_report(CouplerParams(e_y=1e-8))
     assert rep.data["rank"] == 4 and rep.data["cond"] > 1e7
+
+
+def test_inclination_about_z_equals_about_x_up_to_phase():
+    """alpha_b may be applied about x or z: same c1, x- and z-ranges of O_b swap (the platform turns through both)."""
+    p = CouplerParams()
+    rx = ref.single_revolution(p, 0.05, 0.0, 121)
+    rz = ref.single_revolution(p, 0.0, 0.05, 121)
+    assert np.ptp(rx.phi_a - rx.u[:, 0]) == pytest.approx(np.ptp(rz.phi_a - rz.u[:, 0]), rel=1e-9)
+    assert np.ptp(rx.u[:, 1]) == pytest.approx(np.ptp(rz.u[:, 3]), rel=1e-9)

@@ -95,6 +95,10 @@ def test_mjcf_in_pinocchio_and_mujoco_same_kinematics(kind):
         c = pm.shaft_coords(qm, "b")
         got = np.array([c[5] - math.pi / 2, c[0], c[1], c[2]])
         np.testing.assert_allclose(c[3:5], [-0.02, 0.04], atol=1e-14)
+        # directly against the URDF spanning tree + closures
+        pc = PinCoupler.build("single")
+        qu = pc.fpp(inp, pc.q_of(dict(zip(("phi_b", "x_b", "y_b", "z_b"), u, strict=True))))
+        assert np.max(np.abs(pc.coords(qu) - got)) < TOL
     else:
         x = np.array([0.8, 0.02, 0.01, -0.02, 0.05])
         qm = pm.fpp_ramp(dict(zip(ref.DOUBLE_INPUTS, x, strict=True)))

@@ -17,8 +17,8 @@ import numpy as np
 from ...errors import ParameterError, SceneError
 from ...results import Report, SimResult, format_table, write_csv
 from .fe import CatenaryFE, assemble
-from .params import CatenaryParams
 from .pantographs import Pantograph, TwoMassPantograph
+from .params import CatenaryParams
 from .sim import CoupledResult, CoupledSimulation
 from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
 
@@ -45,8 +45,9 @@ def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
             "doppler_factor": (c - speed_ms) / (c + speed_ms), "regime": "subcritical", "warnings": []}
     if ratio >= 1.0:
         raise ParameterError(
-            f"speed {3.6 * speed_ms:.1f} km/h is at or above the contact wire wave speed sqrt(T/rho) = {3.6 * c:.1f} km/h:"
-            " the critical/supercritical regime has no steady solution in this small-displacement model")
+            f"speed {3.6 * speed_ms:.1f} km/h is at or above the contact wire wave speed sqrt(T/rho) = "
+            f"{3.6 * c:.1f} km/h: the critical/supercritical regime has no steady solution in this "
+            "small-displacement model")
     if ratio >= WARN_RATIO:
         info["regime"] = "near-critical" if ratio >= NEAR_CRITICAL_RATIO else "above EN 50119 limit"
         msg = (f"speed {3.6 * speed_ms:.1f} km/h is {100 * ratio:.1f} % of the contact wire wave speed "
@@ -60,14 +61,15 @@ def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
     return info
 
 
-def build_pantograph(kind: str, p: CatenaryParams, overrides: dict[str, Any] | None = None) -> Pantograph:
-    """The pantograph named by the scene's `pantograph` effect."""
+def build_pantograph(kind: str, p: CatenaryParams, overrides: dict[str, Any] | None = None,
+                     dt: float = 1e-4) -> Pantograph:
+    """The pantograph named by the scene's `pantograph` effect (`eppinger_mujoco`: the Eppinger model's MuJoCo path)."""
     if kind == "reference2mass":
         return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
     if kind in ("eppinger", "eppinger_mujoco"):
-        from .eppinger import make_eppinger  # the lead's pantograph package, imported only when asked for
+        from .eppinger import make_eppinger  # the pantograph package, imported only when a scene asks for it
 
-        return make_eppinger(kind, p, overrides or {})
+        return make_eppinger(kind, p, overrides or {}, dt=dt)
     raise SceneError(f"unknown pantograph {kind!r}; valid: ['reference2mass', 'eppinger', 'eppinger_mujoco']")
 
 
@@ -102,7 +104,7 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     regime = speed_regime(p, V)
     t0 = time.perf_counter()
     fe = fe if fe is not None else assemble(p)
-    panto = build_pantograph(pantograph, p) if isinstance(pantograph, str) else pantograph
+    panto = build_pantograph(pantograph, p, dt=dt) if isinstance(pantograph, str) else pantograph
     sim = CoupledSimulation(fe, panto, V, dt, dropper_law=dropper_law, contact=contact)
     t1 = time.perf_counter()
     res = sim.run(p.x_start, p.x_end, progress=progress)
@@ -142,8 +144,14 @@ def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides)
     p = scene.build_params()
     if overrides:
         p = dataclasses.replace(p, **overrides)
+    kind = scene.effects["pantograph"]
+    if scene.solver.engine == "mujoco":
+        if kind != "eppinger":
+            raise SceneError(f"pantograph {kind!r} has no MuJoCo path; use solver.engine = 'reference' "
+                             "(the catenary itself is always the FE reference code)")
+        kind = "eppinger_mujoco"
     return simulate(p, scene_speed(scene, speed_kmh), scene.solver.timestep, dropper_law=scene.effects["droppers"],
-                    pantograph=scene.effects["pantograph"], contact=scene.effects["contact"], progress=progress)
+                    pantograph=kind, contact=scene.effects["contact"], progress=progress)
 
 
 def to_simresult(run: CatenaryRun, scene) -> SimResult:
@@ -186,7 +194,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
     for r in runs:
         c = r.stats["loss_counts"]
         lines.append(f"[{r.dropper_law}] contact losses in window: {len(r.stats['loss_events'])} "
-                     f"(<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, >20 ms: {c['power_loss_gt_20ms']}); "
+                     f"(<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, "
+                     f">20 ms: {c['power_loss_gt_20ms']}); "
                      f"static contact force {r.static_force:.2f} N; run time {r.timing['total_s']:.2f} s "
                      f"({r.timing['steps']} steps, {r.timing['dofs']} DOFs, {r.timing['us_per_step']:.0f} us/step)")
     lines.append(f"speed ratio V/c = {run.regime['speed_ratio']:.3f} (c = {run.regime['cw_wave_speed_kmh']:.1f} km/h), "

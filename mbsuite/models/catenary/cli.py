@@ -28,7 +28,8 @@ def _handler(args: argparse.Namespace, emit) -> None:
     if scene.model != "catenary":
         from ...errors import SceneError
 
-        raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a catenary scene")
+        raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "
+                         "catenary scene")
     if args.timestep is not None:
         scene = scene.replace(solver={"timestep": args.timestep})
     if args.element_length is not None:

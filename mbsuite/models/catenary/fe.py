@@ -91,7 +91,8 @@ class CatenaryFE:
     `M`, `K0` (beams + steady arms + messenger supports), `Kd` (droppers as linear springs) are CSR on free DOFs.
     `B` (n_free x n_droppers) maps DOFs to dropper elongations delta = B^T u (MW up minus CW up); a dropper's tension
     T0 + k delta pulls the CW node up and the MW node down. `w0` is the static CW shape (full DOF vector, w and theta
-    of both wires; the MW static shape does not enter the dynamics and is left at 0), `T0` the droppers' static tensions.
+    of both wires; the MW static shape does not enter the dynamics and is left at 0), `T0` the droppers' static
+    tensions.
     """
 
     params: CatenaryParams

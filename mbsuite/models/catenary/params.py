@@ -67,7 +67,8 @@ class CatenaryParams:
         for name in positive:
             if getattr(self, name) <= 0:
                 what = "tension" if "tension" in name else "value"
-                raise ParameterError(f"catenary parameter {name} must be > 0 (a positive {what}), got {getattr(self, name)!r}")
+                raise ParameterError(
+                    f"catenary parameter {name} must be > 0 (a positive {what}), got {getattr(self, name)!r}")
         for name in non_negative:
             if getattr(self, name) < 0:
                 raise ParameterError(f"catenary parameter {name} must be >= 0, got {getattr(self, name)!r}")

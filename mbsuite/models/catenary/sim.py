@@ -7,9 +7,10 @@ order, no numerical damping) in its midpoint form. With h = dt/2 and the mean ve
     q_n = M v_n - h K u_n   (kept by the recursions q_{n+1} = 2(M - h^2 K) vb - p_n, p_{n+1} = 2(M + h^2 K) vb - q_n)
 
 so one step costs one banded solve (S is symmetric positive definite with half-bandwidth 5 in the node-by-node DOF
-ordering: LAPACK banded Cholesky dpbtrf once, dpbtrs per step) and one sparse mat-vec. C = alpha M + beta K0 (Rayleigh on the wires and support springs; droppers are massless undamped springs).
-K = K0 + Kd holds the droppers as linear springs; g are the local forces: the contact force f N(x) (Hermite shape
-functions at the contact point) and, for slack droppers, a correction -s B_i that cancels the dropper's tension.
+ordering: LAPACK banded Cholesky dpbtrf once, dpbtrs per step) and one sparse mat-vec. C = alpha M + beta K0
+(Rayleigh on the wires and support springs; droppers are massless undamped springs). K = K0 + Kd holds the
+droppers as linear springs; g are the local forces: the contact force f N(x) (Hermite shape functions at the
+contact point) and, for slack droppers, a correction -s B_i that cancels the dropper's tension.
 
 Consistency (no lag): with G = h^2 S^-1, the end-of-step displacement is affine in the unknown local forces,
 u_{n+1} = u* + f G N - G B s, where u* comes from the single solve and G B (all droppers) is precomputed; G N is
@@ -282,6 +283,7 @@ class CoupledSimulation:
         solve = self.lu.solve
         t0 = time.perf_counter()
         n_local = 0
+        gp_nl = None
         e_cur = e
         rec = 0
         for step in range(1, nsteps + 1):
@@ -312,18 +314,31 @@ class CoupledSimulation:
                 yh = panto.trial(t_new - dt, dt, f_prev, f)
                 n_local += 1
             else:
+                # nonlinear pantograph: secant iteration on f_{n+1}; the slope g of the head map is kept between steps
                 y0 = panto.trial(t_new - dt, dt, f_prev, f_prev)
-                y1 = panto.trial(t_new - dt, dt, f_prev, f_prev + 1.0)
-                gp = y0 - y1
+                n_local += 1
+                if gp_nl is None:
+                    gp_nl = y0 - panto.trial(t_new - dt, dt, f_prev, f_prev + 1.0)
+                gp = gp_nl
                 P = y0 + gp * f_prev
-                for _it in range(50):
+                fa, ya = f_prev, y0
+                for _it in range(30):
                     f, S, sS, active = self._solve_local(P, gp, a, c, bz, dstar, active, S)
+                    if f == fa:
+                        yh = ya
+                        panto.trial(t_new - dt, dt, f_prev, f)
+                        break
                     yh = panto.trial(t_new - dt, dt, f_prev, f)
                     n_local += 1
                     err = yh - (P - gp * f)
-                    if abs(err) < 1e-13 + 1e-10 * abs(yh):
+                    if abs(err) < 1e-13 + 1e-11 * abs(yh):
                         break
-                    P += err
+                    if abs(f - fa) > 1e-9:
+                        g_new = (ya - yh) / (f - fa)
+                        if g_new > 0:
+                            gp = gp_nl = g_new
+                    P = yh + gp * f
+                    fa, ya = f, yh
                 else:
                     raise SolverError(f"pantograph-catenary coupling did not converge at t = {t_new:.6f} s")
             panto.commit()

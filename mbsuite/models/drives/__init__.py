@@ -20,10 +20,12 @@ SPEC = ModelSpec(
     effects={
         "mechanism": Effect(("step_up", "step_up_down", "coupled_clutches"), "step_up",
                             "which rotor system: Fig 3.3, Fig 3.4 or Modelica's CoupledClutches"),
-        "param_set": Effect(tuple(PARAM_SETS), "table_4_2", "parameter set (Table 4.2, 100 W design/prototype, App. J)"),
+        "param_set": Effect(tuple(PARAM_SETS), "table_4_2",
+                            "parameter set (Table 4.2, 100 W design/prototype, App. J)"),
         "controller": Effect(("none", "pwm", "resonant", "motor_resonant", "energy_packet"), "pwm",
                              "switching algorithm (App. E / App. F)"),
-        "clutch_matching": Effect((True, False), False, "step-up: delay clutch engagement to the velocity match (Eq 2.1)"),
+        "clutch_matching": Effect((True, False), False,
+                                  "step-up: delay clutch engagement to the velocity match (Eq 2.1)"),
         "closed_loop": Effect((True, False), False, "PI on t_k (step-up) / energy-packet PI (step-up/step-down)"),
         "anti_windup": Effect((True, False), False, "store the clamped PI state (step-up: printed code has none; "
                               "step-up/step-down energy-packet PI always clamps to the spring capacity)"),

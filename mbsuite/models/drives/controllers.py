@@ -41,9 +41,9 @@ def match_time(Omega: float, theta_e: float, w_e: float, w_t: float, theta_sign:
     """Robust velocity-match time for the free spring system (Eq 2.2 / App. B, root choice by enumeration).
 
     Free motion: w(t) = A cos(psi), theta(t) = (A/Omega) sin(psi), psi = Omega t + phi, A = hypot(w_e, Omega theta_e).
-    Returns the earliest t in [0, 2 pi/Omega) with w = w_t and sign(theta) = theta_sign, and True. If no real root exists
-    (the spring system's energy is below 1/2 J_s w_t^2), returns the time of peak speed in the direction of w_t (thesis
-    §6.5 recommendation (i): the least slip) and False."""
+    Returns the earliest t in [0, 2 pi/Omega) with w = w_t and sign(theta) = theta_sign, and True. If no real root
+    exists (the spring system's energy is below 1/2 J_s w_t^2), returns the time of peak speed in the direction of
+    w_t (thesis §6.5 recommendation (i): the least slip) and False."""
     A = math.hypot(w_e, Omega * theta_e)
     phi = math.atan2(Omega * theta_e, w_e)
     period = 2.0 * math.pi / Omega
@@ -173,7 +173,7 @@ class StepUpController:
         return out
 
 
-# ---- step-up/step-down drive (App. F, `switch_bds`, with the documented bug fixes) ------------------------------------
+# ---- step-up/step-down drive (App. F, `switch_bds`, with the documented bug fixes) -----------------------------------
 @dataclass
 class EnergyPacketController:
     """Bi-directional energy-packet resonant switching for the step-up/step-down drive.

@@ -19,7 +19,7 @@ import numpy as np
 from ...errors import ParameterError, SceneError
 from ...paths import mjcf_path
 from .controllers import EnergyPacketController, StepUpController
-from .friction import Friction, Part, RefResult, RotorSystem, Source, simulate_reference
+from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring, simulate_reference
 from .params import motor_line
 
 ROTORS = ["motor", "spring", "load"]
@@ -51,8 +51,6 @@ def build_system(mechanism: str, p: Mapping[str, Any], effects: Mapping[str, Any
             Friction("clutch", 1, 2, [Part("clutch", p["tau_c"], "clutch")], peak=peak),
             Friction("load_ground", 2, -1, load_parts),
         ]
-        from .friction import Spring
-
         springs = [Spring("twist", 0, 1, p["K"])]
         delay_map = {"brake": d, "clutch": d}
     elif mechanism == "step_up_down":
@@ -66,13 +64,17 @@ def build_system(mechanism: str, p: Mapping[str, Any], effects: Mapping[str, Any
             Friction("clutch_a", 0, 1, [Part("clutch_a", p["tau_c1"], "ca")], peak=peak),
             Friction("clutch_b", 1, 2, [Part("clutch_b", p["tau_c2"], "cb")], peak=peak),
         ]
-        from .friction import Spring
-
         springs = [Spring("ground", 1, -1, p["K"])]
         delay_map = {"ca": d, "cb": d}
     else:
         raise SceneError(f"unknown mechanism {mechanism!r}; valid: ['step_up', 'step_up_down']")
-    return RotorSystem(names=list(ROTORS), J=np.array(J), B=np.array(B), springs=springs, frictions=fr, sources=src,
+    # only what is asked for is built: a Coulomb part of zero level (bearings off, no load torque) is not an element
+    fr2 = []
+    for f in fr:
+        f.parts = [pt for pt in f.parts if pt.command is not None or pt.level > 0.0]
+        if f.parts:
+            fr2.append(f)
+    return RotorSystem(names=list(ROTORS), J=np.array(J), B=np.array(B), springs=springs, frictions=fr2, sources=src,
                        delays=delay_map)
 
 
@@ -80,10 +82,6 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
     fs = float(p["fs"])
     delays = effects.get("clutch_delays", True)
     cd = p["d_on"] if delays else 0.0
-    period_free = 2 * math.pi * math.sqrt(p["J_s"] / p["K"])
-    if delays and max(p["d_on"], p["d_off"]) >= period_free:
-        raise ParameterError(f"clutch delay {max(p['d_on'], p['d_off'])} s is longer than the spring system's free "
-                             f"oscillation period {period_free:.4g} s (one energy cycle)")
     closed = bool(effects.get("closed_loop", False))
     if mechanism == "step_up":
         if kind not in ("pwm", "resonant", "motor_resonant"):
@@ -99,6 +97,10 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
                                 anti_windup=bool(effects.get("anti_windup", False)))
     if kind != "energy_packet":
         raise SceneError(f"unknown controller {kind!r} for the step-up/step-down drive; valid: ['energy_packet']")
+    period_free = 2 * math.pi * math.sqrt(p["J_s"] / p["K"])
+    if delays and max(p["d_on"], p["d_off"]) >= period_free:
+        raise ParameterError(f"clutch delay {max(p['d_on'], p['d_off'])} s is longer than the spring system's free "
+                             f"oscillation period {period_free:.4g} s (one energy cycle)")
     K_ctrl = p.get("K_ctrl") or p["K"]
     Om = p.get("Omega_ctrl") or math.sqrt(p["K"] / p["J_s"])
     x_max = p.get("spring_max") or min(p["tau_c1"], p["tau_c2"]) / p["K"]
@@ -167,9 +169,11 @@ def cycle_stats(res: RefResult, ctrl, t0: float = 0.0) -> dict[str, Any]:
     out: dict[str, Any] = {"n_cycles": int(max(0, cyc.size - 1))}
     if cyc.size >= 2:
         out["switching_rate"] = float((cyc.size - 1) / (cyc[-1] - cyc[0]))
-        m = (res.t >= cyc[0]) & (res.t <= cyc[-1])
-        out["mean_load_speed"] = float(np.trapezoid(res.w[2, m], res.t[m]) / (res.t[m][-1] - res.t[m][0]))
-        out["mean_motor_speed"] = float(np.trapezoid(res.w[0, m], res.t[m]) / (res.t[m][-1] - res.t[m][0]))
+    m = res.t >= t0  # speeds over the fixed window [t0, t_end] (comparable between runs)
+    if np.count_nonzero(m) >= 2:
+        span = res.t[m][-1] - res.t[m][0]
+        out["mean_load_speed"] = float(np.trapezoid(res.w[2, m], res.t[m]) / span)
+        out["mean_motor_speed"] = float(np.trapezoid(res.w[0, m], res.t[m]) / span)
     packets = [e.get("eps") for e in ctrl.log if e["event"] == "cycle" and e.get("eps") is not None and e["t"] >= t0]
     if packets:
         out["packets"] = packets
@@ -177,3 +181,27 @@ def cycle_stats(res: RefResult, ctrl, t0: float = 0.0) -> dict[str, Any]:
     if th:
         out["max_extension"] = float(max(th))
     return out
+
+
+def compare_events(a: RefResult, b: RefResult, elements: list[str], kinds=("stuck", "free"), t0: float = 0.0
+                   ) -> dict[str, Any]:
+    """Pair the lock-up (-> stuck) and release (-> free) events of two runs: each event of `a` with the nearest event
+    of `b` of the same element and kind. Returns the counts and the largest time difference per element/kind."""
+    out: dict[str, Any] = {}
+    for el in elements:
+        for kind in kinds:
+            ta = np.array([e["t"] for e in a.events if e["element"] == el and e["to"] == kind and e["t"] >= t0])
+            tb = np.array([e["t"] for e in b.events if e["element"] == el and e["to"] == kind and e["t"] >= t0])
+            if ta.size == 0 and tb.size == 0:
+                continue
+            d = np.array([np.min(np.abs(tb - x)) for x in ta]) if tb.size else np.full(ta.size, np.inf)
+            out[f"{el}->{kind}"] = {"n_a": int(ta.size), "n_b": int(tb.size),
+                                    "max_dt": float(d.max()) if d.size else float("nan"),
+                                    "median_dt": float(np.median(d)) if d.size else float("nan")}
+    return out
+
+
+def transferred_packets(system: RotorSystem, res: RefResult, mechanism: str, ctrl) -> np.ndarray:
+    """Energy delivered per energy cycle = 1/2 K theta_peak^2 at each transfer (step-up/step-down), from the log."""
+    K = system.springs[0].K
+    return np.array([0.5 * K * e["theta_peak"] ** 2 for e in ctrl.log if e["event"] == "transferred"])

@@ -213,6 +213,10 @@ class RefResult:
     stats: dict[str, Any]
 
 
+def _const(y: np.ndarray):
+    return lambda tt: y
+
+
 def _root(fun, a: float, b: float) -> float:
     """Root of fun in [a, b] (brentq to ~1e-15 s); if round-off leaves no bracket the crossing is at an end point."""
     fa, fb = fun(a), fun(b)
@@ -465,7 +469,7 @@ def simulate_reference(
                 stats["steps"] += 1
             t_new = min(solver.t, t_hard)
             sol = solver.dense_output() if solver.t_old is not None else None
-            yfun = (lambda tt: sol(tt)) if sol is not None else (lambda tt: y)
+            yfun = sol if sol is not None else _const(y)
             # state events in (t_cur_old, t_new]
             t_lo = solver.t_old if solver.t_old is not None else t
             t_lo = max(t_lo, t)
@@ -475,7 +479,7 @@ def simulate_reference(
             for i, (g, d, tag) in enumerate(evs):
                 a0, a1 = g_old[i], g_new[i]
                 if (d < 0 and a0 > 0 and a1 <= 0) or (d > 0 and a0 < 0 and a1 >= 0):
-                    te = _root(lambda tt, g=g: g(tt, yfun(tt)), t_lo, t_new)
+                    te = _root(lambda tt, g=g, yf=yfun: g(tt, yf(tt)), t_lo, t_new)
                     fired.append((te, tag))
             if fired:
                 te = min(f[0] for f in fired)

@@ -36,9 +36,9 @@ DESIGN_100W: dict[str, float] = dict(
     tau_c1=5.0, tau_c2=5.0, d_on=0.004, d_off=0.004, fs=1000.0,
     Kp=0.00112, Ki=0.0161, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0,  # L2014; fs not stated (1 kHz assumed)
 )
-# 100 W prototype as fitted to the 100 W open-loop test (L2200: B_s = 107e-5, K = 1.2; J_s = 7.76e-5 from K/J = 18038,
-# L2040-2042; output bearing Cl = 0.0025, Bl = 8.9e-5 (App. J "from MSD data", L3762-3764); spring bearings = spring+output
-# pair minus output (L2119); input bearing = spring+input minus spring (L2121-2123)).
+# 100 W prototype as fitted to the 100 W open-loop test (L2200: B_s = 107e-5, K = 1.2; J_s = 7.76e-5 from
+# K/J = 18038, L2040-2042; output bearing Cl = 0.0025, Bl = 8.9e-5 (App. J "from MSD data", L3762-3764); spring
+# bearings = spring+output pair minus output (L2119); input bearing = spring+input minus spring (L2121-2123)).
 PROTO_100W: dict[str, float] = dict(
     DESIGN_100W,
     K=1.2, J_s=7.76e-5, B_s=107e-5, C_s=0.0078 - 0.0025, C_l=0.0025, B_l=8.9e-5,

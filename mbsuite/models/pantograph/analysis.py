@@ -1,6 +1,7 @@
 """Pantograph analyses: time runs (both engines), equilibrium (three paths), linearised modes, frequency response.
 
-Outputs follow the thesis (Ch. 5.1): F1 = l1 sin t1, F2 = l2 sin t2, HD = lh sin th, y_d = F1 + F2 + HD, against the input
+Outputs follow the thesis (Ch. 5.1): F1 = l1 sin t1, F2 = l2 sin t2, HD = lh sin th, y_d = F1 + F2 + HD, against the
+input
 y_w = y_op + A (1 - cos w t) (EQSIM's YW). Amplitudes are ratios to the input amplitude A; phases are relative to the
 input's fundamental (degrees, negative = lag).
 """
@@ -396,7 +397,8 @@ def modes_report(scene: Scene) -> Report:
         rows.append([md["kind"], md["f_n"], md["zeta"], m2["f_n"], m2["zeta"]])
     table = format_table(["mode", "f_n ref (Hz)", "zeta ref", "f_n MuJoCo (Hz)", "zeta MuJoCo"], rows, ".5g")
     table += ("\nreference: central-difference Jacobian of the hand-derived ODE; MuJoCo: mjd_transitionFD at "
-              f"timestep {scene.solver.timestep:g} s ({scene.solver.integrator}), log(mu)/h. Coulomb friction excluded.")
+              f"timestep {scene.solver.timestep:g} s ({scene.solver.integrator}), log(mu)/h. "
+              "Coulomb friction excluded.")
     return Report({"reference": ref, "mujoco": mj}, table)
 
 

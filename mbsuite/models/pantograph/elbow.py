@@ -3,10 +3,12 @@
 The pinion (radius le) sits at the elbow C = (l1 cos th1, l1 sin th1); the chain ("fourth bar") runs from the base point
 F = (xf, -yf) tangent to the pinion. With t = tan(phi1) the tangency condition B.2 is the quadratic B.3,
     A t^2 + B t + C = 0,  A = (l1 c1 - xf)^2 - le^2,  B = -2 (l1 c1 - xf)(l1 s1 + yf),  C = (l1 s1 + yf)^2 - le^2,
-of which B.4 takes the negative root, phi1 = atan2(-B - sqrt(B^2 - 4AC), 2A) (the EQSIM form). The fourth-bar length B.5 is
+of which B.4 takes the negative root, phi1 = atan2(-B - sqrt(B^2 - 4AC), 2A) (the EQSIM form). The fourth-bar length
+B.5 is
     lfb = sqrt((l1 c1 + le sin phi1 - xf)^2 + (l1 s1 - le cos phi1 + yf)^2)
 and the pinion rotation B.6 is   theta_e = theta_e0 + (lfb - lfb0)/le - theta_1.
-B.6 approximates d(phi1)/d(theta1) = 1 (erratum 22); the exact chain wrap is theta_e = theta_e0 + (lfb - lfb0)/le - (phi1 - phi1_0).
+B.6 approximates d(phi1)/d(theta1) = 1 (erratum 22); the exact chain wrap is theta_e = theta_e0 + (lfb - lfb0)/le -
+(phi1 - phi1_0).
 Derivatives come from implicit differentiation of the quadratic: t' = -(A' t^2 + B' t + C')/(2 A t + B).
 """
 
@@ -38,7 +40,8 @@ def _chain(theta1: float, p: PantographParams) -> tuple[float, float, float]:
     disc = B * B - 4.0 * A * C  # = 4 le^2 (X^2 + Y^2 - le^2)
     if disc <= 0.0 or A == 0.0:
         raise GeometryError(
-            f"elbow chain geometry has no tangent line at theta_1 = {theta1:.6g} rad (B^2-4AC = {disc:.3g}, A = {A:.3g}):"
+            f"elbow chain geometry has no tangent line at theta_1 = {theta1:.6g} rad "
+            f"(B^2-4AC = {disc:.3g}, A = {A:.3g}):"
             " the chain base point lies inside the pinion circle or the chain is vertical"
         )
     sq = math.sqrt(disc)

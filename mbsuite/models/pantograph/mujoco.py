@@ -86,7 +86,7 @@ class MujocoPantograph:
         for j in spec.joints:
             j.solref_friction = [2.0 * self.timestep, 1.0]  # stiffest admissible friction constraint (see modelfiles)
             if not cfg.viscous:
-                j.damping = 0.0
+                j.damping = [0.0, 0.0, 0.0]  # mujoco 4: damping is a 3-vector (polynomial coefficients)
             if not cfg.coulomb:
                 j.frictionloss = 0.0
         cat = spec.actuator("catenary")

@@ -1,6 +1,7 @@
 """Brecknell-Willis pantograph parameters: Table 3-I of Eppinger (1984), seed 000 lines 560-600, SI units.
 
-Angles are measured from the horizontal (Fig 3-3): the lower arm points forward, the upper arm backward, the head forward.
+Angles are measured from the horizontal (Fig 3-3): the lower arm points forward, the upper arm backward, the head
+forward.
 """
 
 from __future__ import annotations

@@ -1,14 +1,17 @@
 """Hand-derived pantograph dynamics in plain numpy/scipy (Eppinger 1984, seed 000), with the errata of
 `shared/reference/pantograph.md` applied.
 
-Coordinates are the thesis' absolute angles theta = (theta_1, theta_2, theta_h) (Fig 3-3). With K12 = m2 l1 d2 + mh l1 l2,
-K13 = mh l1 dh, K23 = mh l2 dh and the catenary force f_s = ks (y_w - y_d) on the head (positive pulls up), Eqs 3.10-3.12
+Coordinates are the thesis' absolute angles theta = (theta_1, theta_2, theta_h) (Fig 3-3). With K12 = m2 l1 d2 + mh
+l1 l2,
+K13 = mh l1 dh, K23 = mh l2 dh and the catenary force f_s = ks (y_w - y_d) on the head (positive pulls up), Eqs
+3.10-3.12
 (= A.28, A.31, A.34 after errata 4, 5, 8) read M(theta) theta'' = R with
 
     M = [[I1+m1 d1^2+(m2+mh) l1^2, K12 cos(t1+t2),        K13 cos(t1-th)],
          [K12 cos(t1+t2),          I2+m2 d2^2+mh l2^2,    K23 cos(t2+th)],
          [K13 cos(t1-th),          K23 cos(t2+th),        Ih+mh dh^2    ]]
-    R1 = K12 t2'^2 sin(t1+t2) + K13 th'^2 sin(th-t1) + cos t1 (l1 f_s - g(m1 d1+m2 l1+mh l1)) + Fc lb sin(alpha-t1) - Te dte/dt1
+    R1 = K12 t2'^2 sin(t1+t2) + K13 th'^2 sin(th-t1) + cos t1 (l1 f_s - g(m1 d1+m2 l1+mh l1)) + Fc lb sin(alpha-t1) -
+    Te dte/dt1
     R2 = K12 t1'^2 sin(t1+t2) + K23 th'^2 sin(t2+th) + cos t2 (l2 f_s - g(m2 d2+mh l2)) + Te
     R3 = K13 t1'^2 sin(t1-th) + K23 t2'^2 sin(t2+th) + cos th (lh f_s - g mh dh) - kh th
     Te = ke (theta_e - t2) + be (theta_e' - t2')                       (3.13-3.14, + sign per erratum 9)
@@ -269,6 +272,31 @@ class PantographODE:
     def rhs(self, t: float, x: np.ndarray, y_w: float, modes: FrictionModes | None = None) -> np.ndarray:
         return self.rhs_with_force(t, x, self.contact_force(y_w, self.contact_height(x)), modes)
 
+    def energy(self, x: np.ndarray, y_w: float) -> float:
+        """Total mechanical energy T + V (A.16-A.17 with the elbow 3.13 and the cylinder as a potential):
+        exact for the constant cylinder (V_c = -Pg Ap x_p) and the linear one's spring (+ kc (P - x_p)^2 / 2)."""
+        p = self.p
+        nq = self.nq
+        q, qd = x[:nq], x[nq : 2 * nq]
+        J, _ = self.theta_jacobian(q)
+        t = self.theta(q)
+        td = J @ qd
+        T = 0.5 * td @ self.mass_matrix_theta(t) @ td
+        Vg = -float(self.gravity_forces_theta(np.zeros(3)) @ np.sin(t))  # g (m d ...) sin(theta)
+        y_d = self.contact_height(x)
+        dy = y_w - y_d
+        Vs = 0.5 * p.ks * (min(dy, 0.0) if self.cfg.contact == "unilateral" else dy) ** 2
+        V = Vg + Vs + 0.5 * p.kh * t[2] ** 2
+        if nq == 3:
+            V += 0.5 * p.ke * (self.elbow(t[0]).theta_e - t[1]) ** 2
+        xp = self.cylinder_lever(t[0])[0]
+        if self.cfg.cylinder == "nonlinear":
+            raise ValueError("energy() is defined for the constant and linear cylinders (the gas is an open system)")
+        V -= p.Pg * p.Ap * xp
+        if self.cfg.cylinder == "linear":
+            V += 0.5 * p.kc * (x[-1] - xp) ** 2
+        return float(T + V)
+
     # ---------------------------------------------------------------- statics
     def static_residual(self, q: np.ndarray, y_w: float) -> np.ndarray:
         """Generalised static force (friction-free, cylinder at its static force Pg Ap) — zero at equilibrium."""
@@ -398,7 +426,8 @@ def simulate(
             evs.append(_contact_event(ode, y_w, in_contact))
             kinds.append(("contact", -1))
         te = None if t_eval is None else t_eval[(t_eval >= t0) & (t_eval <= t_end)]
-        sol = solve_ivp(lambda t, x: ode.rhs(t, x, y_w(t), modes if exact else None), (t0, t_end), x,
+        seg_modes = modes if exact else None
+        sol = solve_ivp(lambda t, x, m=seg_modes: ode.rhs(t, x, y_w(t), m), (t0, t_end), x,
                         t_eval=te, events=evs or None, **kw)
         nfev += sol.nfev
         nsteps += max(len(sol.t) - 1, 0) if t_eval is None else 0

@@ -12,7 +12,10 @@ What each effect installs (nothing else is built):
 - elbow compliant: a passive callback adds Eq 3.13's torque mapped to q: Q = E^T (-Te dte/dt1, Te, 0).
 - elbow rigid: a joint equality q2 = poly(q1), a quartic fit of pi - t1 - theta_e(t1) over the working range (soft
   equality, solref timeconst = 2 timestep; its fit error is reported by `rigid_elbow_fit`).
-The ram is ctrl[catenary] = y_w(t_k) during step k: the forces of a (semi-implicit) Euler step are evaluated at t_k.
+The ram is ctrl[catenary] = y_w(t_k + c h) during step k, with c = 1/2 for RK4 (the hold value that represents y_w over
+the step to O(h^2); with c = 0 RK4 degrades to first order: F1 phase error 0.38 deg vs 6e-7 deg at 4.25 Hz, h = 5e-4 s)
+and c = 0 for the Euler family, whose semi-implicit update is leapfrog-like in position with forces belonging at t_k
+(lab scene, h = 5e-4 s: max phase error 0.51 deg with c = 0 vs 0.92 deg with c = 1/2 over 2-10 Hz).
 """
 
 from __future__ import annotations
@@ -73,6 +76,7 @@ class MujocoPantograph:
         self.model = mje.load_model(spec)
         mje.set_integrator(self.model, integrator, timestep)
         self.data = mujoco.MjData(self.model)
+        self.hold_offset = 0.5 if integrator == "rk4" else 0.0
         self.elbow = Elbow(self.p, exact=self.cfg.elbow_kinematics == "exact")
         self.i_cat = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "catenary")
         self.i_cyl = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "cylinder")
@@ -191,8 +195,7 @@ class MujocoPantograph:
             q0 = self.equilibrium(y_w(0.0))
         mujoco.mj_resetData(m, d)
         cbs = self.callback_set()
-        t_k = np.arange(nstep) * h
-        yw = np.array([y_w(t) for t in t_k])
+        yw = np.array([y_w(t) for t in (np.arange(nstep) + self.hold_offset) * h])
         ctrl = np.zeros((nstep, m.nu))
         ctrl[:, self.i_cat] = yw
         with mje.callbacks(**cbs):

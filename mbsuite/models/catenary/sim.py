@@ -275,7 +275,9 @@ class CoupledSimulation:
         DS = np.zeros((nrec, nd), bool) if record_droppers else None
         if record_droppers:
             DE[0] = fe.T0 + self.kd * (u[self.mw] - u[self.cw])
-        EN = {k: np.zeros(nrec) for k in ("catenary", "pantograph", "contact", "drive_power")} if record_energy else None
+        EN = None
+        if record_energy:
+            EN = {k: np.zeros(nrec) for k in ("catenary", "pantograph", "contact", "drive_power")}
         if record_energy:
             self.q, self.p = q, pv
             self.u = u
@@ -460,8 +462,9 @@ class CoupledSimulation:
 
     def velocity(self) -> np.ndarray:
         """Catenary velocity at the end of the run, from M v = (q + p) / 2."""
-        from scipy.sparse.linalg import spsolve
-        return spsolve(self.fe.M.tocsc(), 0.5 * (self.q + self.p))
+        if getattr(self, "_Mfac", None) is None:
+            self._Mfac = BandedSPD(self.fe.M)
+        return self._Mfac.solve(0.5 * (self.q + self.p))
 
     def energy(self) -> float:
         """Catenary energy (J) relative to the static state, droppers as linear springs (kinetic + strain)."""

@@ -45,6 +45,8 @@ PROTO_100W: dict[str, float] = dict(
     C_m=0.0246 + (0.009 - 0.0053), B_m=7.95e-5 + (14.05e-5 - 7.2e-5), tau_l=0.0,
     K_ctrl=1.32, Omega_ctrl=132.0,  # controller values on the prototype (L2072-2074)
 )
+# 50 W open-loop fit (L2184-2198): spring viscous B_s = 67.6e-5 from the first free-vibration cycle, measured K = 1.40.
+PROTO_50W: dict[str, float] = dict(PROTO_100W, B_s=67.6e-5, K=1.40)
 # 500 W example design, App. J parameter file (L3735-3809) and Sec. 5.4 (L1848-1895).
 EXAMPLE_500W: dict[str, float] = dict(
     tau_0=10.0, tau_slope=-0.05, J_m=0.005, J_add=0.0, C_m=0.0025, B_m=8.9e-5,  # T_m = 10 - 0.05 w (L3744-3748)
@@ -59,6 +61,7 @@ PARAM_SETS: dict[str, dict[str, float]] = {
     "table_4_2": TABLE_4_2,
     "design_100w": DESIGN_100W,
     "proto_100w": PROTO_100W,
+    "proto_50w": PROTO_50W,
     "example_500w": EXAMPLE_500W,
     "modelica": MODELICA,
 }

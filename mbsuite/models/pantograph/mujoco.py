@@ -125,14 +125,15 @@ class MujocoPantograph:
         }
 
     def _elbow_passive(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
-        q1, q2 = d.qpos[0], d.qpos[1]
-        e = self.elbow(q1)
-        th2 = math.pi - q1 - q2
-        Te = self.p.ke * (e.theta_e - th2)
+        qpos = d.qpos.tolist()  # one conversion instead of numpy scalar reads (the callback runs every stage)
+        te, dte = self.elbow.fast(qpos[0])
+        Te = self.p.ke * (te - math.pi + qpos[0] + qpos[1])  # ke (theta_e - theta_2), theta_2 = pi - q1 - q2
         if self.p.be:
-            Te += self.p.be * (e.dtheta_e * d.qvel[0] + d.qvel[0] + d.qvel[1])
-        d.qfrc_passive[0] -= Te * (e.dtheta_e + 1.0)
-        d.qfrc_passive[1] -= Te
+            qvel = d.qvel.tolist()
+            Te += self.p.be * (dte * qvel[0] + qvel[0] + qvel[1])
+        f = d.qfrc_passive
+        f[0] -= Te * (dte + 1.0)
+        f[1] -= Te
 
     def _cylinder_dyn(self, m: mujoco.MjModel, d: mujoco.MjData, i: int) -> float:
         P = d.act[m.actuator_actadr[i]]

@@ -117,15 +117,17 @@ def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
     assert np.max(r.force) < 20 * p.F0
 
 
-def test_pantograph_leaving_the_wire_is_reported_not_nan():
-    p = CatenaryParams(n_spans=2, element_length=0.5, x_end=100.0, window_start=40.0, window_end=80.0, F0=-50.0)
+@pytest.mark.parametrize("F0", [0.0, -50.0])
+def test_pantograph_leaving_the_wire_is_reported_not_nan(F0):
+    """Zero (or negative) static uplift: the head drops off the wire; the run reports it, statistics stay finite."""
+    p = CatenaryParams(n_spans=2, element_length=0.5, x_end=100.0, window_start=40.0, window_end=80.0, F0=F0)
     with pytest.warns(ContactLostWarning, match="off the wire"):
         run = simulate(p, 250.0, 2e-4)
     s = run.stats
     assert s["contact_lost_entirely"] and s["loss_pct"] == 100.0
     for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm"):
         assert math.isfinite(s[k])
-    assert s["Fm"] == 0.0 and s["sigma"] == 0.0
+    assert abs(s["Fm"]) < 1e-6 and s["sigma"] < 1e-6
     assert len(s["loss_events"]) == 1 and s["loss_counts"]["power_loss_gt_20ms"] == 1
 
 

@@ -141,10 +141,10 @@ def run(scene: Scene) -> SimResult:
         th = mp.thetas(r.qpos)
         P = r.act[:, 0] if mp.model.na else None
         sig = signals(ode, th, r.y_w, P)
+        ev = _contact_losses(r.t, sig["contact_force"]) if cfg.contact == "unilateral" else []  # at every step
         every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
         t = r.t[::every]
         sig = {k: v[::every] for k, v in sig.items()}
-        ev = _contact_losses(r.t, signals(ode, th, r.y_w, P)["contact_force"]) if cfg.contact == "unilateral" else []
         res = SimResult(t, sig, {k: UNITS[k] for k in sig}, "mujoco", events=ev,
                         stats={"steps": int(r.t.size - 1), "integrator": s.integrator, "timestep": s.timestep,
                                "warnings": r.warnings})
@@ -232,6 +232,8 @@ def _point(job: tuple[dict, float, str]) -> dict:
     scene = scene.replace(input={"type": "sine", "frequency": f})
     if method == "reference":
         scene = scene.replace(solver={"engine": "reference", "sample_dt": 1.0 / (64.0 * f)})
+    elif method == "mujoco_no_coulomb":  # the same sweep without Coulomb friction, to show its effect on the peaks
+        scene = scene.replace(solver={"engine": "mujoco"}, effects={"coulomb": False})
     else:
         scene = scene.replace(solver={"engine": "mujoco"})
     res = run(scene.replace(outputs=[*FR_SIGNALS, "y_w", "contact_force"]))
@@ -282,6 +284,8 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
         H = linear_response(A, B, C, freqs)
         curves["linear"] = {s: H[:, i] for i, s in enumerate(FR_SIGNALS)}
     sim_methods = [m for m in methods if m != "linear"]
+    if "mujoco" in sim_methods and cfg.coulomb:
+        sim_methods.append("mujoco_no_coulomb")
     jobs = [(scene.to_dict(), float(f), m) for m in sim_methods for f in freqs]
     results = run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp")
     for m in sim_methods:
@@ -316,6 +320,12 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
         lines.append(f"peaks {m:9s} F1: {', '.join(f'{v:.3f}' for v in pk['F1'])} Hz;"
                      f"  HD: {', '.join(f'{v:.3f}' for v in pk['HD'])} Hz")
     lines.append(f"thesis: simulated {THESIS_RESONANCES_SIM} Hz, measured {THESIS_RESONANCES_MEAS} Hz")
+    if "mujoco_no_coulomb" in curves:
+        fr = data["coulomb_effect_on_peaks"] = _peak_heights(freqs, curves["mujoco"], curves["mujoco_no_coulomb"])
+        lines.append("Coulomb friction on the MuJoCo peaks (|F1|/A, |HD|/A at each F1/HD peak: with -> without):")
+        for s, rows_ in fr.items():
+            lines.append(f"  {s}: " + "; ".join(f"{r['f_hz']:.2f} Hz {r['with']:.3f} -> {r['without']:.3f}"
+                                                 for r in rows_))
 
     def write(out: Path) -> list[Path]:
         cols = [("f", "Hz", freqs)]
@@ -331,6 +341,16 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
         return files
 
     return Report(data, "\n".join(lines), write)
+
+
+def _peak_heights(freqs: np.ndarray, on: dict, off: dict) -> dict:
+    """Amplitude at the grid peaks of the friction-free curve, with and without Coulomb friction."""
+    out = {}
+    for s in ("F1", "HD"):
+        a_off, a_on = np.abs(off[s]), np.abs(on[s])
+        idx = [i for i in range(1, len(freqs) - 1) if a_off[i] > a_off[i - 1] and a_off[i] >= a_off[i + 1]]
+        out[s] = [{"f_hz": float(freqs[i]), "with": float(a_on[i]), "without": float(a_off[i])} for i in idx]
+    return out
 
 
 def _agreement(freqs: np.ndarray, a: dict, b: dict) -> dict:

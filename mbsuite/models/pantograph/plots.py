@@ -11,8 +11,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 THESIS_FREQS = (2.0, 3.5, 4.5, 6.5, 8.5, 10.0)
-COLORS = {"linear": "k", "reference": "tab:blue", "mujoco": "tab:orange"}
-STYLES = {"linear": "-", "reference": "o", "mujoco": "x"}
+COLORS = {"linear": "k", "reference": "tab:blue", "mujoco": "tab:orange", "mujoco_no_coulomb": "tab:green"}
+STYLES = {"linear": "-", "reference": "o", "mujoco": "x", "mujoco_no_coulomb": "+"}
 
 
 def plot_freqresp(path: Path, freqs: np.ndarray, curves: dict[str, dict[str, np.ndarray]]) -> Path:

@@ -1,0 +1,200 @@
+"""Two gates of the IFToMM multibody benchmark through mbsuite's MuJoCo and Pinocchio machinery.
+
+- `fourbar` (A02-type): the parallelogram four-bar of `mjcf/iftomm_fourbar.xml`; every half turn of the crank all bars
+  are collinear, the closure Jacobian loses rank and the mechanism may switch to the anti-parallelogram branch.
+  Branch indicator: the coupler's absolute angle (0 on the parallelogram branch).
+- `bricard` (A04-type): the orthogonal Bricard linkage of `mjcf/iftomm_bricard.xml`; 6 closure rows on 5 joint
+  coordinates with 1 DOF: the closure Jacobian has rank 4 (two redundant rows: the Bricard's own and the axial
+  distance of the two `connect`s that make the sixth hinge).
+
+Engines:
+- `mujoco`: the MJCF as shipped (soft `connect` equalities, solref timeconst from the parameters), stepped in Python
+  with divergence checks; energy from MuJoCo's own `mj_energyPos/Vel`.
+- `reference`: the same file read by Pinocchio (`buildModelFromMJCF`); the closures are taken from MuJoCo's compiled
+  `connect` anchors (body -> Pinocchio joint of the same name), and the constrained dynamics are the index-1 DAE
+  `M a = tau - h + J^T lambda`, `J a = -Jdot v - 2 alpha J v - alpha^2 r` (Baumgarte), solved for lambda by
+  least squares on `J M^-1 J^T` (rank-deficient at the four-bar's singular positions and always for the Bricard: the
+  minimum-norm multipliers give the unique accelerations), integrated by scipy (DOP853 by default) at rtol/atol.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+from scipy.integrate import solve_ivp
+
+from ...engines import mujoco_engine as mje
+from ...engines import pinocchio_engine as pe
+from ...errors import SceneError, SolverError
+from ...paths import mjcf_path
+
+MECHANISMS = ("fourbar", "bricard")
+
+
+@dataclass
+class Closure:
+    """A point closure: point `a` fixed in Pinocchio joint `ja` equals point `b` fixed in joint `jb` (0 = world)."""
+
+    ja: int
+    a: np.ndarray
+    jb: int
+    b: np.ndarray
+
+
+@dataclass
+class Trajectory:
+    t: np.ndarray
+    q: np.ndarray  # (N, nq)
+    v: np.ndarray  # (N, nv)
+    energy: np.ndarray
+    closure: np.ndarray  # max |closure error| (m) per sample
+    stats: dict = field(default_factory=dict)
+
+
+def mujoco_model(mechanism: str, timestep: float, integrator: str, solref_timeconst: float,
+                 gravity: float) -> mujoco.MjModel:
+    if mechanism not in MECHANISMS:
+        raise SceneError(f"unknown IFToMM mechanism {mechanism!r}; valid: {list(MECHANISMS)}")
+    m = mje.load_model(mjcf_path(f"iftomm_{mechanism}"))
+    mje.set_integrator(m, integrator, timestep)
+    m.eq_solref[:, 0] = solref_timeconst
+    m.opt.gravity[:] = [0.0, -gravity, 0.0]
+    return m
+
+
+def closure_jacobian_rank(m: mujoco.MjModel, q: np.ndarray, rtol: float = 1e-9) -> tuple[int, np.ndarray]:
+    """Rank (SVD, relative tolerance rtol) and singular values of MuJoCo's equality-constraint Jacobian at q."""
+    d = mujoco.MjData(m)
+    d.qpos[:] = q
+    mujoco.mj_forward(m, d)
+    rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    J = d.efc_J.reshape(d.nefc, m.nv)[rows] if d.nefc else np.zeros((0, m.nv))
+    return pe.numerical_rank(J, rtol)
+
+
+def initial_velocity(m: mujoco.MjModel, rate: float) -> np.ndarray:
+    """Joint velocity at qpos0 on the mechanism's free motion (null space of the closure Jacobian), scaled so that
+    the first (input) joint turns at `rate` rad/s."""
+    if rate == 0.0:
+        return np.zeros(m.nv)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    J = d.efc_J.reshape(d.nefc, m.nv)[rows]
+    _, s, Vt = np.linalg.svd(J)
+    n = Vt[-1]
+    if abs(n[0]) < 1e-9:
+        raise SceneError("the input joint does not move on this mechanism's free motion")
+    return rate * n / n[0]
+
+
+def simulate_mujoco(m: mujoco.MjModel, v0: np.ndarray, duration: float, sample_dt: float) -> Trajectory:
+    d = mujoco.MjData(m)
+    d.qvel[:] = v0
+    mujoco.mj_forward(m, d)
+    n = int(round(duration / m.opt.timestep))
+    every = max(1, int(round(sample_dt / m.opt.timestep))) if sample_dt > 0 else 1
+    rec_t, rec_q, rec_v, rec_e, rec_r = [], [], [], [], []
+    what = f"IFToMM {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, 1)}"
+    for i in range(n + 1):
+        if i % every == 0 or i == n:
+            mujoco.mj_forward(m, d)
+            eq_rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+            rec_t.append(d.time)
+            rec_q.append(d.qpos.copy())
+            rec_v.append(d.qvel.copy())
+            rec_e.append(float(d.energy[0] + d.energy[1]))
+            rec_r.append(float(np.max(np.abs(d.efc_pos[eq_rows]))) if np.any(eq_rows) else 0.0)
+        if i == n:
+            break
+        mujoco.mj_step(m, d)
+        mje.check_finite(m, d, what)
+    return Trajectory(np.array(rec_t), np.array(rec_q), np.array(rec_v), np.array(rec_e), np.array(rec_r),
+                      {"steps": n, "warnings": mje.warnings_raised(d)})
+
+
+class PinocchioMechanism:
+    """The MJCF read by Pinocchio with the closures of MuJoCo's compiled `connect`s (see module docstring)."""
+
+    def __init__(self, mechanism: str, gravity: float, baumgarte: float = 5.0):
+        self.mj = mujoco_model(mechanism, 1e-3, "rk4", 0.004, gravity)
+        self.model = pe.load_mjcf(mjcf_path(f"iftomm_{mechanism}"))
+        self.model.gravity.linear = np.array([0.0, -gravity, 0.0])
+        self.data = self.model.createData()
+        self.alpha = float(baumgarte)
+        self.closures = []
+        for e in range(self.mj.neq):
+            if self.mj.eq_type[e] != mujoco.mjtEq.mjEQ_CONNECT:
+                raise SceneError("only <connect> closures are supported")
+            b1, b2 = int(self.mj.eq_obj1id[e]), int(self.mj.eq_obj2id[e])
+            self.closures.append(Closure(self._joint_of(b1), self.mj.eq_data[e, 0:3].copy(), self._joint_of(b2),
+                                         self.mj.eq_data[e, 3:6].copy()))
+
+    def _joint_of(self, body: int) -> int:
+        if body <= 0 or self.mj.body_jntnum[body] == 0:
+            return 0  # world or the fixed root body (at the origin, identity)
+        name = mujoco.mj_id2name(self.mj, mujoco.mjtObj.mjOBJ_JOINT, int(self.mj.body_jntadr[body]))
+        return self.model.getJointId(name)
+
+    def _points(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        pin.forwardKinematics(self.model, self.data, q)
+        pin.computeJointJacobians(self.model, self.data, q)
+        r, J = [], []
+        for c in self.closures:
+            pts, jacs = [], []
+            for j, loc in ((c.ja, c.a), (c.jb, c.b)):
+                if j == 0:
+                    pts.append(loc)
+                    jacs.append(np.zeros((3, self.model.nv)))
+                    continue
+                M = self.data.oMi[j]
+                p = M.act(loc)
+                J6 = pin.getJointJacobian(self.model, self.data, j, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+                jacs.append(J6[:3] - pin.skew(p - M.translation) @ J6[3:])
+                pts.append(p)
+            r.append(pts[0] - pts[1])
+            J.append(jacs[0] - jacs[1])
+        return np.concatenate(r), np.vstack(J)
+
+    def closure(self, q: np.ndarray) -> np.ndarray:
+        return self._points(q)[0]
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        nq = self.model.nq
+        q, v = x[:nq], x[nq:]
+        r, J = self._points(q)
+        eps = 1e-7
+        _, J2 = self._points(q + eps * v)
+        Jdv = (J2 - J) @ v / eps
+        M = pin.crba(self.model, self.data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        h = pin.nonLinearEffects(self.model, self.data, q, v)
+        Minv_h = np.linalg.solve(M, -h)
+        Minv_Jt = np.linalg.solve(M, J.T)
+        rhs = -Jdv - 2 * self.alpha * (J @ v) - self.alpha**2 * r - J @ Minv_h
+        lam = np.linalg.lstsq(J @ Minv_Jt, rhs, rcond=1e-10)[0]
+        a = Minv_h + Minv_Jt @ lam
+        return np.concatenate([v, a])
+
+    def energy(self, q: np.ndarray, v: np.ndarray) -> float:
+        return float(pin.computeKineticEnergy(self.model, self.data, q, v)
+                     + pin.computePotentialEnergy(self.model, self.data, q))
+
+    def simulate(self, v0: np.ndarray, duration: float, sample_dt: float, method: str = "DOP853",
+                 rtol: float = 1e-10, atol: float = 1e-12, max_step: float = 0.0) -> Trajectory:
+        nq = self.model.nq
+        x0 = np.concatenate([np.zeros(nq), v0])
+        t_eval = np.arange(0.0, duration + 0.5 * sample_dt, sample_dt)
+        t_eval = t_eval[t_eval <= duration]
+        sol = solve_ivp(self.rhs, (0.0, duration), x0, method=method, rtol=rtol, atol=atol, t_eval=t_eval,
+                        max_step=max_step or math.inf)
+        if not sol.success or not np.all(np.isfinite(sol.y)):
+            raise SolverError(f"Pinocchio constrained dynamics ({method}, rtol {rtol:g}) failed: {sol.message}")
+        q, v = sol.y[:nq].T, sol.y[nq:].T
+        e = np.array([self.energy(a, b) for a, b in zip(q, v, strict=True)])
+        res = np.array([float(np.max(np.abs(self.closure(a)))) for a in q])
+        return Trajectory(sol.t, q, v, e, res, {"nfev": int(sol.nfev), "method": method, "rtol": rtol})

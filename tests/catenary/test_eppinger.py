@@ -32,3 +32,17 @@ def test_eppinger_passage_consistent_contact_and_paths_agree():
         assert np.max(np.abs(res.force - expect)) < 1e-6 * np.max(res.force)  # consistent within each step
     assert r_ref.stats["Fm"] == pytest.approx(r_mj.stats["Fm"], abs=0.5)
     assert r_ref.stats["sigma"] == pytest.approx(r_mj.stats["sigma"], abs=0.5)
+
+
+def test_pressure_for_static_force_and_pantograph_that_cannot_hold_the_wire():
+    from mbsuite.errors import ParameterError
+    from mbsuite.models.catenary.eppinger import pressure_for_static_force, static_force
+
+    pg = pressure_for_static_force(120.0)
+    assert static_force({"Pg": pg}) == pytest.approx(120.0, abs=1e-6)
+    assert pg > 710185.0
+    heavy = {"mh": 2 * 13.5}  # doubled head mass: its weight exceeds the uplift at the Table 3-I pressure
+    assert static_force(heavy) < 0
+    p = CatenaryParams(**P_SHORT)
+    with pytest.raises(ParameterError, match="does not press on the wire"):
+        simulate(p, 250.0, 1e-4, pantograph=EppingerReference(heavy))

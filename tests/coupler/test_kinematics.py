@@ -66,6 +66,21 @@ def test_condition_number_closed_form_and_paper(ey):
     assert s[-1] == pytest.approx(2 * ey / l, rel=1e-12)
     assert s[0] / s[-1] == pytest.approx(math.cos(2 * G) / ey, rel=1e-10)
     assert abs(s[0] / s[-1] - analysis.TABLE2[ey][3]) > 50  # the paper's value is not reproducible (reference B2)
+    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-10)
+
+
+@pytest.mark.parametrize("R", [1.0, 1.5, 2.0, 3.0])
+def test_condition_number_closed_form_scales_with_R_squared(R):
+    """J mixes force and moment rows: chi = R^2 cos(2 gamma)/e_y (length units matter); below R ~ 0.85 a translational
+    singular value dominates and there is no closed form (clear error, not a wrong number)."""
+    p = CouplerParams(R=R, e_y=0.1)
+    s = np.linalg.svd(ref.single_jacobian(p), compute_uv=False)
+    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-10)
+    assert ref.cond_asymptotic(p) == pytest.approx(R**2 * math.cos(2 * G) / 0.1, rel=1e-12)
+    from mbsuite.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="too small"):
+        ref.cond_asymptotic(CouplerParams(R=0.5, e_y=0.1))
 
 
 @pytest.mark.parametrize("ey", [0.05, 0.1])

@@ -1,4 +1,4 @@
-"""`mbsuite catenary SCENE --speed KMH [--json] [--out DIR] [--with-linear]`: the EN 50318 statistics of one passage."""
+"""`mbsuite catenary SCENE --speed KMH [--engine E] [--with-linear] [--json] [--out DIR]`: EN 50318 statistics."""
 
 from __future__ import annotations
 
@@ -15,6 +15,8 @@ def register(sub, add_common, emit) -> None:
     p.add_argument("--speed", type=float, default=None, help="train speed (km/h); default: the scene's input.speed")
     p.add_argument("--timestep", type=float, default=None, help="override solver.timestep (s)")
     p.add_argument("--element-length", type=float, default=None, help="override params.element_length (m)")
+    p.add_argument("--engine", choices=["reference", "mujoco"], default=None,
+                   help="pantograph path (mujoco: only with the eppinger pantograph)")
     p.add_argument("--with-linear", action="store_true",
                    help="also run the same scene with linear (bilateral) droppers and report it beside")
     add_common(p)
@@ -30,6 +32,8 @@ def _handler(args: argparse.Namespace, emit) -> None:
 
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "
                          "catenary scene")
+    if args.engine is not None:
+        scene = scene.replace(solver={"engine": args.engine})
     if args.timestep is not None:
         scene = scene.replace(solver={"timestep": args.timestep})
     if args.element_length is not None:

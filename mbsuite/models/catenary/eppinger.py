@@ -38,6 +38,16 @@ def _pantograph_modules():
     return pparams, reference
 
 
+def _no_free_equilibrium(k_wire: float, params) -> None:
+    if k_wire <= 0.0:
+        from ...errors import ParameterError
+
+        raise ParameterError(
+            f"the Eppinger pantograph does not press on the wire at supply pressure Pg = {params.Pg:g} Pa (its static "
+            "contact force is <= 0 with these parameters) and has no equilibrium off the wire: raise Pg "
+            "(see pressure_for_static_force)")
+
+
 class EppingerReference:
     """Eppinger pantograph, hand-derived ODE path (see module docstring)."""
 
@@ -55,6 +65,7 @@ class EppingerReference:
         self._pending = None
 
     def static(self, y_wire: float, k_wire: float) -> float:
+        _no_free_equilibrium(k_wire, self.params)
         _, reference = _pantograph_modules()
         p = dataclasses.replace(self.params, ks=float(k_wire))
         ode = reference.PantographODE(p, self.cfg)
@@ -143,6 +154,7 @@ class EppingerMujoco:
     def static(self, y_wire: float, k_wire: float) -> float:
         from ...engines import mujoco_engine as mje
 
+        _no_free_equilibrium(k_wire, self.params)
         # static equilibrium with the catenary actuator as the shipped spring of stiffness k_wire at the wire height
         m, i = self.m, self.i_cat
         ks = float(self.params.ks)
@@ -196,3 +208,31 @@ def make_eppinger(kind: str, p: CatenaryParams, overrides: dict[str, Any], dt: f
     if kind == "eppinger_mujoco":
         return EppingerMujoco(overrides, timestep=dt)
     raise SceneError(f"unknown Eppinger pantograph path {kind!r}")
+
+
+def static_force(overrides: dict[str, Any] | None = None, k_contact: float = 5.0e4) -> float:
+    """Static contact force (N) of the Eppinger pantograph at its operating height on an undisturbed rigid wire."""
+    return EppingerReference(overrides).static(0.0, k_contact)
+
+
+def pressure_for_static_force(target: float, overrides: dict[str, Any] | None = None, k_contact: float = 5.0e4,
+                              tol: float = 1e-9) -> float:
+    """Supply gauge pressure Pg (Pa) that gives the static contact force `target` (N), by the secant method (the
+    static force is nearly affine in Pg: the cylinder's static force is Pg Ap)."""
+    from ...errors import ParameterError
+
+    ov = dict(overrides or {})
+    p0 = ov.get("Pg", 710185.0)
+    p1 = 1.1 * p0
+    f0 = static_force({**ov, "Pg": p0}, k_contact) - target
+    f1 = static_force({**ov, "Pg": p1}, k_contact) - target
+    for _ in range(30):
+        if abs(f1) < tol * max(1.0, abs(target)):
+            return p1
+        if f1 == f0:
+            break
+        p0, p1, f0 = p1, p1 - f1 * (p1 - p0) / (f1 - f0), f1
+        if p1 <= 0:
+            break
+        f1 = static_force({**ov, "Pg": p1}, k_contact) - target
+    raise ParameterError(f"no supply pressure gives a static contact force of {target} N for {ov}")

@@ -395,6 +395,10 @@ class CoupledSimulation:
                 umax = float(np.max(np.abs(u)))
                 if not (math.isfinite(umax) and math.isfinite(f) and math.isfinite(yh)):
                     raise SolverError(f"non-finite state at t = {t_new:.4f} s (x = {xp:.2f} m)")
+                if abs(yh) > MAX_DISPLACEMENT and f == 0.0:
+                    raise SolverError(
+                        f"the pantograph lost the wire and moved {yh:+.3g} m away from it at t = {t_new:.4f} s "
+                        f"(x = {xp:.2f} m; static contact force {F[0]:.4g} N): it cannot hold the wire")
                 if umax > MAX_DISPLACEMENT or abs(yh) > MAX_DISPLACEMENT:
                     raise SolverError(
                         f"catenary/pantograph displacement {max(umax, abs(yh)):.3g} m exceeds {MAX_DISPLACEMENT} m at "

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import GeometryError, SolverError
+from ...errors import GeometryError, ParameterError
 from ...results import Report, format_table, write_csv
 from . import reference as ref
 from .params import GAMMAS_PAPER, CouplerParams
@@ -38,6 +38,14 @@ class SingularityWarning(UserWarning):
     """The Jacobian is rank deficient (coplanar platforms): the condition number is infinite."""
 
 
+def _closed_form_or_none(p: CouplerParams) -> float | None:
+    """The closed-form aligned-pose condition number, or None where it does not exist (small R, see reference)."""
+    try:
+        return ref.cond_asymptotic(p)
+    except ParameterError:
+        return None
+
+
 # --------------------------------------------------------------------------------------------------- Jacobian report
 def zero_pitch_pair(principal: list[ref.Screw]) -> list[ref.Screw] | None:
     """For a 2-system of finite-pitch screws with principal pitches of opposite sign, the two zero-pitch members of the
@@ -46,10 +54,7 @@ def zero_pitch_pair(principal: list[ref.Screw]) -> list[ref.Screw] | None:
     if len(fin) != 2 or fin[0].pitch * fin[1].pitch >= 0:
         return None
 
-    def tw(sc: ref.Screw) -> np.ndarray:
-        return np.concatenate([np.cross(sc.point, sc.axis) + sc.pitch * sc.axis, sc.axis])
-
-    t1, t2 = tw(fin[0]), tw(fin[1])  # unit omegas, orthogonal, zero cross-pitch
+    t1, t2 = ref.screw_to_twist(fin[0]), ref.screw_to_twist(fin[1])  # unit omegas, orthogonal, zero cross-pitch
     th = math.atan(math.sqrt(-fin[0].pitch / fin[1].pitch))
     out = [ref.twist_to_screw(math.cos(th) * t1 + sgn * math.sin(th) * t2, np.zeros(3)) for sgn in (1, -1)]
     out.sort(key=lambda sc: int(np.argmax(np.abs(sc.axis))))
@@ -73,7 +78,7 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
 
         pc = PinCoupler.build("single", p)
         q = pc.q_of({"phi_a": phi_a, "alpha_bx": alpha_bx, "alpha_bz": alpha_bz,
-                     **dict(zip(("phi_b", "x_b", "y_b", "z_b"), pose.u, strict=True))})
+                     **dict(zip(ref.SINGLE_UNKNOWNS, pose.u, strict=True))})
         J = pc.mechanism_jacobian(q)
     else:
         J = ref.single_jacobian(p, pose)
@@ -94,7 +99,7 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
         "J": J, "J_columns": ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"],
         "J_paper_layout": ref.paper_eq15_layout(J),
         "singular_values": an.singular_values, "rank": an.rank, "rank_rtol": ref.RANK_RTOL,
-        "cond": an.cond, "cond_closed_form": ref.cond_asymptotic(p),
+        "cond": an.cond, "cond_closed_form": _closed_form_or_none(p),
         "principal_screws": [s.as_dict() for s in an.principal_screws],
         "zero_pitch_screws": [s.as_dict() for s in zp] if zp else None,
         "svd_basis_screws": [s.as_dict() for s in an.svd_screws],
@@ -114,8 +119,9 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
     table = (f"single coupler Jacobian (rows = links 1-4, columns v_x v_y v_z w_x w_y w_z; v at o^b):\n"
              f"{np.array2string(J, precision=4, suppress_small=True)}\n"
              f"singular values {np.array2string(an.singular_values, precision=6)}, rank {an.rank} "
-             f"(rtol {ref.RANK_RTOL:g}), cond {an.cond:.6g} (closed form R cos(2 gamma)/e_y = "
-             f"{ref.cond_asymptotic(p):.6g})\nfree motions (null space of J) as screws:\n"
+             f"(rtol {ref.RANK_RTOL:g}), cond {an.cond:.6g} (closed form R^2 cos(2 gamma)/e_y = "
+             f"{'n/a (R too small)' if data['cond_closed_form'] is None else format(data['cond_closed_form'], '.6g')})"
+             "\nfree motions (null space of J) as screws:\n"
              + format_table(["basis", "screw", "axis", "point", "pitch"], rows, ".4g"))
     return Report(data, table)
 
@@ -196,10 +202,12 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
             for z in zcs:
                 try:
                     c = double_c5(p, z, n=max(31, n // 2 + 1))
-                except (GeometryError, SolverError):  # shaft b too inclined for e_y: no physical pose
+                    reason = ""
+                except GeometryError as exc:  # shaft b too inclined for e_y: no physical pose (a solver failure raises)
                     c = {"c5": math.nan, "c5_pp": math.nan, "c1_intermediate": math.nan}
+                    reason = f"no physical pose: {exc}"
                 double.append({"l_b": lb, "phi_bc": pbc, "z_c": z, "c5": c["c5"], "c5_pp": c["c5_pp"],
-                               "c1_intermediate": c["c1_intermediate"]})
+                               "c1_intermediate": c["c1_intermediate"], "reason": reason})
                 double_rows.append([lb, pbc, z, c["c5"], c["c1_intermediate"]])
     data = {"single": single, "double": double,
             "definitions": {"c1": "max|phi_a-phi_b-mean|", "c2": "max(x_b)-min(x_b)", "c3": "max|beta1-beta1_0|",

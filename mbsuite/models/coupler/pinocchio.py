@@ -21,11 +21,9 @@ from ...errors import ModelFileError, SolverError
 from ...paths import urdf_path
 from .modelfiles import PHI_B_OFFSET, Closure, _mounted, closures, closures_from_urdf, phi_c_offset, urdf_text
 from .params import CouplerParams
-from .reference import check_physical
+from .reference import DOUBLE_UNKNOWNS, SINGLE_UNKNOWNS, check_physical
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-SINGLE_UNKNOWNS = ("phi_b", "x_b", "y_b", "z_b")
-DOUBLE_UNKNOWNS = ("phi_c", "y_c", "x_b", "y_b", "z_b", "phi_b", "alpha_bx", "alpha_bz")
 
 
 def load_model(kind: str, p: CouplerParams | None = None) -> tuple[pin.Model, list[Closure]]:

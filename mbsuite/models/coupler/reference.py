@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import GeometryError, SolverError
+from ...errors import GeometryError, ParameterError, SolverError
 from .params import CouplerParams
 
 EY = np.array([0.0, 1.0, 0.0])
@@ -316,6 +316,15 @@ class Screw:
         return {"axis": self.axis, "point": self.point, "pitch": self.pitch, "magnitude": self.magnitude}
 
 
+def screw_to_twist(sc: Screw) -> np.ndarray:
+    """Unit-omega twist (v at the origin, omega) of a finite-pitch screw: v = point x axis + pitch axis (inverse of
+    `twist_to_screw` for |omega| = 1)."""
+    return np.concatenate([np.cross(sc.point, sc.axis) + sc.pitch * sc.axis, sc.axis])
+
+
+SINGLE_UNKNOWNS = ("phi_b", "x_b", "y_b", "z_b")  # single-coupler FPP unknowns (Eqs 4-5)
+
+
 def twist_to_screw(t: np.ndarray, o: np.ndarray, eps: float = 1e-12) -> Screw:
     v, w = t[:3], t[3:]
     nw = float(np.linalg.norm(w))
@@ -379,18 +388,29 @@ def analyse_jacobian(J: np.ndarray, o: np.ndarray, rtol: float = RANK_RTOL) -> J
 
 
 def cond_asymptotic(p: CouplerParams) -> float:
-    """Leading-order condition number of the single coupler's J at the aligned pose for small e_y (README):
-    sigma_max = 2 R cos(pi/4 - g) l0 / l, sigma_min = 2 e_y / l  =>  chi ~ R cos(2 g) / e_y."""
-    return math.inf if p.e_y == 0 else p.R * math.cos(2 * p.gamma) / p.e_y
+    """Condition number of the single coupler's J at the aligned pose, in closed form (README):
+    sigma_min = 2 e_y / l and, while the moment singular value is the largest, sigma_max = 2 R cos(pi/4 - g) l0 / l
+    with l0 = 2 R sin(pi/4 - g)  =>  chi = R^2 cos(2 g) / e_y.
+
+    J mixes force (unit) and moment (length) rows, so chi depends on the length unit: the paper's R = 1 gives
+    cos(2 g)/e_y. Below R ~ 0.85 (gamma = 17 deg) a translational singular value (~ sqrt 2) is the largest and there is
+    no such closed form: ParameterError."""
+    if p.e_y == 0:
+        return math.inf
+    l0 = 2 * p.R * math.sin(math.pi / 4 - p.gamma)
+    l = math.hypot(l0, p.e_y)
+    s_moment = 2 * p.R * math.cos(math.pi / 4 - p.gamma) * l0 / l
+    if s_moment < math.sqrt(2.0) * 1.001:  # the in-plane translational singular values are sqrt 2 (l0/l) + O(e_y)
+        raise ParameterError(
+            f"closed-form condition number needs the moment singular value to dominate (R = {p.R} is too small "
+            f"for gamma = {p.gamma}: 2 R cos(pi/4 - gamma) l0/l = {s_moment:.4g} < sqrt 2)")
+    return p.R**2 * math.cos(2 * p.gamma) / p.e_y
 
 
 def pitch_of_mixed_basis(s1: Screw, s2: Screw, theta: float) -> tuple[float, float]:
     """Pitches of the orthonormal basis rotated by theta from two zero-pitch principal rotations (unit omegas):
     t1' = cos t1 + sin t2, t2' = -sin t1 + cos t2 (used to show Table 2's pitches are basis artefacts)."""
-    def tw(sc: Screw) -> np.ndarray:
-        return np.concatenate([np.cross(sc.point, sc.axis), sc.axis])
-
-    t1, t2 = tw(s1), tw(s2)
+    t1, t2 = screw_to_twist(s1), screw_to_twist(s2)
     c, s = math.cos(theta), math.sin(theta)
     return twist_to_screw(c * t1 + s * t2, np.zeros(3)).pitch, twist_to_screw(-s * t1 + c * t2, np.zeros(3)).pitch
 

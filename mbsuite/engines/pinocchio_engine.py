@@ -10,26 +10,24 @@ import pinocchio as pin
 from ..errors import ModelFileError
 
 
-def load_urdf(path: str | Path) -> pin.Model:
-    """Build a Pinocchio model from a URDF file; parse errors become ModelFileError naming the file."""
+def _load(builder, kind: str, path: str | Path) -> pin.Model:
     p = Path(path)
     if not p.is_file():
-        raise ModelFileError(f"URDF file not found: {p}")
+        raise ModelFileError(f"{kind} file not found: {p}")
     try:
-        return pin.buildModelFromUrdf(str(p))
+        return builder(str(p))
     except Exception as exc:
-        raise ModelFileError(f"Pinocchio cannot load URDF {p}: {exc}") from exc
+        raise ModelFileError(f"Pinocchio cannot load {kind} {p}: {exc}") from exc
+
+
+def load_urdf(path: str | Path) -> pin.Model:
+    """Build a Pinocchio model from a URDF file; parse errors become ModelFileError naming the file."""
+    return _load(pin.buildModelFromUrdf, "URDF", path)
 
 
 def load_mjcf(path: str | Path) -> pin.Model:
     """Build a Pinocchio model from an MJCF file (only the first top-level body of <worldbody> is kept by Pinocchio)."""
-    p = Path(path)
-    if not p.is_file():
-        raise ModelFileError(f"MJCF file not found: {p}")
-    try:
-        return pin.buildModelFromMJCF(str(p))
-    except Exception as exc:
-        raise ModelFileError(f"Pinocchio cannot load MJCF {p}: {exc}") from exc
+    return _load(pin.buildModelFromMJCF, "MJCF", path)
 
 
 def frame_id(model: pin.Model, name: str) -> int:

@@ -86,18 +86,67 @@ def test_energy_cycle_model_step():
     assert np.max(np.abs(z)) > 1
 
 
-def test_springsz_and_srmin():
-    r = D.springsz(0.98, 5.09)
-    assert r["V"] == pytest.approx(1.58e-4, rel=0.01)  # recommended volume, 100 W design (L2026)
-    half = D.springsz(0.98, 5.09, fatigue=0.5)
-    assert r["V"] / half["V"] == pytest.approx(4.0)  # 16x per halving twice: volume ~ 1/fatigue^2 (L1537)
-    assert half["V"] == pytest.approx(3.97e-5, rel=0.01)  # Table 6.3 spring at half tensile stress: 1/4 volume
+def test_springsz_closed_forms_for_a_stated_material():
+    """SPRINGSZ against (5.14)-(5.21) evaluated independently for a stated material: music wire (ASTM A228) at
+    sigma_uts = 2.0 GPa, E = 207 GPa, fatigue 0.25 (sf = 0.5 GPa), U = 1/8, on the 100 W design K = 0.98, x = 5.09.
+    Independent route: energy eps = 1/2 K x^2 (5.18); V = eps E / (U sf^2) from the energy density (5.16);
+    eliminating DN between (5.14) K = d^4 E/(64 DN) and (5.15) V = pi^2 DN d^2 gives d^6 = 64 K V / (pi^2 E);
+    DN = V / (pi^2 d^2). Hand values: eps = 12.695 J, V = 8.409e-5 m^3, d = 3.704 mm, DN = 0.6211 m."""
+    K, x, sig, E = 0.98, 5.09, 2.0e9, 207e9
+    r = D.springsz(K, x, fatigue=0.25, sigma_uts=sig, E=E)
+    sf = 0.25 * sig
+    eps = 0.5 * K * x * x
+    V = eps * E / (sf**2 / 8)
+    d = (64 * K * V / (math.pi**2 * E)) ** (1 / 6)
+    DN = V / (math.pi**2 * d * d)
+    assert (eps, V, d, DN) == pytest.approx((12.695, 8.409e-5, 3.704e-3, 0.6211), rel=1e-3)  # the hand values
+    assert r["V"] == pytest.approx(V, rel=1e-12)
+    assert r["d"] == pytest.approx(d, rel=1e-12)
+    assert r["DN"] == pytest.approx(DN, rel=1e-12)
+    assert d**4 * E / (64 * r["DN"]) == pytest.approx(K, rel=1e-12)  # (5.14) holds for the returned d, DN
+    # scaling laws (5.19)/(5.21): V ~ 1/sf^2 (16x at 1/4 of the stress, L1537), d ~ sf^(-1/3)
+    half = D.springsz(K, x, fatigue=0.5, sigma_uts=sig, E=E)
+    assert r["V"] / half["V"] == pytest.approx(4.0, rel=1e-12)
+    assert r["d"] / half["d"] == pytest.approx(2 ** (1 / 3), rel=1e-12)
+    assert r["V"] / D.springsz(K, x, fatigue=1.0, sigma_uts=sig, E=E)["V"] == pytest.approx(16.0, rel=1e-12)
+
+
+def test_springsz_calibration_and_table_6_3():
+    """The thesis prints no material data. E = 209 GPa follows from the Table 6.3 spring alone via (5.14); the
+    default sigma_uts = 1.465 GPa is a calibration to the recommended 1.58e-4 m^3 (L2026), so that volume is
+    reproduced by construction - this test checks the calibration and the Table 6.3 geometry, it reproduces nothing."""
+    d, Dc, N, K = 3.43e-3, 27.81e-3, 12.3, 1.32  # Table 6.3
+    E = 64 * Dc * N * K / d**4
+    assert E == pytest.approx(D.E_TABLE_6_3, rel=3e-3)
+    assert math.pi**2 * Dc * N * d * d == pytest.approx(3.97e-5, rel=2e-3)  # (5.15) gives the printed volume
+    r = D.springsz(0.98, 5.09)  # calibrated defaults
+    assert r["V"] == pytest.approx(1.58e-4, rel=2e-3)  # calibration, not a prediction
     assert r["V_check"] == pytest.approx(r["V"], rel=1e-12)  # (5.15) with d from (5.21) and DN from (5.14)
+    # the thesis' own statements are consistent: at half the tensile stress 1/4 of the volume, Table 6.3's 3.97e-5
+    assert D.springsz(0.98, 5.09, fatigue=0.5)["V"] == pytest.approx(3.97e-5, rel=0.01)
+
+
+def test_srmin_and_bad_design_input():
     assert D.srmin(500, 50, 5, 0.1) == pytest.approx(20.0)
     with pytest.raises(ParameterError):
         D.srmin(500, 0, 5, 0.1)
     with pytest.raises(ParameterError):
         D.springsz(1.0, 2.0, fatigue=1.5)
+    with pytest.raises(ParameterError, match="sigma_uts"):
+        D.springsz(1.0, 2.0, sigma_uts=-1.0)
+    with pytest.raises(ParameterError, match="w0"):
+        D.gains(0.0023, 1 / 14.5, 2.5e-4, 0.15, 0.0)
+    with pytest.raises(ParameterError, match="J_l"):
+        D.gains(-0.0023, 1 / 14.5, 2.5e-4, 0.15, 400.0)
+    with pytest.raises(ParameterError, match="t_s"):
+        D.gains(0.0023, 0.0, 2.5e-4, 0.15, 400.0)
+    with pytest.raises(ParameterError, match="B_total"):
+        D.gains(0.0023, 1 / 14.5, -1.0, 0.15, 400.0)
+    with pytest.raises(ParameterError, match="K_p"):
+        D.gains(0.0023, 5.0, 2.5e-4, 0.15, 400.0)  # dissipation per cycle above the load's KE: no positive K_p
+    with pytest.raises(ParameterError, match="w0"):
+        D.b_total(100, 0.0, 0.15)
+    assert D.gains(0.0023, 1 / 14.5, 2.5e-4, 0.15, -400.0) == D.gains(0.0023, 1 / 14.5, 2.5e-4, 0.15, 400.0)
 
 
 def test_cli_design_and_run(capsys):
@@ -114,3 +163,13 @@ def test_cli_design_and_run(capsys):
     assert main(["drive", "run", "drives/nope"]) == 2
     assert "no scene" in capsys.readouterr().err
     assert main(["drive", "design", "springsz", "--K", "1", "--xmax", "2", "--fatigue", "2"]) == 2
+    capsys.readouterr()
+    for bad in (["--w0", "0"], ["--w0", "400", "--Jl", "-0.0023"]):
+        args = {"--Jl": "0.0023", "--ts": "0.069", "--taul": "0.15", "--w0": "400", "--btotal": "2.5e-4"}
+        args.update(dict(zip(bad[::2], bad[1::2], strict=True)))
+        assert main(["drive", "design", "gains", *[x for kv in args.items() for x in kv]]) == 2
+        err = capsys.readouterr().err
+        assert ("w0" if bad[1] == "0" else "J_l") in err and "Traceback" not in err
+    assert main(["drive", "design", "springsz", "--K", "0.98", "--xmax", "5.09", "--sigma-uts", "2e9", "--E", "207e9",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["V"] == pytest.approx(8.409e-5, rel=1e-3)

@@ -55,7 +55,7 @@ def test_effect_off_builds_nothing():
 def step_up_pair():
     out = {}
     for eng in ("reference", "mujoco"):
-        out[eng] = _sim("step_up_resonant_matched", engine=eng, duration=4.0, t_settle=0.5)
+        out[eng] = _sim("step_up_resonant_matched", engine=eng, duration=5.0, t_settle=0.5)
     return out
 
 
@@ -74,33 +74,76 @@ def _balance_ok(sys_, res):
 
 
 def test_step_up_paths_agree(step_up_pair):
+    """Issue acceptance over >= 20 energy cycles: same cycles, equal lock/release event counts, every lock-up and
+    release within one controller sample (2 ms), load speed within 0.5 %, both balances within 0.5 %.
+
+    Documented deviation (README "Deviations"): at t = 3.668 s the sliding brake's slip reverses *grazing* (the
+    spring end dips to -0.03 rad/s for ~2 ms). The exact path passes through (holding torque above breakaway at its
+    crossing), MuJoCo - whose crossing falls 1.4 ms earlier in this ill-conditioned tangency - locks and breaks loose
+    again 0.15 ms (1.5 steps) later. Such a blip (stuck < 2 MuJoCo steps) is taken out before pairing; at most one is
+    allowed, and the exact path must have no lock within 3 ms of it."""
     (_, ra, ca, sys_), (_, rb, cb, _) = step_up_pair["reference"], step_up_pair["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.5), drive.cycle_stats(rb, cb, 0.5)
-    assert sa["n_cycles"] >= 18 and sa["n_cycles"] == sb["n_cycles"]
+    assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]
     assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 0.005
-    cmp = drive.compare_events(ra, rb, ["clutch", "spring_ground"])
+    cmd = drive.compare_commands(ca, cb)
+    assert cmd["same_sequence"] and not cmd["flips"], cmd
+    els = ["clutch", "spring_ground"]
+    assert not drive.short_locks(ra, els, 2e-4)
+    blips = drive.short_locks(rb, els, 2e-4)
+    assert len(blips) <= 1, blips
+    for _, t_s, _ in blips:
+        assert not [e for e in ra.events if e["to"] == "stuck" and abs(e["t"] - t_s) < 3e-3]
+    cmp = drive.compare_events(ra, drive.without_events(rb, blips), els)
+    assert {"clutch->stuck", "clutch->free", "spring_ground->stuck"} <= set(cmp)
     dt_c = 1.0 / 500.0
     for k, v in cmp.items():
+        assert v["n_a"] == v["n_b"], (k, v)
         assert v["max_dt"] <= dt_c, (k, v)
     _balance_ok(sys_, ra)
     _balance_ok(sys_, rb)
 
 
 def test_susd_paths_agree(susd_pair):
+    """Issue acceptance on the 100 W design over >= 20 energy cycles: equal event counts, energy packets (energy
+    taken up by the spring system per extraction, `drive.energy_packets`) within 1 %, load speed within 0.5 %, every
+    lock-up/release within one controller sample (1 ms).
+
+    Documented deviation (README "Deviations"): the controller turns a computed wait into samples with the thesis'
+    int() truncation. Where the two paths' computed waits straddle an integer (here 11.990 vs 12.017 samples: the
+    waits agree to 0.03 sample, the truncation does not) that command goes one sample apart and the lock-up it causes
+    follows one sample + the slip-time difference apart (1.11 ms). The test admits exactly that: each command that
+    differs must differ by one sample with both waits within 0.05 sample of each other and on both sides of an
+    integer, and only lock-ups of that clutch within 10 ms after such a command may exceed one sample (< 2 samples).
+    """
     (_, ra, ca, sys_), (_, rb, cb, _) = susd_pair["reference"], susd_pair["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.5), drive.cycle_stats(rb, cb, 0.5)
-    assert sa["n_cycles"] >= 20
+    assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]
     assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 0.005
-    pa, pb = drive.transferred_packets(sys_, ra, "", ca), drive.transferred_packets(sys_, rb, "", cb)
-    n = min(pa.size, pb.size)
-    assert n >= 20
-    assert np.median(np.abs(pa[:n] / pb[:n] - 1)) < 0.01 and abs(pa[:n].sum() / pb[:n].sum() - 1) < 0.01
+    pa, pb = drive.energy_packets(sys_, ra, ca, 0.5), drive.energy_packets(sys_, rb, cb, 0.5)
+    assert pa["stored"].size == pb["stored"].size >= 20
+    np.testing.assert_allclose(pa["t"], pb["t"], rtol=0, atol=1e-9)  # the same cycles
+    assert np.all(pa["stored"] > 1.0)  # J: real packets (demand 12.8 J, the capacity 1/2 K x_max^2)
+    assert np.max(np.abs(pa["stored"] / pb["stored"] - 1)) < 0.01
+    assert np.max(np.abs(pa["delivered"] / pb["delivered"] - 1)) < 0.01
+    dt_c = 1e-3
+    cmd = drive.compare_commands(ca, cb)
+    assert cmd["same_sequence"], cmd
+    assert len(cmd["flips"]) <= 1, cmd["flips"]
+    for f in cmd["flips"]:
+        assert abs(abs(f["t_b"] - f["t_a"]) - dt_c) < 1e-9, f
+        wa, wb = f["wait_a"], f["wait_b"]
+        assert abs(wa - wb) < 0.05 and math.floor(wa) != math.floor(wb), f
+    flip_t = [min(f["t_a"], f["t_b"]) for f in cmd["flips"]]
     cmp = drive.compare_events(ra, rb, ["clutch_a", "clutch_b"])
+    assert len(cmp) == 4
     for k, v in cmp.items():
         assert v["n_a"] == v["n_b"], (k, v)
-        # 1 kHz controller: lock-up/release within one sample (one engagement per run may fall one sample later,
-        # when an int(t * fs) truncation flips: measured max 1.11 ms)
-        assert v["median_dt"] < 1e-4 and v["max_dt"] < 1.2e-3, (k, v)
+        for t_a, d in zip(v["t_a"], v["dt"], strict=True):
+            if abs(d) > dt_c:
+                after_flip = any(0 < t_a - tf < 0.01 for tf in flip_t)
+                assert k.endswith("stuck") and after_flip and abs(d) < 2 * dt_c, (k, t_a, d)
+        assert v["median_dt"] < 1e-4, (k, v)
     _balance_ok(sys_, ra)
     _balance_ok(sys_, rb)
 
@@ -180,10 +223,14 @@ def test_step_up_reproduction(step_up_runs):
 
 
 def test_susd_100w_design_reproduction():
+    """+-400 rad/s and ~5 rad extension as the thesis (L1987-2001). Switching rate: known deviation - ours 12.8
+    cycles/s against the thesis' ~14.5 (Table 6.2: 14.20), 12 % lower; README "Deviations" gives the measured cycle
+    breakdown. The assertion is a regression band around our value, the thesis number is printed next to it."""
     sc, res, ctrl, sys_ = _sim("susd_100w_design")
     cs = drive.cycle_stats(res, ctrl, sc.solver.t_settle)
     assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (L1987-1993)
-    assert 12.0 < cs["switching_rate"] < 15.5  # ~14.5 cycles/s (L2001)
+    print(f"switching rate {cs['switching_rate']:.2f} cycles/s (thesis ~14.5, L2001; Table 6.2 14.20)")
+    assert 12.4 < cs["switching_rate"] < 13.2  # ours 12.8; thesis 14.5: documented deviation (-12 %)
     assert 4.6 < cs["max_extension"] < 5.3  # ~5 rad (L2001)
     sc2, res2, ctrl2, _ = _sim("susd_100w_reverse")
     cs2 = drive.cycle_stats(res2, ctrl2, sc2.solver.t_settle)
@@ -207,6 +254,81 @@ def test_bad_input():
         simulate_scene(sc.replace(params={"d_on": 0.3, "t_l": 0.25}))
     with pytest.raises(SceneError, match="profile"):
         simulate_scene(load_scene("drives/susd_100w_design").replace(input={"profile": [[1.0, 2.0], [0.5, 1.0]]}))
+
+
+@pytest.mark.parametrize("name,value", [
+    ("K_ctrl", 0.0), ("K_ctrl", -1.0), ("Omega_ctrl", -132.0), ("Omega_ctrl", 0.0), ("spring_max", 0.0),
+    ("spring_max", -2.0), ("max_tk", 0.0), ("min_vel", -1.0), ("max_vel", -1.0), ("tau_0", -10.0), ("tau_0", 0.0),
+    ("tau_slope", 0.05), ("twist_tol", -0.1), ("min_motor_vel", -1.0), ("Kp", float("nan")),
+])
+def test_bad_parameter_values_named(name, value):
+    with pytest.raises(ParameterError, match=name):
+        load_scene("drives/susd_100w_design").replace(params={name: value})
+
+
+def test_bad_parameter_combinations():
+    with pytest.raises(ParameterError, match="min_vel"):
+        load_scene("drives/step_up_motor_resonant").replace(params={"min_vel": 70.0, "max_vel": 60.0})
+    # twist_tol at or below the friction-held static twist (C_s + C_l)/K = 0.058 rad: the transfer would never end
+    for tt in (0.0, 0.05):
+        with pytest.raises(ParameterError, match="twist_tol"):
+            simulate_scene(load_scene("drives/step_up_resonant").replace(params={"twist_tol": tt}))
+    # 0 is a value, not "unset": a zero controller spring rate is rejected, not replaced by K
+    p = load_scene("drives/susd_100w_design").build_params().resolved("design_100w")
+    p["K_ctrl"] = 0.0
+    with pytest.raises(ParameterError, match="K must be positive"):
+        drive.build_controller("step_up_down", "energy_packet", p, {"clutch_delays": True})
+
+
+def test_delay_samples_one_conversion():
+    """0.3 ms at 10 kHz is 3 samples everywhere (int(0.0003 * 10000) = 2 in binary floating point)."""
+    from mbsuite.models.drives.friction import CommandQueue, delay_samples
+
+    assert int(0.0003 * 10000) == 2  # the trap
+    assert delay_samples(0.0003, 10000.0) == 3
+    assert delay_samples(0.006, 500.0) == 3  # thesis App. C: 6 ms at 500 Hz = 3 samples
+    assert delay_samples(0.0045, 1000.0) == 4  # truncation as the thesis' (int) cast
+    assert delay_samples(0.0, 1000.0) == 0
+    q = CommandQueue({"ca": (0.0003, 0.0003)}, 1e-4, {"ca": 0})
+    assert q.counts["ca"] == (3, 3)
+    ctrl = C.EnergyPacketController(fs=10000.0, K=1.0, Omega=100.0, clutch_delay=0.0003, spring_max=1.0)
+    assert ctrl.cd == 3
+    with pytest.raises(ParameterError):
+        delay_samples(-1e-3, 1000.0)
+    # the controller compensates the delay actually applied (quantised), the same as the queue
+    p = load_scene("drives/susd_100w_design").build_params().resolved("design_100w")
+    p.update(d_on=0.0045, d_off=0.0045)
+    ctrl = drive.build_controller("step_up_down", "energy_packet", p, {"clutch_delays": True})
+    assert ctrl.clutch_delay == pytest.approx(0.004) and ctrl.cd == 4
+
+
+def test_anti_windup_default_and_printed_variant():
+    """Energy-packet PI: anti-windup unless a scene asks otherwise (issue #5); the step-up closed-loop scene selects
+    the printed, winding-up t_k PI explicitly (the thesis reproduction)."""
+    sc = load_scene("drives/susd_500w_step")
+    assert "anti_windup" not in sc.to_dict().get("effects", {}) or sc.effects["anti_windup"] is True
+    _, ctrl, _ = simulate_scene(sc.replace(solver={"duration": 0.6, "t_settle": 0.0}))
+    assert ctrl.anti_windup is True
+    assert abs(ctrl.eps_state) <= ctrl.E_max * (1 + 1e-12)  # the stored state never leaves the clamp
+    su = load_scene("drives/step_up_closed_loop")
+    assert su.effects["anti_windup"] is False
+    p = su.build_params().resolved("table_4_2")
+    assert drive.build_controller("step_up", "resonant", p, dict(su.effects)).anti_windup is False
+    # without anti-windup the same energy-packet run stores an unclamped (wound-up) state
+    _, ctrl2, _ = simulate_scene(sc.replace(effects={"anti_windup": False}, solver={"duration": 0.6, "t_settle": 0.0}))
+    assert ctrl2.anti_windup is False and abs(ctrl2.eps_state) > ctrl2.E_max
+
+
+def test_windowed_energy_balance_and_zero_input(susd_pair):
+    """Any window closes, including the kinetic energy removed by plastic locks inside it (MuJoCo)."""
+    _, rb, _, sys_ = susd_pair["mujoco"]
+    for a, b in ((0, -1), (500, 1500), (1000, rb.t.size - 1)):
+        bal = drive.energy_balance(sys_, rb, a, b)
+        assert bal.losses["lock_impact"] > 0 and abs(bal.relative) < 1e-5, (a, b, bal)
+    assert rb.energy["lock_impact"][-1] == pytest.approx(rb.stats["reset_energy"])
+    zero = drive.Balance(0.0, 0.0, {}, 0.0, 0.0)
+    assert zero.relative == 0.0
+    assert drive.Balance(0.0, 0.0, {"x": 1.0}, 0.0, -1.0).relative == -1.0
 
 
 def test_motor_resonant_keeps_motor_in_band():

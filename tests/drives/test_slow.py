@@ -69,7 +69,14 @@ def test_full_crosscheck(name, duration):
         runs[eng] = simulate_scene(sc)
     (ra, ca, sys_), (rb, cb, _) = runs["reference"], runs["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.3), drive.cycle_stats(rb, cb, 0.3)
-    assert sa["n_cycles"] >= 14
+    assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]  # issue: >= 20 energy cycles
     assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 0.005
+    # energy packets (energy taken up per extraction) within 1 % in open loop. In closed loop near the set point the
+    # packets are the PI's answer to speed errors of the order of the paths' 0.2 % speed difference, and single packets
+    # differ by up to 3x (500 W step, t > 2.5 s; README Deviations 5): compared there only while the PI is saturated.
+    if name.startswith("susd") and not sc.effects["closed_loop"]:
+        pa, pb = drive.energy_packets(sys_, ra, ca, 0.3), drive.energy_packets(sys_, rb, cb, 0.3)
+        assert pa["stored"].size == pb["stored"].size >= 20
+        assert np.max(np.abs(pa["stored"] / pb["stored"] - 1)) < 0.01
     for b in (drive.energy_balance(sys_, ra), drive.energy_balance(sys_, rb)):
         assert abs(b.relative) < 0.005

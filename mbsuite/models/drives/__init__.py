@@ -27,8 +27,10 @@ SPEC = ModelSpec(
         "clutch_matching": Effect((True, False), False,
                                   "step-up: delay clutch engagement to the velocity match (Eq 2.1)"),
         "closed_loop": Effect((True, False), False, "PI on t_k (step-up) / energy-packet PI (step-up/step-down)"),
-        "anti_windup": Effect((True, False), False, "store the clamped PI state (step-up: printed code has none; "
-                              "step-up/step-down energy-packet PI always clamps to the spring capacity)"),
+        "anti_windup": Effect((True, False), True,
+                              "PI anti-windup: store the clamped state (energy-packet PI: clamped to the spring "
+                              "capacity +-1/2 K x_max^2; step-up t_k PI: to [0, max_tk]). false = the thesis' printed "
+                              "step-up PI (state stored before the clamp, winds up), used by step_up_closed_loop"),
         "clutch_delays": Effect((True, False), True, "pure actuation delays quantised to controller samples"),
         "bearing_friction": Effect((True, False), True, "viscous + Coulomb bearings (with stiction)"),
         "added_motor_inertia": Effect((True, False), False, "add J_add to the motor (L959, L1987)"),

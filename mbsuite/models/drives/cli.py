@@ -71,10 +71,13 @@ def register(sub, add_common, emit) -> None:
     q.add_argument("--K", type=float, required=True)
     q.add_argument("--xmax", type=float, required=True)
     q.add_argument("--fatigue", type=float, default=0.25)
+    q.add_argument("--sigma-uts", type=float, default=D.SIGMA_UTS_CALIBRATED,
+                   help="ultimate tensile stress, Pa (default: calibrated to the thesis' 1.58e-4 m^3, not a material)")
+    q.add_argument("--E", type=float, default=D.E_TABLE_6_3, help="Young's modulus, Pa (default: implied by Table 6.3)")
     add_common(q)
 
     def _spr(a):
-        r = D.springsz(a.K, a.xmax, a.fatigue)
+        r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
         emit(Report(r, format_table(list(r), [list(r.values())], ".4g")), a, None)
 
     q.set_defaults(func=_spr)

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError
+from .friction import delay_samples
 
 STEP_UP_CONTROLLERS = ("pwm", "resonant", "motor_resonant")
 SUSD_CONTROLLERS = ("energy_packet",)
@@ -61,7 +62,10 @@ def match_time(Omega: float, theta_e: float, w_e: float, w_t: float, theta_sign:
 @dataclass
 class StepUpController:
     """PWM (`switch_pwm`), resonant (`switch_fdt`) and motor-resonant (`switch_mv`) switching with optional clutch
-    matching (Eq 2.1) and the incremental PI on the storage time t_k (L2970-2978, every sample, upper clamp only)."""
+    matching (Eq 2.1) and the incremental PI on the storage time t_k (L2970-2978, every sample).
+    `anti_windup=True` (default): t_k clamped to [0, max_tk] and the clamped value stored. `anti_windup=False`: the
+    printed code - state stored before the clamp, upper clamp only - which winds up; the `step_up_closed_loop` scene
+    selects it explicitly to reproduce the thesis' closed loop."""
 
     kind: str
     fs: float
@@ -79,7 +83,7 @@ class StepUpController:
     Ki: float = 4.4e-5
     ref: float = 287.0
     max_tk: float | None = None
-    anti_windup: bool = False
+    anti_windup: bool = True
     state: int = 1
     log: list[dict[str, Any]] = field(default_factory=list)
 
@@ -186,7 +190,11 @@ class EnergyPacketController:
        |theta| >= theta_target - |w_src| C_d), like the transfer release.
     Closed loop: velocity-squared energy-packet PI, once per energy cycle (Eq 5.29),
     eps_k = eps_{k-1} + (Kp + Ki t_s) e_k - Kp e_{k-1} with e = sign(r)(|r| r - |w| w), clamped to the spring capacity
-    +-1/2 K x_max^2 with the clamped value stored (anti-windup). Open loop: a packet of 1/2 K x_max^2 toward sign(ref).
+    +-1/2 K x_max^2 with the clamped value stored (anti-windup, the default; `anti_windup=False` stores the unclamped
+    value and winds up - there is no printed PI to reproduce here, App. F's is P-only and App. J sets anti_windup=1).
+    Open loop: a packet of 1/2 K x_max^2 toward sign(ref).
+    Log: "cycle" (packet demand eps), "extract_on"/"extracted" (input clutch commanded on/off), "transfer_on"/
+    "transferred" (output clutch commanded on/off); `drive.energy_packets` turns them into packet energies.
     """
 
     fs: float
@@ -205,6 +213,14 @@ class EnergyPacketController:
     log: list[dict[str, Any]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
+        for nm in ("fs", "K", "Omega", "spring_max"):
+            v = getattr(self, nm)
+            if not (math.isfinite(v) and v > 0):
+                raise ParameterError(f"energy-packet controller: {nm} must be positive, got {v!r}")
+        for nm in ("clutch_delay", "min_motor_vel", "min_load_vel"):
+            v = getattr(self, nm)
+            if not (math.isfinite(v) and v >= 0):
+                raise ParameterError(f"energy-packet controller: {nm} must be >= 0, got {v!r}")
         self.dt = 1.0 / self.fs
         if self.clutch_delay >= 2 * math.pi / self.Omega:
             raise ParameterError(f"clutch delay {self.clutch_delay} s is longer than a free-oscillation cycle "
@@ -214,7 +230,7 @@ class EnergyPacketController:
         self.eps_state = 0.0
         self.e_prev = 0.0
         self.t_cycle = None
-        self.cd = int(self.clutch_delay * self.fs)
+        self.cd = delay_samples(self.clutch_delay, self.fs)
 
     def r(self, t: float) -> float:
         return float(self.ref(t)) if callable(self.ref) else float(self.ref)
@@ -249,7 +265,10 @@ class EnergyPacketController:
                 src = wm
             self.Ess = abs(self.eps)
             te, ok = match_time(self.Omega, ths, ws, src, 1 if src >= 0 else -1)
-            self.log.append({"t": t, "event": "cycle", "eps": self.eps, "dir": self.E_dir, "root": ok})
+            # wait_samples: the computed wait in samples before the int() truncation (a value within ~1e-4 of an
+            # integer can truncate either way under a ~1e-6 difference in state: one sample later or earlier)
+            self.log.append({"t": t, "event": "cycle", "eps": self.eps, "dir": self.E_dir, "root": ok,
+                             "wait_samples": te * self.fs})
             self.count = max(0, int(te * self.fs) - self.cd)
             self.i = 0
             self.state = 2
@@ -260,6 +279,7 @@ class EnergyPacketController:
                 out["ca" if self.E_dir == 1 else "cb"] = 1
                 self.state = 3
                 self.src_sign = 1 if (wm if self.E_dir == 1 else wl) >= 0 else -1
+                self.log.append({"t": t, "event": "extract_on", "clutch": "ca" if self.E_dir == 1 else "cb"})
                 return out
         if self.state == 3:  # ENERGY_EXTRACTION (delay-compensated end)
             src = wm if self.E_dir == 1 else wl
@@ -278,7 +298,9 @@ class EnergyPacketController:
                 self.count = max(0, int((tt + self.clutch_delay) * self.fs) - self.cd)
                 self.i = 0
                 self.state = 4
-                self.log.append({"t": t, "event": "extracted", "theta": ths, "root": ok})
+                self.log.append({"t": t, "event": "extracted", "theta": ths, "root": ok,
+                                 "clutch": "ca" if self.E_dir == 1 else "cb",
+                                 "wait_samples": (tt + self.clutch_delay) * self.fs})
                 return out
         if self.state == 4:  # WAIT_ENERGY_TRANSFER
             self.i += 1
@@ -286,11 +308,13 @@ class EnergyPacketController:
                 out["cb" if self.E_dir == 1 else "ca"] = 1
                 self.state = 5
                 self.th_peak = abs(ths)
+                self.log.append({"t": t, "event": "transfer_on", "clutch": "cb" if self.E_dir == 1 else "ca"})
                 return out
         if self.state == 5:  # ENERGY_TRANSFER: predictive release
             self.th_peak = max(self.th_peak, abs(ths))
             if abs(ths) <= abs(ws * self.clutch_delay):
                 out["cb" if self.E_dir == 1 else "ca"] = 0
                 self.state = 1
-                self.log.append({"t": t, "event": "transferred", "theta_peak": self.th_peak})
+                self.log.append({"t": t, "event": "transferred", "theta_peak": self.th_peak,
+                                 "clutch": "cb" if self.E_dir == 1 else "ca"})
         return out

@@ -133,13 +133,22 @@ def at_clutch_torque(P: float, Sr_min: float, w_min: float, w_max: float, V_m: f
 
 
 # ---- spring sizing ---------------------------------------------------------------------------------------------------
-def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = 1.465e9, E: float = 209e9,
-             U: float = 1 / 8) -> dict[str, float]:
-    """SPRINGSZ (5.14-5.21): d = (32 K^2 x^2 / (U sf^2 pi^2))^(1/6), DN = d^4 E / (64 K), V = E/(U sf^2) 1/2 K x^2,
-    sf = fatigue * sigma_uts. E = 209 GPa is implied by Table 6.3 ([DERIVED]); sigma_uts = 1.465 GPa is backed out
-    of the recommended volume 1.58e-4 m^3 for the 100 W design (L2026) - the thesis prints neither."""
+SIGMA_UTS_CALIBRATED = 1.465e9  # Pa: calibrated so that the 100 W design gives the thesis' V = 1.58e-4 m^3 (L2026)
+E_TABLE_6_3 = 209e9  # Pa: implied by the Table 6.3 spring via (5.14): d 3.43 mm, D 27.81 mm, N 12.3, K 1.32 N m/rad
+
+
+def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = SIGMA_UTS_CALIBRATED,
+             E: float = E_TABLE_6_3, U: float = 1 / 8) -> dict[str, float]:
+    """SPRINGSZ (5.14-5.21) for a material (sigma_uts, E): allowed stress sf = fatigue * sigma_uts,
+    V = E/(U sf^2) 1/2 K x^2 (5.19), d = (32 K^2 x^2 / (U sf^2 pi^2))^(1/6) (5.21), DN = d^4 E / (64 K) (5.14, equal
+    to (5.20)). The thesis prints no material data. The defaults are not a material: E = 209 GPa is implied by the
+    Table 6.3 spring ([DERIVED]) and sigma_uts = 1.465 GPa is a *calibration*, backed out of the recommended volume
+    1.58e-4 m^3 for the 100 W design (L2026) - so that volume is reproduced by construction, not predicted."""
     _pos("K", K)
     _pos("x_max", x_max)
+    _pos("sigma_uts", sigma_uts)
+    _pos("E", E)
+    _pos("U", U)
     if not 0 < fatigue <= 1:
         raise ParameterError(f"fatigue factor must be in (0, 1], got {fatigue!r}")
     sf = fatigue * sigma_uts
@@ -150,26 +159,52 @@ def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = 1
 
 
 # ---- discrete controller model and gains -----------------------------------------------------------------------------
+def _plant_args(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> None:
+    _pos("J_l", J_l)
+    _pos("t_s", t_s)
+    for nm, v in (("B_total", B_total), ("tau_l", tau_l)):
+        if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+            raise ParameterError(f"{nm} must be a number >= 0, got {v!r}")
+    if not (isinstance(w0, int | float) and math.isfinite(w0) and w0 != 0):
+        raise ParameterError(f"w0 (operating speed) must be a nonzero number, got {w0!r}")
+
+
 def plant_AB(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tuple[float, float]:
     """Eq 5.25: G(z) = A / (z - 1 + B), A = 2/J_l, B = t_s/J_l (2 B_total + tau_l / x0^(1/2)), x0 = w0^2."""
+    _plant_args(J_l, t_s, B_total, tau_l, w0)
     return 2.0 / J_l, t_s / J_l * (2 * B_total + tau_l / abs(w0))
 
 
 def gains(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tuple[float, float]:
     """Eqs 5.32-5.37: K_p = J_l/2 - t_s (B_total + tau_l / (2 x0^(1/2))) (one pole at the origin) and the largest
-    K_I = J_l / (2 t_s) keeping the other pole on the positive real axis."""
-    return J_l / 2 - t_s * (B_total + tau_l / (2 * abs(w0))), J_l / (2 * t_s)
+    K_I = J_l / (2 t_s) keeping the other pole on the positive real axis. A non-positive K_p (dissipation per cycle
+    above the load's kinetic energy: open loop unstable, (5.27)) is an error."""
+    _plant_args(J_l, t_s, B_total, tau_l, w0)
+    kp = J_l / 2 - t_s * (B_total + tau_l / (2 * abs(w0)))
+    if kp <= 0:
+        raise ParameterError(f"no positive K_p: t_s (B_total + tau_l/(2|w0|)) = {J_l / 2 - kp:.4g} >= J_l/2 = "
+                             f"{J_l / 2:.4g} (open-loop pole outside the unit circle, Eq 5.27)")
+    return kp, J_l / (2 * t_s)
 
 
 def b_total(P: float, w0: float, tau_l: float) -> float:
     """Eq 5.38: B_total = (P/w0 - tau_l) / w0 (all power not spent on the load is viscous loss at w0)."""
-    return (P / w0 - tau_l) / w0
+    _pos("P", P)
+    _plant_args(1.0, 1.0, 0.0, tau_l, w0)
+    bt = (P / abs(w0) - tau_l) / abs(w0)
+    if bt < 0:
+        raise ParameterError(f"B_total = (P/|w0| - tau_l)/|w0| = {bt:.4g} < 0: the load torque {tau_l} N m takes more "
+                             f"than the power P = {P} W at w0 = {w0} rad/s")
+    return bt
 
 
 def closed_loop_poles(Kp: float, Ki: float, J_l: float, t_s: float, B_total: float, tau_l: float, w0: float
                       ) -> np.ndarray:
     """Roots of Eq 5.31: z^2 + z (B - 2 + Kp A / C) + 1 - B - Kp A, C = Kp / (Kp + Ki t_s)."""
     A, B = plant_AB(J_l, t_s, B_total, tau_l, w0)
+    _pos("Kp", Kp)
+    if not (math.isfinite(Ki) and Ki >= 0):
+        raise ParameterError(f"Ki must be a number >= 0, got {Ki!r}")
     C = Kp / (Kp + Ki * t_s)
     return np.roots([1.0, B - 2 + Kp * A / C, 1 - B - Kp * A])
 

@@ -9,6 +9,7 @@ tau_l/(C_l+tau_l) of the dissipation is the output work (Eq 3.22).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -19,17 +20,18 @@ import numpy as np
 from ...errors import ParameterError, SceneError
 from ...paths import mjcf_path
 from .controllers import EnergyPacketController, StepUpController
-from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring, simulate_reference
+from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring, delay_samples, simulate_reference
 from .params import motor_line
 
 ROTORS = ["motor", "spring", "load"]
+T0_TOL = 1e-9  # s: window starts compare controller times with this tolerance
 
 
 def build_system(mechanism: str, p: Mapping[str, Any], effects: Mapping[str, Any]) -> RotorSystem:
     """Rotor system of a drive from resolved parameters; effects `bearing_friction`, `clutch_delays`,
     `added_motor_inertia` decide what is built (an effect that is off adds no element)."""
     bearings = bool(effects.get("bearing_friction", True))
-    J = [p["J_m"] + (p["J_add"] or 0.0 if effects.get("added_motor_inertia", False) else 0.0), p["J_s"], p["J_l"]]
+    J = [p["J_m"] + ((p["J_add"] or 0.0) if effects.get("added_motor_inertia", False) else 0.0), p["J_s"], p["J_l"]]
     if effects.get("added_motor_inertia", False) and not p["J_add"]:
         raise ParameterError("effect added_motor_inertia is on but parameter J_add is 0")
     B = [p["B_m"], p["B_s"], p["B_l"]] if bearings else [0.0, 0.0, 0.0]
@@ -78,36 +80,54 @@ def build_system(mechanism: str, p: Mapping[str, Any], effects: Mapping[str, Any
                        delays=delay_map)
 
 
+def _given(p: Mapping[str, Any], key: str, default: float) -> float:
+    """p[key] if it is set (not None), else the default; 0 is a value, not 'unset' (DriveParams rejects a 0 where it
+    is not allowed)."""
+    v = p.get(key)
+    return float(default if v is None else v)
+
+
 def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: Mapping[str, Any], ref=None):
+    """Controller of a drive from resolved parameters. The clutch delay it compensates is the one actually applied:
+    `delay_samples(d_on, fs) / fs` (the command queue quantises the same way)."""
     fs = float(p["fs"])
     delays = effects.get("clutch_delays", True)
-    cd = p["d_on"] if delays else 0.0
+    cd = delay_samples(p["d_on"], fs) / fs if delays else 0.0
     closed = bool(effects.get("closed_loop", False))
+    anti_windup = bool(effects.get("anti_windup", True))
     if mechanism == "step_up":
         if kind not in ("pwm", "resonant", "motor_resonant"):
             raise SceneError(f"unknown controller {kind!r} for the step-up drive; valid: "
                              "['pwm', 'resonant', 'motor_resonant']")
         if delays and p["d_on"] >= p["t_l"]:
             raise ParameterError(f"delay {p['d_on']} s is longer than the PWM cycle t_l = {p['t_l']} s")
+        # the transfer ends when the twist falls below twist_tol; the friction on the spring end and the load holds a
+        # static twist (C_s + C_l)/K, so a smaller twist_tol is never reached and the transfer never ends
+        bearings = bool(effects.get("bearing_friction", True))
+        held = (p["C_s"] + p["C_l"]) / p["K"] if bearings else 0.0
+        twist_tol = _given(p, "twist_tol", 0.0)
+        if twist_tol <= held:
+            raise ParameterError(f"parameter twist_tol = {twist_tol} rad must exceed the friction-held static twist "
+                                 f"(C_s + C_l)/K = {held:.4g} rad, else a transfer never ends")
         return StepUpController(kind=kind, fs=fs, t_l=p["t_l"], duty=p["duty"], t_n=p["t_n"],
-                                twist_tol=p["twist_tol"] or 0.0, min_vel=p["min_vel"], max_vel=p["max_vel"],
+                                twist_tol=twist_tol, min_vel=p["min_vel"], max_vel=p["max_vel"],
                                 clutch_matching=bool(effects.get("clutch_matching", False)),
                                 Omega=math.sqrt(p["K"] / p["J_s"]), delay_comp=0.0, closed_loop=closed,
-                                Kp=p["Kp"], Ki=p["Ki"], ref=p["ref"], max_tk=p["max_tk"],
-                                anti_windup=bool(effects.get("anti_windup", False)))
+                                Kp=p["Kp"], Ki=p["Ki"], ref=p["ref"], max_tk=p["max_tk"], anti_windup=anti_windup)
     if kind != "energy_packet":
         raise SceneError(f"unknown controller {kind!r} for the step-up/step-down drive; valid: ['energy_packet']")
     period_free = 2 * math.pi * math.sqrt(p["J_s"] / p["K"])
     if delays and max(p["d_on"], p["d_off"]) >= period_free:
         raise ParameterError(f"clutch delay {max(p['d_on'], p['d_off'])} s is longer than the spring system's free "
                              f"oscillation period {period_free:.4g} s (one energy cycle)")
-    K_ctrl = p.get("K_ctrl") or p["K"]
-    Om = p.get("Omega_ctrl") or math.sqrt(p["K"] / p["J_s"])
-    x_max = p.get("spring_max") or min(p["tau_c1"], p["tau_c2"]) / p["K"]
+    K_ctrl = _given(p, "K_ctrl", p["K"])
+    Om = _given(p, "Omega_ctrl", math.sqrt(p["K"] / p["J_s"]))
+    x_max = _given(p, "spring_max", min(p["tau_c1"], p["tau_c2"]) / p["K"])
     return EnergyPacketController(fs=fs, K=K_ctrl, Omega=Om, clutch_delay=cd, spring_max=x_max,
-                                  min_motor_vel=p["min_motor_vel"], min_load_vel=p["min_load_vel"] or 0.0,
+                                  min_motor_vel=_given(p, "min_motor_vel", 70.0),
+                                  min_load_vel=_given(p, "min_load_vel", 0.0),
                                   closed_loop=closed, Kp=p["Kp"], Ki=p["Ki"], ref=ref if ref is not None else p["ref"],
-                                  anti_windup=bool(effects.get("anti_windup", True)))
+                                  anti_windup=anti_windup)
 
 
 def run_paths(system: RotorSystem, mechanism: str, make_controller, t_end: float, engines=("reference", "mujoco"),
@@ -139,19 +159,25 @@ class Balance:
 
     @property
     def relative(self) -> float:
-        return self.residual / self.input if self.input else float("nan")
+        """residual / energy turnover, the turnover being the largest of |input|, |output|, sum |losses|, |stored|
+        (= the input whenever the drive is driven); 0 when nothing moved at all (no NaN for a zero input)."""
+        scale = max(abs(self.input), abs(self.output), sum(abs(v) for v in self.losses.values()), abs(self.stored))
+        if scale == 0.0:
+            return 0.0 if self.residual == 0.0 else math.copysign(math.inf, self.residual)
+        return self.residual / scale
 
 
 def energy_balance(system: RotorSystem, res: RefResult, i0: int = 0, i1: int = -1) -> Balance:
-    """input - output - sum(losses) - delta(stored) between samples i0 and i1 (Eqs 3.21-3.24 corrected)."""
+    """input - output - sum(losses) - delta(stored) between samples i0 and i1 (Eqs 3.21-3.24 corrected). The losses
+    include `lock_impact`, the kinetic energy removed by plastic locks, recorded as a cumulative series in step with
+    the sampled state, so any window [i0, i1] closes (not only the whole run)."""
     E = res.energy
     d = {k: float(v[i1] - v[i0]) for k, v in E.items()}
     outputs = {p.label for f in system.frictions for p in f.parts if p.output}
     e_in = d.pop("source")
     e_out = sum(d.pop(k) for k in list(d) if k in outputs)
-    reset = float(res.stats.get("reset_energy", 0.0)) if i0 == 0 and i1 in (-1, res.t.size - 1) else 0.0
-    if reset:
-        d["lock_impact"] = reset
+    if "lock_impact" not in E and i0 == 0 and i1 in (-1, res.t.size - 1):  # results without the series
+        d["lock_impact"] = float(res.stats.get("reset_energy", 0.0))
     ke1, pe1 = system.stored_energy(res.q[:, i1], res.w[:, i1])
     ke0, pe0 = system.stored_energy(res.q[:, i0], res.w[:, i0])
     stored = ke1 + pe1 - ke0 - pe0
@@ -165,6 +191,7 @@ def lock_times(res: RefResult, element: str, to: str = "stuck") -> np.ndarray:
 
 def cycle_stats(res: RefResult, ctrl, t0: float = 0.0) -> dict[str, Any]:
     """Energy cycles (from the controller log), switching rate, mean load speed, packet sizes, peak extension."""
+    t0 = t0 - T0_TOL  # controller times are k/fs in one path and step*dt in the other: a boundary sample counts in both
     cyc = np.array([e["t"] for e in ctrl.log if e["event"] == "cycle" and e["t"] >= t0])
     out: dict[str, Any] = {"n_cycles": int(max(0, cyc.size - 1))}
     if cyc.size >= 2:
@@ -183,10 +210,32 @@ def cycle_stats(res: RefResult, ctrl, t0: float = 0.0) -> dict[str, Any]:
     return out
 
 
+def cycle_phases(ctrl, t0: float = 0.0) -> dict[str, float]:
+    """Mean duration (s) of the phases of the step-up/step-down energy cycle from the controller log, over the cycles
+    started at t >= t0: `wait_extraction` (cycle start -> input clutch commanded on), `extraction` (-> commanded off),
+    `wait_transfer` (-> output clutch on), `transfer` (-> off), `restart` (-> next cycle start)."""
+    keys = ("cycle", "extract_on", "extracted", "transfer_on", "transferred")
+    rows = []
+    log = [e for e in ctrl.log if e["event"] in keys]
+    for i in range(len(log) - 5):
+        seq = log[i:i + 6]
+        if [e["event"] for e in seq] == [*keys, "cycle"] and seq[0]["t"] >= t0 - T0_TOL:
+            rows.append(np.diff([e["t"] for e in seq]))
+    if not rows:
+        return {}
+    m = np.mean(rows, axis=0)
+    names = ("wait_extraction", "extraction", "wait_transfer", "transfer", "restart")
+    out = {k: float(v) for k, v in zip(names, m, strict=True)}
+    out["cycle"] = float(m.sum())
+    out["n"] = len(rows)
+    return out
+
+
 def compare_events(a: RefResult, b: RefResult, elements: list[str], kinds=("stuck", "free"), t0: float = 0.0
                    ) -> dict[str, Any]:
-    """Pair the lock-up (-> stuck) and release (-> free) events of two runs: each event of `a` with the nearest event
-    of `b` of the same element and kind. Returns the counts and the largest time difference per element/kind."""
+    """Pair the lock-up (-> stuck) and release (-> free) events of two runs in order, per element and kind. Returns
+    the counts n_a, n_b, the paired times t_a and differences dt = t_b - t_a, and max/median |dt|; when the counts
+    differ nothing is paired and max_dt = inf (the runs do not have the same event sequence)."""
     out: dict[str, Any] = {}
     for el in elements:
         for kind in kinds:
@@ -194,14 +243,105 @@ def compare_events(a: RefResult, b: RefResult, elements: list[str], kinds=("stuc
             tb = np.array([e["t"] for e in b.events if e["element"] == el and e["to"] == kind and e["t"] >= t0])
             if ta.size == 0 and tb.size == 0:
                 continue
-            d = np.array([np.min(np.abs(tb - x)) for x in ta]) if tb.size else np.full(ta.size, np.inf)
-            out[f"{el}->{kind}"] = {"n_a": int(ta.size), "n_b": int(tb.size),
-                                    "max_dt": float(d.max()) if d.size else float("nan"),
-                                    "median_dt": float(np.median(d)) if d.size else float("nan")}
+            same = ta.size == tb.size
+            d = tb - ta if same else np.full(0, np.nan)
+            out[f"{el}->{kind}"] = {"n_a": int(ta.size), "n_b": int(tb.size), "t_a": ta if same else None, "dt": d,
+                                    "max_dt": float(np.max(np.abs(d))) if same and d.size else
+                                    (0.0 if same else float("inf")),
+                                    "median_dt": float(np.median(np.abs(d))) if same and d.size else float("nan")}
     return out
 
 
-def transferred_packets(system: RotorSystem, res: RefResult, mechanism: str, ctrl) -> np.ndarray:
-    """Energy delivered per energy cycle = 1/2 K theta_peak^2 at each transfer (step-up/step-down), from the log."""
+def short_locks(res: RefResult, elements: list[str], max_len: float) -> list[tuple[str, float, float]]:
+    """Stuck episodes that break loose again within `max_len` s: (element, t_stuck, t_release). In MuJoCo a grazing
+    slip reversal near the breakaway torque can lock for a step or two where the exact path passes through."""
+    out = []
+    for el in elements:
+        ev = [e for e in res.events if e["element"] == el]
+        out += [(el, a["t"], b["t"]) for a, b in zip(ev, ev[1:], strict=False)
+                if a["to"] == "stuck" and b["from"] == "stuck" and b["t"] - a["t"] < max_len]
+    return out
+
+
+def without_events(res: RefResult, episodes: list[tuple[str, float, float]]) -> RefResult:
+    """The result with the events of `episodes` (from `short_locks`) removed, for pairing the remaining events."""
+    drop = {(el, t) for el, a, b in episodes for t in (a, b)}
+    return dataclasses.replace(res, events=[e for e in res.events if (e["element"], e["t"]) not in drop])
+
+
+def compare_commands(ca, cb) -> dict[str, Any]:
+    """Pair the two controllers' logs entry by entry. `same_sequence`: same events in the same order; `flips`: the
+    entries whose controller sample differs, each with the computed waits (in samples, before the int() truncation)
+    of both runs taken from the entry that set the wait."""
+    la, lb = ca.log, cb.log
+    same = len(la) == len(lb) and all(x["event"] == y["event"] for x, y in zip(la, lb, strict=False))
+    flips = []
+    if same:
+        dt = ca.dt
+        wait_a = wait_b = None
+        for x, y in zip(la, lb, strict=True):
+            if round(x["t"] / dt) != round(y["t"] / dt):
+                flips.append({"event": x["event"], "t_a": x["t"], "t_b": y["t"], "wait_a": wait_a, "wait_b": wait_b})
+            if "wait_samples" in x:
+                wait_a, wait_b = x["wait_samples"], y.get("wait_samples")
+    return {"same_sequence": same, "n": len(la), "n_b": len(lb), "flips": flips}
+
+
+def _spring_system_energy(system: RotorSystem, res: RefResult, t: np.ndarray) -> np.ndarray:
+    """Energy of the step-up/step-down spring system 1/2 J_s w_s^2 + 1/2 K theta_s^2 at times t (interpolated on the
+    samples; exact when t is on the sample grid, as the actuation times are when sample_dt = the controller period)."""
+    ws = np.interp(t, res.t, res.w[1])
+    th = np.interp(t, res.t, res.q[1])
+    return 0.5 * system.J[1] * ws**2 + 0.5 * system.springs[0].K * th**2
+
+
+def energy_packets(system: RotorSystem, res: RefResult, ctrl, t0: float = 0.0) -> dict[str, np.ndarray]:
+    """Energy packets of the step-up/step-down drive, one per complete energy cycle (cycle started at t >= t0).
+
+    A packet is the energy the spring system takes up while the input clutch is applied (extraction):
+    `stored = E_s(input clutch released) - E_s(input clutch engaged)`, E_s = 1/2 J_s w_s^2 + 1/2 K theta_s^2 (with the
+    velocities matched at both ends this is 1/2 K (theta_end^2 - theta_start^2), the packet the controller asks for);
+    `delivered = E_s(output clutch engaged) - E_s(output clutch released)` is what it hands on during the transfer.
+    The engage/release times are the controller's commands plus the quantised actuation delays (`delay_samples`),
+    i.e. when the clutch torque actually switches. Returns arrays t (cycle start), stored, delivered, demand (the PI's
+    signed packet demand eps) and dir (+1 motor -> load, -1 load -> motor: regeneration).
+    """
+    if len(system.springs) != 1 or system.springs[0].a != 1 or system.springs[0].b >= 0:
+        raise SceneError("energy packets are defined for the step-up/step-down drive (spring system to ground)")
+    fs = 1.0 / ctrl.dt
+
+    def act(e: dict, on: bool) -> float:
+        d_on, d_off = system.delays.get(e["clutch"], (0.0, 0.0))
+        return e["t"] + delay_samples(d_on if on else d_off, fs) / fs
+
+    out: dict[str, list[float]] = {"t": [], "stored": [], "delivered": [], "demand": [], "dir": []}
+    log = ctrl.log
+    t_last = res.t[-1]
+    for i, e in enumerate(log):
+        if e["event"] != "cycle" or e["t"] < t0 - T0_TOL:
+            continue
+        seq = {}
+        for f in log[i + 1:]:
+            if f["event"] == "cycle":
+                break
+            seq[f["event"]] = f
+        if not all(k in seq for k in ("extract_on", "extracted", "transfer_on", "transferred")):
+            continue
+        times = np.array([act(seq["extract_on"], True), act(seq["extracted"], False), act(seq["transfer_on"], True),
+                          act(seq["transferred"], False)])
+        if times[-1] > t_last:
+            continue
+        E = _spring_system_energy(system, res, times)
+        out["t"].append(e["t"])
+        out["stored"].append(E[1] - E[0])
+        out["delivered"].append(E[2] - E[3])
+        out["demand"].append(float(e.get("eps", 0.0)))
+        out["dir"].append(float(e.get("dir", 1)))
+    return {k: np.asarray(v, float) for k, v in out.items()}
+
+
+def peak_spring_energies(system: RotorSystem, ctrl) -> np.ndarray:
+    """1/2 K theta_peak^2 at each transfer (the spring system's peak potential energy; not the packet size - see
+    `energy_packets`)."""
     K = system.springs[0].K
     return np.array([0.5 * K * e["theta_peak"] ** 2 for e in ctrl.log if e["event"] == "transferred"])

@@ -24,6 +24,7 @@ steps) truncate the step exactly. A discrete controller is sampled at its period
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -180,11 +181,24 @@ class Controller(Protocol):
     def __call__(self, k: int, t: float, q: np.ndarray, w: np.ndarray) -> dict[str, int] | None: ...
 
 
+def delay_samples(delay: float, fs: float) -> int:
+    """Actuation delay in controller samples, as the thesis' shift registers: `count = (int)(delay*sample_rate)`
+    (App. C L2569-2575), i.e. truncation - but of the product rounded to 9 decimals, so that a delay that is a whole
+    number of samples in decimal (0.3 ms at 10 kHz: 0.0003*10000 = 2.9999999999999996 in binary) gives that number
+    (3), not one less. The one conversion used by the command queue, the controllers and `drive.build_controller`."""
+    if not (math.isfinite(delay) and delay >= 0.0):
+        raise ParameterError(f"actuation delay must be a finite number >= 0 s, got {delay!r}")
+    if not (math.isfinite(fs) and fs > 0.0):
+        raise ParameterError(f"controller sample rate must be positive, got {fs!r}")
+    return int(math.floor(round(delay * fs, 9)))
+
+
 class CommandQueue:
-    """Commands with pure actuation delays quantised to controller samples (thesis App. C: count = int(delay*fs))."""
+    """Commands with pure actuation delays quantised to controller samples (`delay_samples`, thesis App. C)."""
 
     def __init__(self, delays: dict[str, tuple[float, float]], dt: float, initial: dict[str, int]):
-        self.counts = {c: (int(round(d_on / dt, 9)), int(round(d_off / dt, 9))) for c, (d_on, d_off) in delays.items()}
+        fs = 1.0 / dt
+        self.counts = {c: (delay_samples(d_on, fs), delay_samples(d_off, fs)) for c, (d_on, d_off) in delays.items()}
         self.dt = dt
         self.commanded = dict(initial)
         self.pending: list[tuple[float, str, int]] = []
@@ -421,6 +435,7 @@ def simulate_reference(
     out_y = np.empty((t_samples.size, y.size))
     out_m = np.empty((ne, t_samples.size), dtype=int)
     out_u = {c: np.empty(t_samples.size) for c in u}
+    out_reset = np.empty(t_samples.size)  # cumulative plastic-lock (impact) loss, in step with the recorded state
     i_out = 0
     ctrl_k = 0
     breaks = sorted(b for b in sys.breaks if 0.0 < b < t_end)
@@ -435,6 +450,7 @@ def simulate_reference(
             out_m[:, i_out] = modes
             for c in u:
                 out_u[c][i_out] = u[c]
+            out_reset[i_out] = stats["reset_energy"]
             i_out += 1
 
     # controller at t = 0
@@ -538,6 +554,7 @@ def simulate_reference(
     Y = out_y[:m]
     e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + labels
     energy = {nm: Y[:, 2 * n + i] for i, nm in enumerate(e_names)}
+    energy["lock_impact"] = out_reset[:m]
     return RefResult(t=t_samples[:m], q=Y[:, :n].T, w=Y[:, n:2 * n].T, modes=out_m[:, :m], energy=energy,
                      events=events, u={c: v[:m] for c, v in out_u.items()}, stats=stats)
 

@@ -11,8 +11,9 @@ Conventions of the MJCF files (`mjcf/coupled_clutches.xml`, `mjcf/drive_step_up.
 
 Per step: sliding elements whose slip changed sign are tried for a lock (velocities of the new rigid group are set to
 their momentum-weighted mean, the equality is activated, `mj_forward` gives the constraint torque; if it exceeds the
-breakaway torque the element slides on in the other direction), stuck elements break loose when the equality force of
-the previous step exceeds the breakaway torque, and the sliding torques are applied through the actuators.
+breakaway torque the element slides on in the other direction), stuck elements break loose when the equality force at
+the current state (an `mj_forward` at the start of the step) exceeds the breakaway torque, and the sliding torques are
+applied through the actuators. The controller is sampled at its period, not at t_end (as the hand path).
 """
 
 from __future__ import annotations
@@ -69,6 +70,10 @@ class MujocoRotorSim:
             m.eq_solref[e] = (tc, 1.0)
             m.eq_solimp[e] = (0.9999, 0.9999, 0.001, 0.5, 2.0)
         self.d = mujoco.MjData(m)
+        self._dof_idx = np.array(self.dof, int)
+        self._qadr_idx = np.array(self.qadr, int)
+        self._eq_pos = {int(e): k for k, e in enumerate(self.eq)}
+        self._G_all = sys.G(list(range(len(sys.frictions))))  # w_rel = G w for every element
         # mujoco 4: run-time inertia changes reach M only after mj_setConst (it refreshes the cached constants)
         mujoco.mj_setConst(m, self.d)
         mujoco.mj_forward(m, self.d)
@@ -78,16 +83,25 @@ class MujocoRotorSim:
 
     # -- helpers -------------------------------------------------------------------------------------------------
     def _w(self) -> np.ndarray:
-        return np.array([self.d.qvel[i] for i in self.dof])
+        return self.d.qvel[self._dof_idx]  # fancy indexing: a copy
 
     def _q(self) -> np.ndarray:
-        return np.array([self.d.qpos[i] for i in self.qadr])
+        return self.d.qpos[self._qadr_idx]
 
-    def _eq_force(self, e: int) -> float:
+    def _eq_forces(self) -> np.ndarray:
+        """Force of every friction element's lock equality from the last `mj_forward` (0 where inactive)."""
         d = self.d
-        rows = np.nonzero((d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-                          & (d.efc_id[: d.nefc] == self.eq[e]))[0]
-        return float(d.efc_force[rows[0]]) if rows.size else 0.0
+        out = np.zeros(len(self.eq))
+        nefc = d.nefc
+        if nefc:
+            rows = np.nonzero(d.efc_type[:nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)[0]
+            seen = set()
+            for r in rows:  # the first row of each equality (a joint equality has one)
+                k = self._eq_pos.get(int(d.efc_id[r]))
+                if k is not None and k not in seen:
+                    out[k] = d.efc_force[r]
+                    seen.add(k)
+        return out
 
     def _activate(self, stuck: list[int]) -> float:
         """Lock the elements `stuck`: project velocities (plastic impact), set the equality offsets and activate.
@@ -146,17 +160,31 @@ class MujocoRotorSim:
         MO = np.empty((ne, n_out), int)
         UU = {c: np.empty(n_out) for c in u}
         e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + labels
-        E = {k: np.empty(n_out) for k in e_names}
+        E = {k: np.empty(n_out) for k in e_names + ["lock_impact"]}
         acc = np.zeros(len(e_names))
         stats = {"reset_energy": 0.0, "lock_trials": 0, "steps": n_steps}
         k_out = 0
 
+        # levels depend on time only through schedules: without any, cache them per command state
+        timevar = any(pt.schedule is not None for f in sys.frictions for pt in f.parts)
+        lv_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+
         def levels(t):
+            key = None if timevar else tuple(u[c] for c in u)
+            if key is not None and key in lv_cache:
+                return lv_cache[key]
             lv = sys.levels(t, u)
             el = np.zeros(ne)
             np.add.at(el, part_owner, lv)
+            if key is not None:
+                lv_cache[key] = (lv, el)
             return lv, el
 
+        G_all = self._G_all
+        free_tol = np.array([1e-12 * max(1.0, sum(p.level for p in f.parts)) for f in sys.frictions])
+        part_idx = np.arange(len(part_owner))
+        part_el = np.array(part_owner, int)
+        rk4 = m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
         g_prev = np.full(ne, np.nan)  # event function of each element at the previous step (slip or overload)
         g_now = np.full(ne, np.nan)
 
@@ -171,7 +199,7 @@ class MujocoRotorSim:
                 events.append({"t": float(te), "element": sys.frictions[e].name, "from": MODE_NAME[int(old)],
                                "to": MODE_NAME[int(new)], "t_step": float(t)})
 
-        def step_work(tm, lv, el, w0, q0, w1, q1):
+        def step_work(tm, lv, w0, q0, w1, q1):
             """Energy terms of one step: constant (held) torques do work torque x displacement (exact for the
             integrated motion, also when a slip reverses inside the step); velocity-proportional terms trapezoidal."""
             out = np.zeros(len(e_names))
@@ -180,47 +208,41 @@ class MujocoRotorSim:
                 i = s.body
                 out[0] += s.c0 * (s.shape(tm) if s.shape else 1.0) * dq[i] + s.c1 * 0.5 * (w0[i] ** 2 + w1[i] ** 2) * dt
             out[1:1 + n] = sys.B * 0.5 * (w0**2 + w1**2) * dt
-            for i, e in enumerate(part_owner):
-                if modes[e] in (FWD, BWD):
-                    f = sys.frictions[e]
-                    dqr = (dq[f.b] if f.b >= 0 else 0.0) - dq[f.a]
-                    out[1 + n + i] = modes[e] * lv[i] * dqr
+            sliding = (modes == FWD) | (modes == BWD)
+            if sliding.any():
+                dqr = G_all @ dq  # relative displacement of every element
+                on = sliding[part_el]
+                out[1 + n + part_idx[on]] = modes[part_el[on]] * lv[on] * dqr[part_el[on]]
             return out
 
-        def powers(t, lv, el, w):
-            p = np.zeros(len(e_names))
-            for s in sys.sources:
-                p[0] += (s.c0 * (s.shape(t) if s.shape else 1.0) + s.c1 * w[s.body]) * w[s.body]
-            p[1:1 + n] = sys.B * w * w
-            wr = sys.w_rel(w)
-            for i, e in enumerate(part_owner):
-                if modes[e] in (FWD, BWD):
-                    p[1 + n + i] = lv[i] * abs(wr[e])
-            return p
-
         first = True
+        lam_all = np.zeros(ne)  # lock-equality forces of the last mj_forward
         for step in range(n_steps + 1):
             t = step * dt
-            if controller is not None and step % every == 0:
+            if controller is not None and step % every == 0 and step < n_steps:  # as the hand path: none at t_end
                 k = step // every
                 queue.issue(k, controller(k, t, self._q(), self._w()))
                 while queue.pending and queue.pending[0][0] <= t + 0.5 * dt:
                     _, c, v = queue.pending.pop(0)
                     u[c] = v
             lv, el = levels(t)
-            wr = sys.w_rel(self._w())
+            wr = G_all @ self._w()
             old = modes.copy()
-            if not first and np.any(modes == STUCK):
+            fresh = False  # d holds an mj_forward of the current state and ctrl
+            any_stuck = not first and bool(np.any(modes == STUCK))
+            if any_stuck:
                 mujoco.mj_forward(m, d)  # constraint torques at the current state for the break-loose test
+                lam_all = self._eq_forces()
+                fresh = True
             trial: list[int] = []
             g_now[:] = np.nan
+            sl = (modes == FWD) | (modes == BWD)
+            g_now[sl] = modes[sl] * wr[sl]
+            if any_stuck:
+                st = modes == STUCK
+                g_now[st] = peaks[st] * el[st] - np.abs(lam_all[st])
             for e in range(ne):
-                if modes[e] in (FWD, BWD):
-                    g_now[e] = modes[e] * wr[e]
-                elif modes[e] == STUCK and not first:
-                    g_now[e] = peaks[e] * el[e] - abs(self._eq_force(e))
-            for e in range(ne):
-                if el[e] <= 1e-12 * max(1.0, sum(p.level for p in sys.frictions[e].parts)):
+                if el[e] <= free_tol[e]:
                     modes[e] = FREE
                 elif modes[e] == FREE:
                     if abs(wr[e]) < 1e-12:
@@ -234,7 +256,7 @@ class MujocoRotorSim:
                     elif armed[e]:
                         trial.append(e)
                 elif modes[e] == STUCK and not first:
-                    lam = self._eq_force(e)
+                    lam = lam_all[e]
                     if abs(lam) > peaks[e] * el[e]:
                         modes[e] = FWD if lam > 0 else BWD
                         armed[e] = False
@@ -248,10 +270,12 @@ class MujocoRotorSim:
                     stats["reset_energy"] += dke
                     self._set_ctrl(t, el, modes)
                     mujoco.mj_forward(m, d)
+                    lam_all = self._eq_forces()
+                    fresh = True
                     stats["lock_trials"] += 1
                     if not stuck:
                         break
-                    lam = np.array([self._eq_force(e) for e in stuck])
+                    lam = lam_all[stuck]
                     ratio = np.abs(lam) / (peaks[stuck] * el[stuck])
                     r = int(np.argmax(ratio))
                     if ratio[r] <= 1.0:
@@ -261,21 +285,21 @@ class MujocoRotorSim:
                     armed[e] = False
                 # the KE removed by the plastic lock is slip loss of the locking element(s)
             if not first:
-                for e in range(ne):
-                    note(t, e, old[e], modes[e])
+                for e in np.nonzero(modes != old)[0]:
+                    note(t, int(e), old[e], modes[e])
             first = False
             # event functions of the new modes, for interpolating the next event
-            wr = sys.w_rel(self._w())
-            for e in range(ne):
-                if modes[e] in (FWD, BWD):
-                    g_prev[e] = modes[e] * wr[e]
-                elif modes[e] == STUCK:
-                    g_prev[e] = peaks[e] * el[e] - abs(self._eq_force(e))
-                else:
-                    g_prev[e] = np.nan
+            wr = G_all @ self._w()
+            g_prev[:] = np.nan
+            sl = (modes == FWD) | (modes == BWD)
+            g_prev[sl] = modes[sl] * wr[sl]
+            st = modes == STUCK
+            g_prev[st] = peaks[st] * el[st] - np.abs(lam_all[st])
             # held over the step: time-varying levels and source shapes at mid-step (second order)
-            lv_mid, el_mid = levels(t + 0.5 * dt)
+            lv_mid, el_mid = levels(t + 0.5 * dt) if timevar else (lv, el)
+            ctrl_before = d.ctrl.copy()
             self._set_ctrl(t + 0.5 * dt, el_mid, modes)
+            fresh = fresh and np.array_equal(ctrl_before, d.ctrl)
             if step % out_every == 0 and k_out < n_out:
                 T[k_out] = t
                 Q[:, k_out] = self._q()
@@ -285,13 +309,21 @@ class MujocoRotorSim:
                     UU[c][k_out] = u[c]
                 for i, k in enumerate(e_names):
                     E[k][k_out] = acc[i]
+                E["lock_impact"][k_out] = stats["reset_energy"]
                 k_out += 1
             if step == n_steps:
                 break
             w_a, q_a = self._w(), self._q()
-            mujoco.mj_step(m, d)
+            if fresh and rk4:
+                # the forward of this state and ctrl is already in d: mj_step without repeating it
+                mujoco.mj_checkPos(m, d)
+                mujoco.mj_checkVel(m, d)
+                mujoco.mj_checkAcc(m, d)
+                mujoco.mj_RungeKutta(m, d, 4)
+            else:
+                mujoco.mj_step(m, d)
             mujoco_engine.check_finite(m, d, "drives MuJoCo path")
-            acc += step_work(t + 0.5 * dt, lv_mid, el_mid, w_a, q_a, self._w(), self._q())
+            acc += step_work(t + 0.5 * dt, lv_mid, w_a, q_a, self._w(), self._q())
         stats["warnings"] = mujoco_engine.warnings_raised(d)
         return RefResult(t=T[:k_out], q=Q[:, :k_out], w=W[:, :k_out], modes=MO[:, :k_out],
                          energy={k: v[:k_out] for k, v in E.items()}, events=events,

@@ -118,9 +118,11 @@ class DriveParams:
     spring_max: float | None = None
 
     def __post_init__(self) -> None:
-        positive = ("J_m", "J_s", "J_l", "K", "R", "K_t", "fs", "t_l")
+        positive = ("J_m", "J_s", "J_l", "K", "R", "K_t", "fs", "t_l", "K_ctrl", "Omega_ctrl", "spring_max", "max_tk",
+                    "tau_0")
         nonneg = ("J_add", "C_m", "B_m", "C_s", "B_s", "C_l", "B_l", "tau_l", "tau_b", "tau_c", "tau_c1", "tau_c2",
-                  "d_on", "d_off", "K_e", "t_n", "twist_tol", "Kp", "Ki", "min_motor_vel", "min_load_vel")
+                  "d_on", "d_off", "K_e", "t_n", "twist_tol", "Kp", "Ki", "min_motor_vel", "min_load_vel", "min_vel",
+                  "max_vel")
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             if v is None:
@@ -131,13 +133,20 @@ class DriveParams:
                 raise ParameterError(f"parameter {f.name} must be positive, got {v!r}")
             if f.name in nonneg and v < 0:
                 raise ParameterError(f"parameter {f.name} must be >= 0, got {v!r}")
+        if self.tau_slope is not None and self.tau_slope > 0:
+            raise ParameterError(f"parameter tau_slope (motor torque-speed slope) must be <= 0, got {self.tau_slope!r}"
+                                 " (a torque rising with speed runs away)")
         if self.duty is not None and not 0 < self.duty < 1:
             raise ParameterError(f"parameter duty must be in (0, 1), got {self.duty!r}")
         if self.peak is not None and self.peak < 1:
             raise ParameterError(f"parameter peak (breakaway/sliding) must be >= 1, got {self.peak!r}")
+        if self.min_vel is not None and self.max_vel is not None and self.min_vel > self.max_vel:
+            raise ParameterError(f"parameter min_vel = {self.min_vel!r} must not exceed max_vel = {self.max_vel!r}")
 
     def resolved(self, param_set: str) -> dict[str, Any]:
-        """The parameter set with the overrides applied; validates combinations (delay vs controller period)."""
+        """The parameter set with the overrides applied, validated as a whole (ranges as in `__post_init__`, and
+        min_vel <= max_vel). Combinations that depend on the mechanism and effects (delay vs PWM cycle / free
+        oscillation period, twist_tol vs the friction-held twist) are checked by `drive.build_controller`."""
         if param_set not in PARAM_SETS:
             raise ParameterError(f"unknown parameter set {param_set!r}; valid: {sorted(PARAM_SETS)}")
         p: dict[str, Any] = {f.name: None for f in dataclasses.fields(self)}

@@ -27,6 +27,8 @@ from .reference import PantographConfig, PantographODE, simulate
 UNITS = {
     "F1": "m", "F2": "m", "HD": "m", "y_d": "m", "y_w": "m", "theta1": "rad", "theta2": "rad", "thetah": "rad",
     "theta_e": "rad", "elbow_windup": "rad", "contact_force": "N", "cylinder_force": "N", "cylinder_state": "m or Pa",
+    # under a catenary (input type "catenary"): the FE model's signals
+    "position": "m", "head_height": "m", "wire_height": "m", "contact_force_filtered": "N",
 }
 FR_SIGNALS = ("F1", "F2", "HD", "y_d")
 THESIS_RESONANCES_SIM = (4.25, 8.75, 19.5)
@@ -115,8 +117,40 @@ def _contact_losses(t: np.ndarray, fc: np.ndarray) -> list[dict]:
     return ev
 
 
+def run_under_catenary(scene: Scene) -> SimResult:
+    """The same pantograph scene under the EN 50318 finite-element catenary instead of the ram (input type
+    "catenary"): effects, parameters and engine are the scene's; the catenary's contact spring replaces ks. The
+    reference path uses the smooth Coulomb law there (event-exact stick/slip needs an adaptive integrator, the coupled
+    scheme is fixed-step). Statistics (EN 50318 procedure) are in `stats`; contact losses in `events`."""
+    from ..catenary.analysis import simulate as catenary_simulate
+    from ..catenary.analysis import to_simresult
+    from ..catenary.eppinger import EppingerMujoco, EppingerReference
+    from ..catenary.params import CatenaryParams
+
+    inp = scene.input
+    dt = float(inp.get("timestep", 1e-4))
+    effects = dict(scene.effects)
+    contact = effects.pop("contact")
+    if scene.solver.engine == "reference":
+        if effects["coulomb"] is True:
+            effects["coulomb"] = "smooth"
+        panto = EppingerReference(dict(scene.params), effects)
+    else:
+        panto = EppingerMujoco(dict(scene.params), effects, timestep=dt)
+    cp = CatenaryParams(element_length=float(inp.get("element_length", 0.5)))
+    run_ = catenary_simulate(cp, float(inp.get("speed", 250.0)), dt, dropper_law=str(inp.get("droppers", "slack")),
+                             pantograph=panto, contact=contact)
+    res = to_simresult(run_, None)
+    res.scene = scene.to_dict()
+    res.stats["static_contact_force"] = run_.static_force
+    return res
+
+
 def run(scene: Scene) -> SimResult:
-    """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference")."""
+    """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference"), under the ram of the
+    thesis' lab (input sine/step/static) or under a finite-element catenary (input catenary)."""
+    if scene.input.get("type") == "catenary":
+        return run_under_catenary(scene)
     p = scene.build_params()
     cfg = config_of(scene)
     ode = PantographODE(p, cfg)

@@ -90,6 +90,8 @@ class CatenaryRun:
     ranges: dict | None = None
     warnings: list[str] = field(default_factory=list)
     static_force: float = 0.0
+    engine_warnings: dict[str, int] = field(default_factory=dict)
+    is_reference: bool = False  # the EN 50318 reference scene (2-mass pantograph, specification's parameters)
 
 
 def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = "slack",
@@ -128,13 +130,16 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
               "method": "trapezoidal rule (Newmark beta=1/4), banded Cholesky (LAPACK dpbtrf/dpbtrs) factorised once, "
                         "exact per-step contact/slack-dropper active set on precomputed influence columns"}
     name = pantograph if isinstance(pantograph, str) else getattr(pantograph, "name", "custom")
+    eng_warn = panto.engine_warnings() if hasattr(panto, "engine_warnings") else {}
+    if eng_warn:
+        warn.append(f"MuJoCo warnings in the pantograph model: {eng_warn}")
     # the EN 50318 ranges apply to the reference scene only: 2-mass pantograph, specification's parameters
     is_reference = name == "reference2mass" and dataclasses.replace(p, element_length=1.0) == CatenaryParams(
         element_length=1.0)
     return CatenaryRun(params=p, speed_kmh=float(speed_kmh), dt=float(dt), dropper_law=dropper_law,
                        pantograph=name, result=res, stats=stats, filtered=ff, regime=regime, timing=timing,
                        ranges=check_ranges(stats, speed_kmh) if is_reference else None, warnings=warn,
-                       static_force=float(res.force[0]))
+                       static_force=float(res.force[0]), engine_warnings=eng_warn, is_reference=is_reference)
 
 
 # --- scene plumbing ---------------------------------------------------------------------------------------------
@@ -171,9 +176,11 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
     if scene is not None and scene.outputs:
         keep = set(scene.outputs)
         signals = {k: v for k, v in signals.items() if k in keep or (k.startswith("uplift_") and "uplift" in keep)}
-    return SimResult(t=r.t, signals=signals, units={k: units[k] for k in signals}, engine="reference",
+    engine = "mujoco" if run.pantograph.endswith("mujoco") else "reference"
+    return SimResult(t=r.t, signals=signals, units={k: units[k] for k in signals}, engine=engine,
                      events=run.stats["loss_events"],
-                     stats={**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run)},
+                     stats={**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
+                            "warnings": dict(run.engine_warnings)},
                      scene=scene.to_dict() if scene is not None else {})
 
 
@@ -196,7 +203,7 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
             lo, hi = rng[name]
             row += [f"{lo:g} .. {hi:g}", "yes" if run.ranges[name]["inside"] else "NO"]
         rows.append(row)
-    what = "EN 50318 reference scene" if run.ranges is not None else "catenary passage (EN 50318 statistics)"
+    what = "EN 50318 reference scene" if run.is_reference else "catenary passage (EN 50318 statistics)"
     lines = [f"{what}, {run.pantograph} pantograph, {run.speed_kmh:g} km/h "
              f"(element {run.params.element_length:g} m, dt {run.dt:g} s)", format_table(headers, rows)]
     for r in runs:
@@ -266,7 +273,7 @@ def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
     axes[1].set_ylabel("CW height at contact (mm)")
     axes[2].set_ylabel("uplift at support (mm)")
     axes[2].set_xlabel("pantograph position x (m)")
-    what = "EN 50318 reference scene" if runs[0].ranges is not None else "catenary passage"
+    what = "EN 50318 reference scene" if runs[0].is_reference else "catenary passage"
     axes[0].set_title(f"{what}, {runs[0].pantograph} pantograph, {runs[0].speed_kmh:g} km/h "
                       "(grey: statistics window)")
     fig.tight_layout()

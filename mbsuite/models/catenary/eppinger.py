@@ -194,6 +194,12 @@ class EppingerMujoco:
         self.mujoco.mj_setState(self.m, self.d, self._state, self._spec)
         return self._height()
 
+    def engine_warnings(self) -> dict[str, int]:
+        """MuJoCo warning counters raised during the run (empty if none)."""
+        from ...engines import mujoco_engine as mje
+
+        return mje.warnings_raised(self.d)
+
     def signals(self) -> dict[str, float]:
         self.mujoco.mj_setState(self.m, self.d, self._state, self._spec)
         th = self.q_to_theta(np.array(self.d.qpos[:3]))

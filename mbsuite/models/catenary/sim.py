@@ -278,10 +278,8 @@ class CoupledSimulation:
         EN = None
         if record_energy:
             EN = {k: np.zeros(nrec) for k in ("catenary", "pantograph", "contact", "drive_power")}
-        if record_energy:
-            self.q, self.p = q, pv
-            self.u = u
-            self._energy_record(EN, 0, x_start, f, 0, Nl)
+            self.q, self.p, self.u = q, pv, u
+            self._energy_record(EN, 0, x_start, f, e, Nl)
         T[0], X[0], F[0], H[0], W[0] = 0.0, x_start, f, panto.head(), w0 + float(Nl @ u[dofs])
         for k, val in panto.signals().items():
             psig[k][0] = val

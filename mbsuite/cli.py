@@ -1,4 +1,5 @@
-"""Command line: `mbsuite list | run | equilibrium | modes | freqresp` plus model-specific groups.
+"""Command line: `mbsuite list | run | equilibrium | modes | freqresp | workprecision | hardcases` plus model-specific
+groups.
 
 Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the
 header), PNG plots and `summary.json` (versions + scene). A model package may add its own sub-commands by defining
@@ -12,8 +13,12 @@ import importlib
 import json
 import sys
 from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
 
 from . import registry
+from .analysis.sweep import EXECUTORS, sweep_options
 from .errors import MbsuiteError
 from .results import Report, SimResult, format_table, to_jsonable
 from .scenes import load_scene
@@ -48,6 +53,150 @@ def _cmd_list(args: argparse.Namespace) -> None:
     _emit(Report(data, format_table(["model", "default", "scenes", "engines", "summary"], rows)), args, None)
 
 
+def _sweep_args(p: argparse.ArgumentParser) -> None:
+    """Where the command's sweep runs (the one sweep API, mbsuite.analysis.sweep)."""
+    p.add_argument("--executor", choices=EXECUTORS, default="local",
+                   help="local: processes on all cores (default); dask: a Dask distributed cluster")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler address (tcp://HOST:PORT) for --executor dask")
+    p.add_argument("--store", metavar="FILE", help="stream finished points to FILE (JSON lines) and resume from it")
+
+
+def _sweeping(args: argparse.Namespace):
+    return sweep_options(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
+                         store=getattr(args, "store", None))
+
+
+def _cmd_workprecision(args: argparse.Namespace) -> None:
+    from .analysis.workprecision import workprecision
+
+    scene = load_scene(args.scene)
+    if args.repeats < 1:
+        raise MbsuiteError(f"--repeats must be >= 1, got {args.repeats}")
+    progress = (lambda msg: print(msg, file=sys.stderr, flush=True)) if args.verbose else None
+    report = workprecision(scene, repeats=args.repeats, quick=args.quick, progress=progress)
+    _emit(report, args, scene.to_dict())
+
+
+def _cmd_hardcases(args: argparse.Namespace) -> None:
+    from . import hardcases
+
+    cases = hardcases.cases(args.model, include_slow=not args.no_slow)
+    if args.name:
+        cases = [hardcases.get(n) for n in args.name]
+    data: dict = {"cases": []}
+    rows = []
+    outcomes = {}
+    if args.run:
+        for c in cases:
+            outcomes[c.name] = hardcases.run_case(c)
+    for c in cases:
+        d = {"name": c.name, "model": c.model, "hard": c.hard, "scene": c.scene, "asserts": c.asserts,
+             "slow": c.slow, "known": c.known or None, "expected_failure": c.expected_failure or None}
+        status = ""
+        if c.name in outcomes:
+            o = outcomes[c.name]
+            status = "PASS" if o.passed else ("KNOWN FAIL" if c.expected_failure else "FAIL")
+            d.update(passed=o.passed, error=o.error,
+                     checks=[{"what": k.what, "ok": k.ok, "value": k.value, "bound": k.bound} for k in o.checks])
+        data["cases"].append(d)
+        rows.append([c.name, c.model, "slow" if c.slow else "", status, c.hard])
+    counts: dict[str, int] = {}
+    for c in cases:
+        counts[c.model] = counts.get(c.model, 0) + 1
+    data["counts"] = {"total": len(cases), "by_model": counts}
+    table = format_table(["case", "model", "", "result" if args.run else "", "what makes it hard"], rows)
+    table += "\n" + f"{len(cases)} hard cases: " + ", ".join(f"{m} {n}" for m, n in sorted(counts.items()))
+    if args.run:
+        n_ok = sum(o.passed for o in outcomes.values())
+        n_known = sum(1 for n, o in outcomes.items() if not o.passed and hardcases.get(n).expected_failure)
+        data["counts"].update(passed=n_ok, known_failures=n_known)
+        table += (f"; {n_ok}/{len(outcomes)} pass, {n_known} known failure(s)\n\n"
+                  + "\n".join(o.text() for o in outcomes.values()))
+    else:
+        table += "\n" + "\n".join(f"- {c.name}: scene {c.scene}; asserts {c.asserts}" +
+                                   (f"; KNOWN: {c.known}" if c.known else "")
+                                   + (f"; FAILS TODAY: {c.expected_failure}" if c.expected_failure else "")
+                                   for c in cases)
+    _emit(Report(data, table), args, None)
+    bad = [n for n, o in outcomes.items() if not o.passed and not hardcases.get(n).expected_failure]
+    if bad:
+        raise MbsuiteError("hard case(s) failed: " + ", ".join(bad))
+
+
+def _parse_values(text: str) -> list:
+    """`a,b,c` or `start:stop:step` (stop included); numbers, true/false, or strings."""
+    if text.count(":") == 2 and "," not in text:
+        a, b, c = (float(x) for x in text.split(":"))
+        if c <= 0 or b < a:
+            raise MbsuiteError(f"bad range {text!r}: need start <= stop and step > 0")
+        return [float(v) for v in np.round(np.arange(a, b + 0.5 * c, c), 12)]
+    out: list = []
+    for v in text.split(","):
+        v = v.strip()
+        if v.lower() in ("true", "false"):
+            out.append(v.lower() == "true")
+            continue
+        try:
+            out.append(float(v))
+        except ValueError:
+            out.append(v)
+    return out
+
+
+def _cmd_sweep(args: argparse.Namespace) -> None:
+    import itertools
+
+    from .analysis.sweep import run_sweep, scene_point
+    from .results import write_csv
+
+    scene = load_scene(args.scene)
+    axes = []
+    for spec in args.vary or []:
+        key, sep, vals = spec.partition("=")
+        section, dot, name = key.partition(".")
+        if not sep or not dot or section not in ("input", "params", "solver", "effects"):
+            raise MbsuiteError(f"--vary {spec!r}: expected SECTION.KEY=VALUES with SECTION in input, params, solver, "
+                               "effects (e.g. input.frequency=1:30:0.5 or params.k_s=1e5,2e5)")
+        axes.append((section, name, _parse_values(vals)))
+    if not axes:
+        raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")
+    combos = list(itertools.product(*[a[2] for a in axes]))
+    points = []
+    for combo in combos:
+        sections: dict = {}
+        for (section, name, _), v in zip(axes, combo, strict=True):
+            sections.setdefault(section, {})[name] = v
+        scene.replace(**sections)  # validate every point before anything runs
+        points.append((scene.to_dict(), sections))
+    with _sweeping(args):
+        results = run_sweep(scene_point, points, workers=args.workers, desc="sweep")
+    signals = [x for x in (args.signals.split(",") if args.signals else []) if x] or \
+        sorted(results[0]["signals"]) if results else []
+    head = [f"{s}.{n}" for s, n, _ in axes]
+    rows, cols = [], {h: [] for h in head}
+    for combo, r in zip(combos, results, strict=True):
+        row = list(combo)
+        for h, v in zip(head, combo, strict=True):
+            cols[h].append(v)
+        for sig in signals:
+            st = r["signals"].get(sig)
+            if st is None:
+                raise MbsuiteError(f"signal {sig!r} not in the results; available: {sorted(r['signals'])}")
+            row += [st["min"], st["max"], st["mean"]]
+            for k in ("min", "max", "mean"):
+                cols.setdefault(f"{sig}_{k}", []).append(st[k])
+        rows.append(row)
+    table = format_table(head + [f"{sig} {k}" for sig in signals for k in ("min", "max", "mean")], rows, ".5g")
+    data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "points": [
+        {"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}
+
+    def write(out: Path) -> list[Path]:
+        return [write_csv(Path(out) / "sweep.csv", [(k, "", v) for k, v in cols.items()])]
+
+    _emit(Report(data, table, write), args, scene.to_dict())
+
+
 def _hook_command(hook: str):
     def run(args: argparse.Namespace) -> None:
         scene = load_scene(args.scene)
@@ -60,7 +209,8 @@ def _hook_command(hook: str):
         if hook == "freqresp":
             kwargs = {"f_min": args.f_min, "f_max": args.f_max, "df": args.df, "methods": args.methods,
                       "workers": args.workers}
-        report = fn(scene, **kwargs)
+        with _sweeping(args):
+            report = fn(scene, **kwargs)
         if isinstance(report, SimResult):
             report = report.report()
         _emit(report, args, scene.to_dict())
@@ -94,7 +244,35 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--methods", default="linear,mujoco,reference",
                            help="comma list of linear, mujoco, reference")
             p.add_argument("--workers", type=int, default=0, help="parallel processes (0 = all cores)")
+            _sweep_args(p)
         p.set_defaults(func=_hook_command(hook))
+
+    p = sub.add_parser("sweep", help="parameter study: run a scene over a grid of inputs/parameters/settings")
+    p.add_argument("scene", help="scene TOML path, model name (default scene) or model/scene")
+    p.add_argument("--vary", action="append", metavar="SECTION.KEY=VALUES",
+                   help="a grid axis: comma list or start:stop:step, e.g. input.frequency=1:30:0.5 (repeatable: "
+                        "the grid is the product)")
+    p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
+    p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
+    _sweep_args(p)
+    _common(p)
+    p.set_defaults(func=_cmd_sweep)
+
+    p = sub.add_parser("workprecision", help="what accuracy costs: error vs wall time for every engine and method")
+    p.add_argument("scene", help="scene TOML path, model name (default scene) or model/scene")
+    p.add_argument("--repeats", type=int, default=5, help="runs per setting; wall time = median (default 5)")
+    p.add_argument("--quick", action="store_true", help="a few settings and short runs (smoke test)")
+    p.add_argument("--verbose", action="store_true", help="print each setting as it finishes (stderr)")
+    _common(p)
+    p.set_defaults(func=_cmd_workprecision)
+
+    p = sub.add_parser("hardcases", help="the hard-case registry: what is hard, the scene, what is asserted")
+    p.add_argument("--run", action="store_true", help="run the cases and report each assertion (exit 2 on failure)")
+    p.add_argument("--model", help="only this model's cases")
+    p.add_argument("--name", action="append", help="only this case (repeatable)")
+    p.add_argument("--no-slow", action="store_true", help="leave out the slow cases")
+    _common(p)
+    p.set_defaults(func=_cmd_hardcases)
 
     for name in sorted(registry.models()):
         try:

@@ -65,7 +65,8 @@ def n_workers(workers: int = 0) -> int:
 
 
 @contextlib.contextmanager
-def sweep_options(executor: str | None = None, scheduler: Any = None, store: str | Path | None = None) -> Iterator[None]:
+def sweep_options(executor: str | None = None, scheduler: Any = None,
+                  store: str | Path | None = None) -> Iterator[None]:
     """Defaults for every `run_sweep` in the block that does not pass its own (the CLI's `--executor/--scheduler`)."""
     saved = dict(_defaults)
     try:

@@ -12,9 +12,12 @@ Engines:
   with divergence checks; energy from MuJoCo's own `mj_energyPos/Vel`.
 - `reference`: the same file read by Pinocchio (`buildModelFromMJCF`); the closures are taken from MuJoCo's compiled
   `connect` anchors (body -> Pinocchio joint of the same name), and the constrained dynamics are the index-1 DAE
-  `M a = tau - h + J^T lambda`, `J a = -Jdot v - 2 alpha J v - alpha^2 r` (Baumgarte), solved for lambda by
-  least squares on `J M^-1 J^T` (rank-deficient at the four-bar's singular positions and always for the Bricard: the
-  minimum-norm multipliers give the unique accelerations), integrated by scipy (DOP853 by default) at rtol/atol.
+  replaced by the penalty formulation `(M + p J^T J) a = -h - p J^T (Jdot v + 2 w J v + w^2 r)` (p = 1e7, w = 10/s:
+  positive definite whatever the rank of J, so the Bricard's redundant rows need no special treatment), integrated by
+  scipy (DOP853 by default). The four-bar's reference is integrated on its parallelogram branch q = (s, -s, s)
+  (Pinocchio's M(q) and h(q, v) projected on the branch tangent): the Lagrange-multiplier and penalty formulations
+  both leave the branch at the singular positions (measured: rcond/damping variants end up on the anti-parallelogram
+  branch or stall; see the package README), which is exactly what the A02 gate is about.
 """
 
 from __future__ import annotations
@@ -120,12 +123,15 @@ def simulate_mujoco(m: mujoco.MjModel, v0: np.ndarray, duration: float, sample_d
 class PinocchioMechanism:
     """The MJCF read by Pinocchio with the closures of MuJoCo's compiled `connect`s (see module docstring)."""
 
-    def __init__(self, mechanism: str, gravity: float, baumgarte: float = 5.0):
+    def __init__(self, mechanism: str, gravity: float, penalty: float = 1e7, omega: float = 10.0):
         self.mj = mujoco_model(mechanism, 1e-3, "rk4", 0.004, gravity)
         self.model = pe.load_mjcf(mjcf_path(f"iftomm_{mechanism}"))
         self.model.gravity.linear = np.array([0.0, -gravity, 0.0])
         self.data = self.model.createData()
-        self.alpha = float(baumgarte)
+        self.penalty, self.omega = float(penalty), float(omega)
+        # the four-bar is integrated on its parallelogram branch q = (s, -s, s): a linear map, exact on that branch;
+        # penalty and multiplier formulations leave the branch at the singular positions (README)
+        self.branch = np.array([[1.0], [-1.0], [1.0]]) if mechanism == "fourbar" else None
         self.closures = []
         for e in range(self.mj.neq):
             if self.mj.eq_type[e] != mujoco.mjtEq.mjEQ_CONNECT:
@@ -164,8 +170,21 @@ class PinocchioMechanism:
         return self._points(q)[0]
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """Penalty formulation (Bayo et al.): (M + p J^T J) a = -h - p J^T (Jdot v + 2 w J v + w^2 r).
+
+        M + p J^T J stays positive definite when J loses rank (singular positions, redundant closures), unlike the
+        Lagrange-multiplier KKT system; the closure error obeys r'' + 2 w r' + w^2 r = O(1/p)."""
         nq = self.model.nq
         q, v = x[:nq], x[nq:]
+        if self.branch is not None:  # reduced to the branch's tangent: q = T s, v = T s'
+            T = self.branch
+            s, sd = q[:T.shape[1]], v[:T.shape[1]]
+            qq, vv = T @ s, T @ sd
+            M = pin.crba(self.model, self.data, qq)
+            M = np.triu(M) + np.triu(M, 1).T
+            h = pin.nonLinearEffects(self.model, self.data, qq, vv)
+            sdd = np.linalg.solve(T.T @ M @ T, -T.T @ h)
+            return np.concatenate([sd, np.zeros(nq - sd.size), sdd, np.zeros(nq - sd.size)])
         r, J = self._points(q)
         eps = 1e-7
         _, J2 = self._points(q + eps * v)
@@ -173,11 +192,8 @@ class PinocchioMechanism:
         M = pin.crba(self.model, self.data, q)
         M = np.triu(M) + np.triu(M, 1).T
         h = pin.nonLinearEffects(self.model, self.data, q, v)
-        Minv_h = np.linalg.solve(M, -h)
-        Minv_Jt = np.linalg.solve(M, J.T)
-        rhs = -Jdv - 2 * self.alpha * (J @ v) - self.alpha**2 * r - J @ Minv_h
-        lam = np.linalg.lstsq(J @ Minv_Jt, rhs, rcond=1e-10)[0]
-        a = Minv_h + Minv_Jt @ lam
+        w, p = self.omega, self.penalty
+        a = np.linalg.solve(M + p * J.T @ J, -h - p * J.T @ (Jdv + 2 * w * (J @ v) + w * w * r))
         return np.concatenate([v, a])
 
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
@@ -187,6 +203,11 @@ class PinocchioMechanism:
     def simulate(self, v0: np.ndarray, duration: float, sample_dt: float, method: str = "DOP853",
                  rtol: float = 1e-10, atol: float = 1e-12, max_step: float = 0.0) -> Trajectory:
         nq = self.model.nq
+        if self.branch is not None:
+            s0 = np.linalg.lstsq(self.branch, v0, rcond=None)[0]
+            if np.max(np.abs(self.branch @ s0 - v0)) > 1e-9 * max(1.0, np.max(np.abs(v0))):
+                raise SceneError("initial velocity is not on the four-bar's parallelogram branch")
+            v0 = np.concatenate([s0, np.zeros(nq - s0.size)])
         x0 = np.concatenate([np.zeros(nq), v0])
         t_eval = np.arange(0.0, duration + 0.5 * sample_dt, sample_dt)
         t_eval = t_eval[t_eval <= duration]
@@ -195,6 +216,9 @@ class PinocchioMechanism:
         if not sol.success or not np.all(np.isfinite(sol.y)):
             raise SolverError(f"Pinocchio constrained dynamics ({method}, rtol {rtol:g}) failed: {sol.message}")
         q, v = sol.y[:nq].T, sol.y[nq:].T
+        if self.branch is not None:
+            k = self.branch.shape[1]
+            q, v = q[:, :k] @ self.branch.T, v[:, :k] @ self.branch.T
         e = np.array([self.energy(a, b) for a, b in zip(q, v, strict=True)])
         res = np.array([float(np.max(np.abs(self.closure(a)))) for a in q])
         return Trajectory(sol.t, q, v, e, res, {"nfev": int(sol.nfev), "method": method, "rtol": rtol})

@@ -1,0 +1,566 @@
+"""Work-precision studies: what accuracy costs in wall time, for every engine and method of a scene.
+
+`workprecision(scene)` (CLI: `mbsuite workprecision SCENE [--out DIR] [--json]`) runs the scene's study:
+
+- pantograph scenes: MuJoCo timestep x integrator (euler, implicitfast, implicit, rk4, discrete) and the hand-derived
+  path with scipy methods x rtol. Reference: Radau at rtol 1e-12 (its own accuracy is measured against DOP853 at
+  rtol 1e-12 and reported). Coulomb friction is switched off for the study: MuJoCo's regularised frictionloss and the
+  reference's event-exact stick/slip are different models whose ~0.5 % difference would be an error floor.
+  State error: max over the trajectory (t >= t_settle, 1 ms grid) of |F1, F2, HD, y_d - ref| / A (A = input amplitude,
+  the characteristic scale of every output displacement). Physics metric: max of the relative amplitude errors and
+  the phase errors (rad) of F1 and HD at the forcing frequency (near the first resonance), and the relative errors of
+  the contact-force mean and standard deviation (std as scale).
+- coupler scenes: (a) the double-coupler FPP over one revolution: Gauss-Newton tolerance x continuation steps per
+  revolution; reference: scipy `least_squares` (trust-region, a different method) at xtol = ftol = gtol = 1e-15 on the
+  same equations (4). State error: max |u - u_ref| over the 8 unknowns (angles in rad, lengths in R). Physics metric:
+  max(|phi_c - phi_c,ref| (rad), |c5 - c5_ref| (rad; c5 is ~1e-14 at phi_bc = 0, so not relative), closure residual
+  max |r| / R^2). (b) MuJoCo dynamics,
+  timestep x integrator, 1 s; reference: MuJoCo RK4 at 1e-4 s (the soft closures are part of the model: a
+  different integrator at a 5x smaller step than the finest setting). State error: max of |phi_c - ref| / 1 rad,
+  |omega_c - ref| / omega, |torque_in - ref| / T_load. Physics metric: relative errors of the settled phi_c error
+  (phi_c - phi_c,kin), of the closure residual, and of the input-torque ripple.
+- drives scenes: the hand path (event-exact DOP853) x rtol and MuJoCo (rk4, euler) x timestep; reference: the hand
+  path at rtol 1e-12 (checked against rtol 1e-11; the hand path has one integrator, so the MuJoCo rows are the
+  different-method comparison). State error: max |w - w_ref| / max |w_ref| over the rotors. Physics metric: relative
+  errors of the cycle-mean load speed and of the efficiency E_out/E_in over [t_settle, T], and the lock-up time error
+  (max over matched stick events) over the energy-cycle period (CoupledClutches: over 0.1 s).
+
+- iftomm four-bar: MuJoCo (euler, implicitfast, rk4) x timestep and the Pinocchio path with scipy methods x rtol;
+  reference: the closed form on the parallelogram branch (psi'' = -(6/5) g cos psi, DOP853 rtol 1e-13). State error:
+  max |crank angle - ref| (rad). Physics metric: max(relative error of the crank's turns, closure residual / L,
+  energy drift / initial kinetic energy, coupler angle (branch)).
+
+Wall time: median of `repeats` (>= 5 by default) runs in this process, one after another, min-max shown.
+The result lists, per engine/method, the cheapest setting reaching 1e-2, 1e-4 and 1e-6 relative physics error.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import MbsuiteError, SceneError
+from ..results import Report, format_table, write_csv
+from ..scenes import Scene
+
+TOLS = (1e-2, 1e-4, 1e-6)
+
+
+@dataclass
+class Row:
+    engine: str
+    method: str
+    setting: Any
+    time_s: float = math.nan
+    time_min: float = math.nan
+    time_max: float = math.nan
+    state_error: float = math.nan
+    physics_error: float = math.nan
+    details: dict = field(default_factory=dict)
+    error: str | None = None
+
+    def as_dict(self) -> dict:
+        return {"engine": self.engine, "method": self.method, "setting": self.setting, "time_s": self.time_s,
+                "time_min": self.time_min, "time_max": self.time_max, "state_error": self.state_error,
+                "physics_error": self.physics_error, "details": self.details, "error": self.error}
+
+
+def timed(fn: Callable[[], Any], repeats: int) -> tuple[Any, float, float, float]:
+    times, res = [], None
+    for _ in range(max(1, repeats)):
+        t0 = time.perf_counter()
+        res = fn()
+        times.append(time.perf_counter() - t0)
+    return res, float(np.median(times)), float(min(times)), float(max(times))
+
+
+def _rel(a: float, b: float, floor: float = 1e-300) -> float:
+    return abs(a - b) / max(abs(b), floor)
+
+
+@dataclass
+class Setting:
+    engine: str
+    method: str
+    setting: Any
+    run: Callable[[], Any]
+
+
+class Study:
+    """One scene family's study: settings, the reference, and the two error measures."""
+
+    state_doc = ""
+    physics_doc = ""
+
+    def __init__(self, scene: Scene, quick: bool = False):
+        self.scene = scene
+        self.quick = quick
+
+    def settings(self) -> list[Setting]:
+        raise NotImplementedError
+
+    def reference(self) -> tuple[Any, dict]:
+        raise NotImplementedError
+
+    def state_error(self, res: Any, ref: Any) -> float:
+        raise NotImplementedError
+
+    def physics_error(self, res: Any, ref: Any) -> tuple[float, dict]:
+        raise NotImplementedError
+
+
+# ================================================================================================ pantograph
+class PantographStudy(Study):
+    SIGNALS = ("F1", "F2", "HD", "y_d")
+    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4", "discrete")
+    MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5)
+    SCIPY = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "RK45": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8, 1e-10),
+             "LSODA": (1e-4, 1e-6, 1e-8, 1e-10), "BDF": (1e-4, 1e-6, 1e-8)}
+    state_doc = "max_t |F1, F2, HD, y_d - ref| / A (A = input amplitude), t >= t_settle, 1 ms grid"
+    physics_doc = ("max(rel. amplitude error F1, HD; phase error F1, HD in rad at the forcing frequency; rel. error of "
+                   "contact-force mean and std)")
+
+    def __init__(self, scene: Scene, quick: bool = False, frequency: float | None = None, duration: float = 3.0):
+        super().__init__(scene, quick)
+        inp = dict(scene.input)
+        if inp.get("type", "sine") != "sine":
+            raise SceneError("the pantograph work-precision study needs a sine input")
+        self.f = float(frequency or inp.get("frequency", 4.25))
+        T = 1.0 if quick else duration
+        self.ts = T / 2
+        self.base = scene.replace(effects={"coulomb": False}, input={"frequency": self.f},
+                                  outputs=[*self.SIGNALS, "y_w", "contact_force"],
+                                  solver={"duration": T, "t_settle": self.ts, "sample_dt": 1e-3,
+                                          "max_step": 1.0 / (16 * self.f)})
+        self.A = float(self.base.input.get("amplitude", 1.85e-3))
+
+    def _run(self, **solver):
+        from .. import run
+
+        sc = self.base.replace(solver=solver)
+        return lambda: run(sc)
+
+    def settings(self) -> list[Setting]:
+        out = []
+        integ = ("implicitfast", "rk4") if self.quick else self.MJ_INTEGRATORS
+        steps = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
+        for i in integ:
+            for h in steps:
+                out.append(Setting("mujoco", i, h, self._run(engine="mujoco", integrator=i, timestep=h)))
+        meth = {"DOP853": (1e-4, 1e-6)} if self.quick else self.SCIPY
+        for mth, rtols in meth.items():
+            for r in rtols:
+                out.append(Setting("reference", mth, r, self._run(engine="reference", method=mth, rtol=r,
+                                                                   atol=r * 1e-2)))
+        return out
+
+    def reference(self):
+        from .. import run
+
+        ref = run(self.base.replace(solver={"engine": "reference", "method": "Radau", "rtol": 1e-12, "atol": 1e-14}))
+        chk = run(self.base.replace(solver={"engine": "reference", "method": "DOP853", "rtol": 1e-12, "atol": 1e-14}))
+        err, det = self.physics_error(chk, ref)
+        return ref, {"reference": "scipy Radau rtol 1e-12, atol 1e-14",
+                     "check": "scipy DOP853 rtol 1e-12", "check_state_error": self.state_error(chk, ref),
+                     "check_physics_error": err}
+
+    def state_error(self, res, ref) -> float:
+        m = ref.t >= self.ts
+        grid = ref.t[m]
+        return max(float(np.max(np.abs(np.interp(grid, res.t, res[s]) - ref[s][m]))) / self.A for s in self.SIGNALS)
+
+    def physics_error(self, res, ref):
+        from .harmonic import fundamental
+
+        det = {}
+        for s in ("F1", "HD"):
+            a, b = fundamental(res.t, res[s], self.f, self.ts), fundamental(ref.t, ref[s], self.f, self.ts)
+            det[f"{s}_amp_rel"] = abs(abs(a) / abs(b) - 1.0)
+            det[f"{s}_phase_rad"] = abs(float(np.angle(a / b)))
+        fr, fc = ref["contact_force"][ref.t >= self.ts], res["contact_force"][res.t >= self.ts]
+        sd = float(np.std(fr)) or 1.0
+        det["Fc_mean_rel"] = abs(float(np.mean(fc)) - float(np.mean(fr))) / abs(float(np.mean(fr)))
+        det["Fc_std_rel"] = abs(float(np.std(fc)) - sd) / sd
+        return max(det.values()), det
+
+
+# ================================================================================================ coupler
+class CouplerStudy(Study):
+    FPP_TOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-13)
+    FPP_STEPS = (19, 37, 73, 181)
+    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
+    MJ_STEPS = (1e-3, 5e-4, 2.5e-4)
+    state_doc = ("FPP: max |u - u_ref| over the 8 unknowns (rad, R); MuJoCo: max(|phi_c - ref| / 1 rad, |omega_c - "
+                 "ref| / omega, |torque_in - ref| / T_load)")
+    physics_doc = ("FPP: max(|phi_c - ref| rad, |c5 - c5_ref| rad, max closure residual / R^2); MuJoCo: max rel. error "
+                   "of settled (phi_c - phi_c,kin) max, closure residual max, input-torque ripple")
+
+    def __init__(self, scene: Scene, quick: bool = False):
+        super().__init__(scene, quick)
+        from ..models.coupler.mujoco import _inputs
+
+        self.p = scene.build_params()
+        self.inp = _inputs(scene)
+        T = 0.5 if quick else 1.0
+        self.base = scene.replace(solver={"duration": T, "t_settle": 0.3 if quick else 0.5, "sample_dt": 2e-3},
+                                  outputs=["phi_a", "phi_c", "phi_c_kin", "phi_c_err", "omega_c", "torque_in",
+                                           "closure_residual"])
+        self.rest = np.array([self.inp["alpha_cx"], self.inp["alpha_cz"], self.inp["x_c"], self.inp["z_c"]])
+
+    # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
+    def fpp(self, tol: float, n: int) -> np.ndarray:
+        from ..models.coupler import reference as ref
+
+        phis = np.linspace(0.0, 2 * math.pi, n)
+        u = ref._ramp_double(self.p, np.r_[0.0, self.rest])
+        out = [u]
+        du = np.zeros_like(u)
+        for ph in phis[1:]:
+            g = u + du
+            u_new = ref.solve_double(self.p, np.r_[ph, self.rest], g, tol=tol)
+            du = u_new - u
+            u = u_new
+            out.append(u)
+        return np.array(out)
+
+    def fpp_reference(self, n: int) -> np.ndarray:
+        from scipy.optimize import least_squares
+
+        from ..models.coupler import reference as ref
+
+        u = self.fpp(1e-13, n)
+        out = []
+        for ph, g in zip(np.linspace(0.0, 2 * math.pi, n), u, strict=True):
+            x = np.r_[ph, self.rest]
+            sol = least_squares(lambda v, x=x: ref.double_residual(self.p, x, v), g,
+                                jac=lambda v, x=x: ref.double_residual_jac(self.p, x, v), method="trf",
+                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            out.append(sol.x)
+        return np.array(out)
+
+    def settings(self) -> list[Setting]:
+        from .. import run
+
+        out = []
+        tols = (1e-4, 1e-8) if self.quick else self.FPP_TOLS
+        steps = (19, 37) if self.quick else self.FPP_STEPS
+        for tol in tols:
+            for n in steps:
+                out.append(Setting("fpp", "gauss-newton", f"tol {tol:g}, {n} steps",
+                                   lambda tol=tol, n=n: ("fpp", n, self.fpp(tol, n))))
+        integ = ("implicitfast",) if self.quick else self.MJ_INTEGRATORS
+        hs = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
+        for i in integ:
+            for h in hs:
+                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
+                out.append(Setting("mujoco", i, h, lambda sc=sc: ("mujoco", 0, run(sc))))
+        return out
+
+    def reference(self):
+        from .. import run
+
+        self._fpp_ref = {n: self.fpp_reference(n) for n in ((19, 37) if self.quick else self.FPP_STEPS)}
+        mj_ref = run(self.base.replace(solver={"engine": "mujoco", "integrator": "rk4", "timestep": 1e-4}))
+        return {"mujoco": mj_ref}, {"reference": "FPP: scipy least_squares (trf) xtol=ftol=gtol=1e-15; "
+                                                 "MuJoCo: rk4 at 1e-4 s (same soft-closure model)"}
+
+    def _c5(self, u: np.ndarray, n: int) -> float:
+        phis = np.linspace(0.0, 2 * math.pi, n)
+        d = phis - u[:, 0]
+        return float(np.max(np.abs(d - d.mean())))
+
+    def state_error(self, res, ref) -> float:
+        kind, n, r = res
+        if kind == "fpp":
+            return float(np.max(np.abs(r - self._fpp_ref[n])))
+        rr = ref["mujoco"]
+        om, tl = self.inp["omega"], self.inp["load_torque"]
+        m = rr.t >= self.base.solver.t_settle  # the start-up ramp of the stiff servo is not compared
+
+        def err(sig: str) -> float:
+            return float(np.max(np.abs(np.interp(rr.t[m], r.t, r[sig]) - rr[sig][m])))
+
+        return max(err("phi_c"), err("omega_c") / om, err("torque_in") / tl)
+
+    def physics_error(self, res, ref):
+        from ..models.coupler import reference as cref
+
+        kind, n, r = res
+        if kind == "fpp":
+            uref = self._fpp_ref[n]
+            phis = np.linspace(0.0, 2 * math.pi, n)
+            resid = max(float(np.max(np.abs(cref.double_residual(self.p, np.r_[ph, self.rest], u))))
+                        for ph, u in zip(phis, r, strict=True)) / self.p.R**2
+            det = {"phi_c_err_rad": float(np.max(np.abs(r[:, 0] - uref[:, 0]))),
+                   "c5_err_rad": abs(self._c5(r, n) - self._c5(uref, n)), "closure_residual": resid}
+            return max(det.values()), det
+        sr, sf = r.stats, ref["mujoco"].stats
+        det = {"phi_c_err_rel": _rel(sr["phi_c_err_max"], sf["phi_c_err_max"]),
+               "closure_rel": _rel(sr["closure_residual_max"], sf["closure_residual_max"]),
+               "ripple_rel": _rel(sr["torque_in_ripple_pp"], sf["torque_in_ripple_pp"])}
+        return max(det.values()), det
+
+
+# ================================================================================================ drives
+class DrivesStudy(Study):
+    HAND_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+    MJ_INTEGRATORS = ("rk4", "euler")
+    MJ_STEPS = (1e-4, 5e-5, 2e-5)
+    state_doc = "max_t |w_i - w_i,ref| / max_t,i |w_ref| over the rotor speeds, on the output grid"
+    physics_doc = ("max(rel. error of cycle-mean load speed and of efficiency E_out/E_in over [t_settle, T]; max "
+                   "lock-up time error / energy-cycle period (CoupledClutches: / 0.1 s))")
+
+    def __init__(self, scene: Scene, quick: bool = False, duration: float | None = None):
+        super().__init__(scene, quick)
+        cc = scene.effects["mechanism"] == "coupled_clutches"
+        self.cc = cc
+        T = min(scene.solver.duration, duration or (1.0 if quick else 2.0))
+        ts = 0.0 if cc else T / 2
+        self.speeds = ["w1", "w2", "w3", "w4"] if cc else ["w_motor", "w_spring", "w_load"]
+        self.base = scene.replace(solver={"duration": T, "t_settle": ts}, outputs=[*self.speeds, "E_in", "E_out"])
+        self.ts = ts
+
+    def settings(self) -> list[Setting]:
+        from .. import run
+
+        out = []
+        for r in ((1e-6,) if self.quick else self.HAND_RTOLS):
+            sc = self.base.replace(solver={"engine": "reference", "rtol": r, "atol": r * 1e-2})
+            out.append(Setting("reference", "event-exact DOP853", r, lambda sc=sc: run(sc)))
+        integ = ("rk4",) if self.quick else self.MJ_INTEGRATORS
+        for i in integ:
+            for h in ((1e-4,) if self.quick else self.MJ_STEPS):
+                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
+                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
+        return out
+
+    def reference(self):
+        from .. import run
+
+        ref = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-12, "atol": 1e-14}))
+        chk = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-11, "atol": 1e-13}))
+        err, _ = self.physics_error(chk, ref)
+        return ref, {"reference": "hand path (event-exact DOP853) rtol 1e-12, atol 1e-14",
+                     "check": "hand path rtol 1e-11", "check_state_error": self.state_error(chk, ref),
+                     "check_physics_error": err}
+
+    def state_error(self, res, ref) -> float:
+        scale = max(float(np.max(np.abs(ref[s]))) for s in self.speeds) or 1.0
+        return max(float(np.max(np.abs(np.interp(ref.t, res.t, res[s]) - ref[s]))) for s in self.speeds) / scale
+
+    def _locks(self, res) -> list[tuple[str, float]]:
+        return [(e.get("element", "?"), float(e["t"])) for e in res.events
+                if e.get("to") == "stuck" and e.get("t") is not None and e["t"] >= self.ts]
+
+    def physics_error(self, res, ref):
+        det = {}
+        period = 0.1
+        if not self.cc:
+            cr, cf = res.stats.get("cycles", {}), ref.stats.get("cycles", {})
+            if abs(cf.get("mean_load_speed", 0.0)) > 0:
+                det["load_speed_rel"] = _rel(cr.get("mean_load_speed", math.nan), cf["mean_load_speed"])
+            if cf.get("switching_rate"):
+                period = 1.0 / cf["switching_rate"]
+
+            def eff(r):
+                m = r.t >= self.ts
+                ein = r["E_in"][m][-1] - r["E_in"][m][0]
+                return (r["E_out"][m][-1] - r["E_out"][m][0]) / ein if ein else math.nan
+
+            det["efficiency_rel"] = _rel(eff(res), eff(ref))
+        lr, lf = self._locks(res), self._locks(ref)
+        by_el: dict[str, tuple[list, list]] = {}
+        for el, t in lf:
+            by_el.setdefault(el, ([], []))[1].append(t)
+        for el, t in lr:
+            by_el.setdefault(el, ([], []))[0].append(t)
+        errs = []
+        for a, b in by_el.values():
+            k = min(len(a), len(b))
+            errs += [abs(x - y) for x, y in zip(a[:k], b[:k], strict=True)]
+            if len(a) != len(b):
+                errs.append(period)  # a missing or extra lock-up counts as a whole period
+        if lf:
+            det["lock_time_rel"] = (max(errs) if errs else 0.0) / period
+        det["n_locks_ref"] = len(lf)
+        vals = [v for k, v in det.items() if k != "n_locks_ref"]
+        # nothing to compare (no lock-up and no load speed in the window) is no accuracy: NaN, not 0
+        return (max(vals) if vals else math.nan), det
+
+
+# ================================================================================================ iftomm
+class FourbarStudy(Study):
+    MJ_INTEGRATORS = ("euler", "implicitfast", "rk4")
+    MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4)
+    PIN = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "LSODA": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8)}
+    state_doc = "max_t |crank angle - ref| / 1 rad, 10 s through 24 singular positions"
+    physics_doc = ("max(rel. error of the crank's turns in 10 s, max closure residual / L, |energy drift| / E_kin(0), "
+                   "max |coupler angle| (branch))")
+
+    def __init__(self, scene: Scene, quick: bool = False):
+        super().__init__(scene, quick)
+        if scene.effects["mechanism"] != "fourbar":
+            raise MbsuiteError("the IFToMM work-precision study covers the four-bar (closed-form reference); the "
+                               "Bricard has none (its hard case compares MuJoCo with Pinocchio)")
+        T = 2.0 if quick else 10.0
+        self.base = scene.replace(solver={"duration": T, "sample_dt": 1e-2})
+        self.rate = float(scene.input.get("rate", 6.0))
+        self.g = float(scene.build_params().gravity)
+
+    def settings(self) -> list[Setting]:
+        from .. import run
+
+        out = []
+        for i in (("rk4",) if self.quick else self.MJ_INTEGRATORS):
+            for h in ((1e-3,) if self.quick else self.MJ_STEPS):
+                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
+                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
+        for mth, rtols in ({"DOP853": (1e-6,)} if self.quick else self.PIN).items():
+            for r in rtols:
+                sc = self.base.replace(solver={"engine": "reference", "method": mth, "rtol": r, "atol": r * 1e-2})
+                out.append(Setting("pinocchio", mth, r, lambda sc=sc: run(sc)))
+        return out
+
+    def reference(self):
+        from scipy.integrate import solve_ivp
+
+        t = np.arange(0.0, self.base.solver.duration + 5e-3, 1e-2)
+        g = self.g
+        sol = solve_ivp(lambda _, x: [x[1], -1.2 * g * math.cos(x[0])], (0.0, t[-1]), [math.pi / 2, self.rate],
+                        method="DOP853", rtol=1e-13, atol=1e-13, t_eval=t)
+        self.e_kin0 = 0.5 * (5.0 / 3.0) * self.rate**2
+        return {"t": sol.t, "angle": sol.y[0] - math.pi / 2}, {
+            "reference": "closed form on the parallelogram branch, psi'' = -(6/5) g cos(psi), DOP853 rtol 1e-13"}
+
+    def state_error(self, res, ref) -> float:
+        return float(np.max(np.abs(np.interp(ref["t"], res.t, res["input_angle"]) - ref["angle"])))
+
+    def physics_error(self, res, ref):
+        turns = (res["input_angle"][-1] - res["input_angle"][0]) / (2 * math.pi)
+        turns_ref = (ref["angle"][-1] - ref["angle"][0]) / (2 * math.pi)
+        det = {"turns_rel": _rel(turns, turns_ref), "closure_residual": res.stats["closure_residual_max"],
+               "energy_drift_rel": res.stats["energy_drift_max"] / self.e_kin0,
+               "branch_rad": res.stats["branch_angle_max"]}
+        return max(det.values()), det
+
+
+STUDIES: dict[str, type[Study]] = {"pantograph": PantographStudy, "coupler": CouplerStudy, "drives": DrivesStudy,
+                                   "iftomm": FourbarStudy}
+
+
+def study_for(scene: Scene, quick: bool = False) -> Study:
+    if scene.model not in STUDIES:
+        raise MbsuiteError(f"no work-precision study for model '{scene.model}'; available: {sorted(STUDIES)}")
+    return STUDIES[scene.model](scene, quick=quick)
+
+
+def cheapest(rows: list[Row], tols=TOLS) -> list[dict]:
+    """Per engine/method and overall: the cheapest (median wall time) setting reaching each physics tolerance."""
+    ok = [r for r in rows if r.error is None and math.isfinite(r.physics_error)]
+    out = []
+    for tol in tols:
+        keys = sorted({(r.engine, r.method) for r in ok}) + [("any", "any")]
+        for key in keys:
+            cand = [r for r in ok if (key == ("any", "any") or (r.engine, r.method) == key) and r.physics_error <= tol]
+            best = min(cand, key=lambda r: r.time_s) if cand else None
+            out.append({"tol": tol, "engine": key[0], "method": key[1], "setting": best.setting if best else None,
+                        "time_s": best.time_s if best else None,
+                        "physics_error": best.physics_error if best else None,
+                        "best_engine": f"{best.engine} {best.method}" if best else None})
+    return out
+
+
+def workprecision(scene: Scene, repeats: int = 5, quick: bool = False, progress: Callable[[str], None] | None = None
+                  ) -> Report:
+    """Run the scene's study (module docstring) and return a Report (table, data, CSV/JSON/PNG writer)."""
+    study = study_for(scene, quick)
+    ref, ref_info = study.reference()
+    rows: list[Row] = []
+    for s in study.settings():
+        row = Row(s.engine, s.method, s.setting)
+        try:
+            res, row.time_s, row.time_min, row.time_max = timed(s.run, repeats)
+            row.state_error = study.state_error(res, ref)
+            row.physics_error, row.details = study.physics_error(res, ref)
+        except MbsuiteError as exc:  # a diverging setting is a data point, not a crash
+            row.error = str(exc)
+        rows.append(row)
+        if progress:
+            progress(f"{row.engine} {row.method} {row.setting}: {row.time_s:.3g} s, physics {row.physics_error:.2e}")
+    best = cheapest(rows)
+    data = {"scene": scene.name or scene.model, "model": scene.model, "repeats": repeats, "quick": quick,
+            "state_error": study.state_doc, "physics_error": study.physics_doc, **ref_info,
+            "rows": [r.as_dict() for r in rows], "cheapest": best}
+    return Report(data, _table(rows, best, study, ref_info), lambda out: _write(out, rows, best, scene, study))
+
+
+def _fmt_setting(s: Any) -> str:
+    return f"{s:g}" if isinstance(s, float) else str(s)
+
+
+def _table(rows: list[Row], best: list[dict], study: Study, ref_info: dict) -> str:
+    body = [[r.engine, r.method, _fmt_setting(r.setting), r.time_s, r.time_min, r.time_max, r.state_error,
+             r.physics_error] if r.error is None else
+            [r.engine, r.method, _fmt_setting(r.setting), "diverged", "", "", "", ""] for r in rows]
+    lines = [f"reference: {ref_info.get('reference')}"]
+    if "check_physics_error" in ref_info:
+        lines.append(f"  its accuracy ({ref_info['check']}): state {ref_info['check_state_error']:.2e}, "
+                     f"physics {ref_info['check_physics_error']:.2e}")
+    lines += [f"state error: {study.state_doc}", f"physics error: {study.physics_doc}", ""]
+    lines.append(format_table(["engine", "method", "h / rtol / setting", "median s", "min s", "max s", "state err",
+                               "physics err"], body, ".3g"))
+    lines += ["", "cheapest setting reaching a relative physics error:"]
+    lines.append(format_table(["tol", "engine", "method", "setting", "median s", "physics err"],
+                              [[f"{b['tol']:g}", b["engine"], b["method"],
+                                _fmt_setting(b["setting"]) if b["setting"] is not None else "-",
+                                b["time_s"] if b["time_s"] is not None else "-",
+                                b["physics_error"] if b["physics_error"] is not None else "-"] for b in best], ".3g"))
+    return "\n".join(lines)
+
+
+def _write(out: Path, rows: list[Row], best: list[dict], scene: Scene, study: Study) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    ok = [r for r in rows if r.error is None]
+    files = [write_csv(out / "workprecision.csv", [
+        ("engine", "", [r.engine for r in ok]), ("method", "", [r.method for r in ok]),
+        ("setting", "s, rtol or tol/steps", [_fmt_setting(r.setting) for r in ok]),
+        ("time_median", "s", [r.time_s for r in ok]), ("time_min", "s", [r.time_min for r in ok]),
+        ("time_max", "s", [r.time_max for r in ok]), ("state_error", "-", [r.state_error for r in ok]),
+        ("physics_error", "-", [r.physics_error for r in ok])])]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
+    for key in sorted({(r.engine, r.method) for r in ok}):
+        rr = sorted([r for r in ok if (r.engine, r.method) == key], key=lambda r: r.time_s)
+        for ax, attr in zip(axes, ("state_error", "physics_error"), strict=True):
+            y = np.array([max(getattr(r, attr), 1e-17) for r in rr])
+            ax.errorbar([r.time_s for r in rr], y,
+                        xerr=[[r.time_s - r.time_min for r in rr], [r.time_max - r.time_s for r in rr]],
+                        marker="o" if key[0] == "mujoco" else "s", ls="-" if key[0] == "mujoco" else "--",
+                        label=f"{key[0]} {key[1]}", ms=4)
+    for ax, title in zip(axes, (f"state error: {study.state_doc}", f"physics: {study.physics_doc}"), strict=True):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("wall time (s), median; bars min-max")
+        ax.set_title(title, fontsize=7, wrap=True)
+        ax.grid(True, which="both", alpha=0.3)
+        for tol in TOLS:
+            ax.axhline(tol, color="grey", lw=0.6, ls=":")
+    axes[0].set_ylabel("error")
+    axes[1].legend(fontsize=7, ncol=2)
+    fig.suptitle(f"work-precision: {scene.model}/{scene.name}")
+    fig.tight_layout()
+    p = out / "workprecision.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    files.append(p)
+    return files

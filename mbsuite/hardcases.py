@@ -1,0 +1,690 @@
+"""The hard-case registry: situations that break naive multibody codes, each with the scene that provokes it and what
+must hold (no NaN/inf, bounded work in steps or RHS calls, bounded closure residual, bounded energy drift, correct
+detection and reporting).
+
+Every entry calls the models' own machinery (scenes through `mbsuite.run`, or the model modules' public functions);
+nothing here re-implements physics. `mbsuite hardcases` lists the registry; `mbsuite hardcases --run` runs it and
+prints what was measured against each bound; `tests/suite/test_hardcases.py` runs every entry (entries marked slow
+only under `pytest -m slow`). Bounds are stated with the numbers measured when they were set (README-style comments).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .errors import GeometryError, MbsuiteError, ParameterError, SceneError, SolverError
+
+
+@dataclass
+class Check:
+    what: str
+    ok: bool
+    value: Any = None
+    bound: Any = None
+
+    def line(self) -> str:
+        v = "" if self.value is None else f" = {_fmt(self.value)}"
+        b = "" if self.bound is None else f" (bound {_fmt(self.bound)})"
+        return f"[{'ok' if self.ok else 'FAIL'}] {self.what}{v}{b}"
+
+
+def _fmt(x: Any) -> str:
+    if isinstance(x, float | np.floating):
+        return f"{float(x):.4g}"
+    return str(x)
+
+
+class Checker:
+    """Collects the assertions of one hard case (all are evaluated; the case fails if any fails)."""
+
+    def __init__(self) -> None:
+        self.checks: list[Check] = []
+        self.measured: dict[str, Any] = {}
+
+    def le(self, what: str, value: float, bound: float) -> None:
+        value = float(value)
+        self.checks.append(Check(what, bool(math.isfinite(value) and value <= bound), value, f"<= {bound:g}"))
+
+    def ge(self, what: str, value: float, bound: float) -> None:
+        value = float(value)
+        self.checks.append(Check(what, bool(math.isfinite(value) and value >= bound), value, f">= {bound:g}"))
+
+    def true(self, what: str, cond: bool, value: Any = None) -> None:
+        self.checks.append(Check(what, bool(cond), value))
+
+    def finite(self, what: str, *arrays: Any) -> None:
+        ok = all(np.all(np.isfinite(np.asarray(a, float))) for a in arrays)
+        self.checks.append(Check(f"{what}: no NaN/inf", ok))
+
+    def raises(self, what: str, fn: Callable[[], Any], exc: type[BaseException] | tuple, match: str) -> None:
+        try:
+            fn()
+        except exc as e:  # noqa: B030 - exc is a class or tuple of classes
+            self.checks.append(Check(what, match.lower() in str(e).lower(), f"{type(e).__name__}: {str(e)[:90]}"))
+            return
+        except Exception as e:  # noqa: BLE001 - a different error is a failed check, reported
+            self.checks.append(Check(what, False, f"unexpected {type(e).__name__}: {str(e)[:90]}"))
+            return
+        self.checks.append(Check(what, False, "no error raised"))
+
+
+@dataclass(frozen=True)
+class HardCase:
+    name: str
+    model: str
+    hard: str  # what makes it hard
+    scene: str  # the scene (or machinery) that provokes it
+    asserts: str  # what is asserted, in words
+    check: Callable[[Checker], None] = field(repr=False, compare=False)
+    slow: bool = False
+    known: str = ""  # a limitation found by this case and left to the model's owner
+    expected_failure: str = ""  # non-empty: the case fails today for this reason (tests: strict xfail)
+
+
+@dataclass
+class Outcome:
+    case: HardCase
+    checks: list[Check]
+    measured: dict[str, Any]
+    error: str | None = None
+
+    @property
+    def passed(self) -> bool:
+        return self.error is None and bool(self.checks) and all(c.ok for c in self.checks)
+
+    def text(self) -> str:
+        lines = [f"{self.case.name}: {'PASS' if self.passed else 'FAIL'}"]
+        if self.error:
+            lines.append(f"  error: {self.error}")
+        lines += ["  " + c.line() for c in self.checks]
+        return "\n".join(lines)
+
+
+def run_case(case: HardCase) -> Outcome:
+    ck = Checker()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            case.check(ck)
+    except Exception as e:  # noqa: BLE001 - an unexpected error is a failed hard case, reported with its message
+        return Outcome(case, ck.checks, ck.measured, f"{type(e).__name__}: {e}")
+    return Outcome(case, ck.checks, ck.measured)
+
+
+# ================================================================================================ pantograph
+def _pantograph_stick_slip(ck: Checker) -> None:
+    from . import load_scene, run
+    from .analysis.harmonic import fundamental
+
+    sc = load_scene("pantograph").replace(input={"frequency": 2.0}, solver={"duration": 4.0, "t_settle": 2.0})
+    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
+    mj = run(sc)
+    sticks = sum(1 for e in ref.events if e["kind"] == "stick")
+    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
+    ck.ge("stick events in 4 s (the head joint sticks twice per cycle)", sticks, 8)
+    ck.le("reference RHS calls (no stall at the sign change)", ref.stats["nfev"], 50_000)
+    ck.le("reference smooth segments", ref.stats["segments"], 500)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+    a, b = fundamental(mj.t, mj["F1"], 2.0, 2.0), fundamental(ref.t, ref["F1"], 2.0, 2.0)
+    ck.le("|F1| MuJoCo frictionloss vs event-exact reference, relative", abs(abs(a) / abs(b) - 1), 0.02)
+
+
+def _pantograph_orifice_dp0(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("pantograph/nonlinear_cylinder").replace(solver={"duration": 2.0, "t_settle": 1.0})
+    ref = run(sc.replace(solver={"engine": "reference"}))
+    mj = run(sc)
+    P = ref["cylinder_state"] if "cylinder_state" in ref.signals else None
+    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
+    ck.le("reference RHS calls starting at P = Ps (dp = 0)", ref.stats["nfev"], 50_000)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+    if P is not None:
+        ck.true("cylinder pressure stays positive", bool(np.min(P) > 0), float(np.min(P)))
+
+
+def _pantograph_orifice_choked(ck: Checker) -> None:
+    from .models.pantograph.reference import PantographODE
+
+    ode = PantographODE(cylinder="nonlinear")
+    p = ode.p
+    flows = np.array([ode.orifice_mass_flow(r * p.Ps) for r in np.linspace(0.05, 1.5, 2901)])
+    ck.finite("orifice flow over 0.05-1.5 Ps", flows)
+    ck.true("inflow below Ps, outflow above, zero at Ps",
+            ode.orifice_mass_flow(0.9 * p.Ps) > 0 > ode.orifice_mass_flow(1.1 * p.Ps)
+            and ode.orifice_mass_flow(p.Ps) == 0.0)
+    choked = [ode.orifice_mass_flow(r * p.Ps) for r in (0.1, 0.3, 0.5)]
+    ck.le("choked plateau: flow independent of Pd/Pu < 0.528 (relative spread)", np.ptp(choked) / choked[0], 1e-12)
+    r = 0.528
+    ck.le("continuity at the choke ratio 0.528 (relative jump)",
+          abs(ode.orifice_mass_flow(r * p.Ps * (1 - 1e-9)) / ode.orifice_mass_flow(r * p.Ps * (1 + 1e-9)) - 1),
+          1e-6)
+    edge = p.r_laminar * p.Ps
+    ck.le("continuity at the laminar band edge (relative jump)",
+          abs(ode.orifice_mass_flow(edge * (1 - 1e-12)) / ode.orifice_mass_flow(edge * (1 + 1e-12)) - 1), 1e-6)
+    slope = np.diff(flows) / np.diff(np.linspace(0.05, 1.5, 2901) * p.Ps)
+    ck.finite("finite slope d(mdot)/dP everywhere (Lipschitz RHS near dp = 0)", slope)
+
+
+def _pantograph_unilateral(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("pantograph/unilateral").replace(solver={"duration": 4.0, "t_settle": 2.0})
+    mj = run(sc)
+    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
+    lm = [e for e in mj.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
+    lr = [e for e in ref.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
+    ck.finite("outputs", *mj.signals.values(), *ref.signals.values())
+    ck.ge("contact losses detected (reference, 2-4 s)", len(lr), 8)
+    ck.le("|losses MuJoCo - reference|", abs(len(lm) - len(lr)), 1)
+    ck.true("contact force never negative (push-only)", min(np.min(mj["contact_force"]),
+                                                            np.min(ref["contact_force"])) >= 0.0)
+    tot_m, tot_r = sum(e["duration"] for e in lm), sum(e["duration"] for e in lr)
+    ck.le("total loss time MuJoCo vs reference, relative", abs(tot_m / tot_r - 1) if tot_r else math.inf, 0.1)
+
+
+def _pantograph_big_step(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("pantograph").replace(solver={"timestep": 0.02, "duration": 2.0, "t_settle": 1.0})
+    for integ in ("euler", "implicitfast"):
+        ck.raises(f"{integ} at h = 0.02 s: SolverError telling to reduce the step",
+                  lambda i=integ: run(sc.replace(solver={"integrator": i})), SolverError, "reduce solver.timestep")
+    res = run(sc.replace(solver={"integrator": "rk4"}))
+    ck.finite("RK4 at h = 0.02 s", *res.signals.values())
+
+
+def _pantograph_energy_100s(ck: Checker) -> None:
+    import mujoco
+
+    from .engines.mujoco_engine import callbacks
+    from .models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
+    from .models.pantograph.mujoco import MujocoPantograph
+    from .models.pantograph.reference import PantographConfig, PantographODE
+
+    cfg = PantographConfig(cylinder="constant", viscous=False, coulomb=False)
+    ode = PantographODE(config=cfg)
+    x0 = ode.equilibrium()
+    x0[3:6] = [0.05, -0.03, 0.1]
+    y_w = 1.58
+    E0 = ode.energy(x0, y_w)
+    mp = MujocoPantograph(config=cfg, integrator="rk4", timestep=1e-3)
+    m, d = mp.model, mp.data
+    mujoco.mj_resetData(m, d)
+    d.qpos[:] = theta_to_q(x0[:3])
+    d.qvel[:] = np.linalg.solve(E_THETA_Q, x0[3:6])
+    d.ctrl[:] = y_w
+    drift = []
+    with callbacks(**mp.callback_set()):
+        mujoco.mj_forward(m, d)
+        for k in range(100_000):
+            mujoco.mj_step(m, d)
+            if k % 1000 == 999:
+                drift.append(ode.energy(np.r_[q_to_theta(d.qpos), E_THETA_Q @ d.qvel], y_w) - E0)
+    drift = np.abs(np.array(drift))
+    ck.finite("state after 100 s", d.qpos, d.qvel)
+    ck.le("energy drift over 100 s, MuJoCo RK4 1 ms, no damping (J)", drift.max(), 1e-3)
+    # RK4 is not symplectic: its energy error grows linearly (measured 1.6e-4 J at 100 s, ratio 9.4 = linear from 0);
+    # faster growth (quadratic: ratio ~100, exponential) would be an instability
+    ck.le("drift last 10 s / first 10 s (linear growth gives ~10; faster growth fails)",
+          drift[-10:].max() / (drift[:10].max() + 1e-9), 15.0)
+
+
+# ================================================================================================ coupler
+def _coupler_ey_to_zero(ck: Checker) -> None:
+    from .models.coupler import reference as ref
+    from .models.coupler.params import CouplerParams
+
+    conds = {}
+    for ey in (1e-1, 1e-2, 1e-4, 1e-6, 1e-8):
+        p = CouplerParams(e_y=ey)
+        an = ref.analyse_jacobian(ref.single_jacobian(p, ref.solve_single(p, 0.0)), np.zeros(3))
+        conds[ey] = an.cond
+        ck.le(f"cond(J) at e_y = {ey:g} vs R cos(2 gamma)/e_y, relative", abs(an.cond / (math.cos(2 * p.gamma) / ey)
+                                                                            - 1), 1e-3)
+        ck.true(f"rank 4 at e_y = {ey:g}", an.rank == 4, an.rank)
+    p0 = CouplerParams(e_y=0.0)
+    an0 = ref.analyse_jacobian(ref.single_jacobian(p0), np.zeros(3))
+    ck.true("e_y = 0: rank 3 detected, cond = inf", an0.rank == 3 and math.isinf(an0.cond), (an0.rank, an0.cond))
+    ck.true("e_y = 0: a free translation along the shaft is reported",
+            any(not math.isfinite(s.pitch) and abs(abs(s.axis[1]) - 1) < 1e-9 for s in an0.principal_screws))
+    ck.measured["cond"] = conds
+
+
+def _coupler_ey_below_alpha(ck: Checker) -> None:
+    from .models.coupler import reference as ref
+    from .models.coupler.params import CouplerParams
+
+    p = CouplerParams(e_y=0.02)
+    ck.raises("single FPP with e_y = 0.02 < R alpha = 0.07", lambda: ref._ramp_single(p, 0.0, 0.07, 0.0),
+              GeometryError, "no physical pose")
+    ck.raises("single revolution with e_y = 0.02, alpha = 0.07", lambda: ref.single_revolution(p, 0.07, n=37),
+              GeometryError, "e_y")
+    ck.raises("e_y = 0 with any inclination", lambda: ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01),
+              GeometryError, "coplanar")
+    ok = ref.single_revolution(CouplerParams(e_y=0.1), 0.07, n=73)
+    ck.le("e_y = 0.1 > R alpha: closes after a turn |phi_b(2 pi) - phi_b(0) - 2 pi|",
+          abs(ok.u[-1, 0] - ok.u[0, 0] - 2 * math.pi), 1e-9)
+
+
+def _coupler_phibc90(ck: Checker) -> None:
+    from . import load_scene, run
+    from .models.coupler import reference as ref
+    from .models.coupler.params import CouplerParams
+
+    rev = ref.double_revolution(CouplerParams(phi_bc=math.pi / 2), z_c=0.08, n=73)
+    ck.le("FPP revolution closes: |phi_c(2 pi) - phi_c(0) - 2 pi|", abs(rev.u[-1, 0] - rev.u[0, 0] - 2 * math.pi),
+          1e-9)
+    res = run(load_scene("coupler/double_phibc90").replace(solver={"duration": 1.0}))
+    ck.finite("MuJoCo outputs", *res.signals.values())
+    ck.true("MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
+    # README: settled residual 2.77e-5 m (2 s); the start-up ramp peak is excluded by t_settle
+    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-4)
+    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-3)
+
+
+def _coupler_big_step(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("coupler/double_lateral").replace(solver={"duration": 0.5, "t_settle": 0.3, "sample_dt": 0.0})
+    for h in (5e-3, 2e-2):
+        try:
+            res = run(sc.replace(solver={"timestep": h}))
+        except SolverError as e:
+            ck.true(f"h = {h:g} s: a clear SolverError", "timestep" in str(e), str(e)[:80])
+            continue
+        # not an error: the result is finite and its degraded closure is reported in the stats (measured 1.3e-2 m at
+        # 5 ms vs 3.8e-5 m at the default 0.5 ms: MuJoCo silently stiffens solref to 2 h; see `known`)
+        ck.finite(f"h = {h:g} s outputs", *res.signals.values())
+        ck.true(f"h = {h:g} s: closure residual reported in the stats", "closure_residual_max" in res.stats,
+                res.stats.get("closure_residual_max"))
+        ck.le(f"h = {h:g} s: closure residual (m) bounded", res.stats["closure_residual_max"], 0.05)
+
+
+def _coupler_rk4_limit(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("coupler/double_lateral").replace(solver={"integrator": "rk4", "timestep": 1e-3, "duration": 1.0})
+    try:
+        res = run(sc)
+    except SolverError as e:
+        ck.true("RK4 at h = solref/2: a clear SolverError", "timestep" in str(e), str(e)[:80])
+        return
+    ck.finite("outputs", *res.signals.values())
+    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-3)
+    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-2)
+    # power balance: the mean input torque equals the 1 kN m load (README: 1000.01 N m), ripple ~7 N m p-p
+    ck.le("|mean input torque / load - 1|", abs(res.stats["torque_in_mean"] / 1000.0 - 1), 0.01)
+    ck.le("input-torque ripple p-p (N m)", res.stats["torque_in_ripple_pp"], 100.0)
+
+
+def _coupler_drift_100s(ck: Checker) -> None:
+    from . import load_scene, run
+
+    res = run(load_scene("coupler/double_lateral").replace(solver={"duration": 100.0, "sample_dt": 0.01}))
+    r, t = res["closure_residual"], res.t
+    ck.finite("100 s outputs", *res.signals.values())
+    ck.le("closure residual over 100 s after the ramp (m)", np.max(r[t >= 0.5]), 1e-4)
+    ck.le("residual last 10 s / residual 0.5-10.5 s (no drift)",
+          np.max(r[t >= 90]) / np.max(r[(t >= 0.5) & (t < 10.5)]), 1.5)
+    ck.le("phi_c - phi_c,kin over 100 s (rad)", np.max(np.abs(res["phi_c_err"][t >= 0.5])), 1e-3)
+
+
+# ================================================================================================ drives
+def _drives_coupled_clutches(ck: Checker) -> None:
+    from .models.drives import coupled_clutches as cc
+    from .models.drives.friction import simulate_reference
+    from .models.drives.mujoco_path import MujocoRotorSim
+    from .paths import mjcf_path
+
+    rev = cc.reference_events(cc.load_reference())
+    hand = simulate_reference(cc.build_system(), cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
+    mj = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=1e-4).run(
+        cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
+    for name, res, tol in (("hand path", hand, 1e-5), ("MuJoCo", mj, 2e-4)):
+        rows = cc.match_events(cc.events_as_codes(res.events), rev)
+        same = all(r["t"] is not None and r["t_ref"] is not None for r in rows)
+        ck.true(f"{name}: same clutch mode sequence as Dymola (lock/unlock x {len(rows)})", same)
+        dts = [abs(r["t"] - r["t_ref"]) for r in rows if r["t"] is not None and r["t_ref"] is not None]
+        ck.le(f"{name}: max |event time - Dymola| (s)", max(dts) if dts else math.inf, tol)
+        ck.finite(f"{name} speeds", res.w)
+    ck.le("hand path RHS calls", hand.stats.get("nfev", 0), 50_000)
+
+
+def _rotors(frictions, J, springs=(), sources=(), breaks=()):
+    from .models.drives.friction import RotorSystem
+
+    return RotorSystem(names=["motor", "spring", "load"], J=np.asarray(J, float), B=np.zeros(3),
+                       frictions=list(frictions), springs=list(springs), sources=list(sources), breaks=list(breaks))
+
+
+def _drives_load_reversal(ck: Checker) -> None:
+    from .models.drives.friction import Friction, Part, Spring, simulate_reference
+    from .models.drives.mujoco_path import MujocoRotorSim
+    from .paths import mjcf_path
+
+    sys_ = _rotors([Friction("load_ground", 2, -1, [Part("load", 0.05, output=True)])], [1.0, 1.0, 1e-3],
+                   springs=[Spring("k", 2, -1, 1.0)])
+    res = simulate_reference(sys_, [0, 0, 1.0], [0, 0, 0], 2.0, sample_dt=1e-3)
+    kinds = [(e["from"], e["to"]) for e in res.events]
+    n_rev = sum(1 for k in kinds if "stuck" not in k)
+    ck.true("hand path: ends stuck", bool(kinds) and kinds[-1][1] == "stuck")
+    ck.true("hand path: 9 reversals (amplitude 1.0 -> C/K in steps of 2C/K), no chatter", n_rev == 9, n_rev)
+    ck.le("hand path RHS calls", res.stats["nfev"], 20_000)
+    mj = MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-4).run([0, 0, 1.0], [0, 0, 0], 2.0,
+                                                                                  sample_dt=1e-3)
+    n_mj = sum(1 for e in mj.events if "stuck" not in (e["from"], e["to"]))
+    ck.le("MuJoCo reversals vs hand path", abs(n_mj - n_rev), 1)
+    ck.le("MuJoCo final |theta| within the stiction band C/K (+1e-3)", abs(mj.q[2, -1]), 0.05 + 1e-3)
+    ck.true("MuJoCo warnings", mj.stats.get("warnings", {}) == {}, mj.stats.get("warnings"))
+
+
+def _drives_both_locked(ck: Checker) -> None:
+    from .models.drives.friction import Friction, Part, simulate_reference
+    from .models.drives.mujoco_path import MujocoRotorSim
+    from .paths import mjcf_path
+
+    def brake(t: float) -> float:
+        return 1.0 if t >= 0.3 else 0.0
+
+    sys_ = _rotors([Friction("clutch_a", 0, 1, [Part("ca", 0.5)]), Friction("clutch_b", 1, 2, [Part("cb", 0.5)]),
+                    Friction("spring_ground", 1, -1, [Part("brake", 0.3, schedule=brake)])], [1e-3, 2e-3, 3e-3],
+                   breaks=[0.3])
+    w0 = [30.0, 10.0, 0.0]
+    res = simulate_reference(sys_, [0, 0, 0], w0, 1.0, sample_dt=1e-3)
+    mj = MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-4).run([0, 0, 0], w0, 1.0,
+                                                                                  sample_dt=1e-3)
+    stuck = [e["t"] for e in res.events if e["to"] == "stuck" and e["element"] in ("clutch_a", "clutch_b")]
+    ck.ge("both clutches lock (hand path)", len(stuck), 2)
+    ck.true("hand path: all three rotors held at the end", res.modes[:, -1].tolist() == [0, 0, 0])
+    ck.true("MuJoCo: all three rotors held at the end", mj.modes[:, -1].tolist() == [0, 0, 0])
+    ck.le("MuJoCo final speeds (rad/s)", np.max(np.abs(mj.w[:, -1])), 1e-6)
+    dt = []
+    for el in ("clutch_a", "clutch_b", "spring_ground"):
+        tr = [e["t"] for e in res.events if e["element"] == el]
+        tm = [e["t"] for e in mj.events if e["element"] == el]
+        ck.true(f"{el}: same number of events in both paths", len(tr) == len(tm), (len(tr), len(tm)))
+        if len(tr) == len(tm):
+            dt += [abs(a - b) for a, b in zip(tr, tm, strict=True)]
+    ck.le("max |event time MuJoCo - hand| (s)", max(dt) if dt else math.inf, 1e-4)
+
+
+def _drives_mismatch(ck: Checker) -> None:
+    from .models.drives.friction import Friction, Part, Source, simulate_reference
+    from .models.drives.mujoco_path import MujocoRotorSim
+    from .paths import mjcf_path
+
+    J1, J2, dw = 2e-3, 5e-4, 50.0
+    sys_ = _rotors([Friction("clutch_a", 0, 1, [Part("ca", 0.5)])], [J1, J2, 1.0], sources=[Source("motor", 0, 0.0)])
+    expected = 0.5 * J1 * J2 / (J1 + J2) * dw**2
+    for name, res in (("hand path", simulate_reference(sys_, [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3)),
+                      ("MuJoCo", MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-5).run(
+                          [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3))):
+        lost = res.energy["ca"][-1] + res.stats["reset_energy"]
+        ck.le(f"{name}: slip loss vs 1/2 J1 J2/(J1+J2) dw^2, relative", abs(lost / expected - 1), 0.01)
+        ck.le(f"{name}: common speed vs momentum, relative",
+              float(np.max(np.abs(res.w[:2, -1] / (J1 * dw / (J1 + J2)) - 1))), 1e-4)
+        ck.true(f"{name}: one lock event", [e["to"] for e in res.events] == ["stuck"])
+
+
+def _drives_big_step(ck: Checker) -> None:
+    from . import load_scene, run
+
+    sc = load_scene("drives/step_up_pwm").replace(solver={"engine": "mujoco", "duration": 0.2, "t_settle": 0.0})
+    ck.raises("a timestep that does not divide the controller period", lambda: run(sc.replace(
+        solver={"timestep": 3e-4})), SceneError, "must divide")
+    res = run(sc.replace(solver={"timestep": 2e-3}))
+    ck.finite("h = controller period (2 ms)", *res.signals.values())
+    ck.le("h = 2 ms: energy balance residual / input", abs(res.stats["energy_balance"]["relative"]), 1e-3)
+
+
+def _drives_energy_balance(ck: Checker) -> None:
+    from . import load_scene, run
+
+    for scene in ("step_up_pwm", "susd_500w_open"):
+        for eng in ("reference", "mujoco"):
+            res = run(load_scene(f"drives/{scene}").replace(solver={"engine": eng, "duration": 0.5, "t_settle": 0.0}))
+            ck.finite(f"{scene} {eng}", *res.signals.values())
+            # README: <= 4e-5 of the input (hand path), <= 2e-7 (MuJoCo) over the shipped scenes
+            ck.le(f"{scene} {eng}: |input - output - losses - stored| / input", abs(
+                res.stats["energy_balance"]["relative"]), 1e-4)
+
+
+# ================================================================================================ iftomm
+def _iftomm_fourbar(ck: Checker) -> None:
+    from scipy.integrate import solve_ivp
+
+    from . import load_scene, run
+
+    sc = load_scene("iftomm/fourbar")
+    mj = run(sc)
+    ref = run(sc.replace(solver={"engine": "reference", "rtol": 1e-10, "atol": 1e-12}))
+    # independent closed form on the parallelogram branch: M = (1/3 + 1/3 + 1) m L^2, V = 2 m g L sin(psi)
+    g = 9.81
+    an = solve_ivp(lambda t, x: [x[1], -1.2 * g * math.cos(x[0])], (0, ref.t[-1]), [math.pi / 2, 6.0],
+                   method="DOP853", rtol=1e-12, atol=1e-12, t_eval=ref.t)
+    ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
+    turns = (mj["input_angle"][-1] - mj["input_angle"][0]) / (2 * math.pi)
+    ck.ge("crank turns in 10 s (2 singular positions per turn)", turns, 10)
+    ck.le("Pinocchio (branch-reduced) vs closed form, crank angle (rad)",
+          np.max(np.abs(ref["input_angle"] + math.pi / 2 - an.y[0])), 1e-6)
+    ck.le("MuJoCo stays on the parallelogram branch: max |coupler angle| (rad)", mj.stats["branch_angle_max"], 0.01)
+    ck.le("MuJoCo closure residual (m)", mj.stats["closure_residual_max"], 2e-4)
+    # measured 0.36 J of 30 J kinetic energy: the soft closure (solref 4 ms, damping ratio 1) dissipates
+    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.5)
+    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-6)
+    ck.le("MuJoCo vs Pinocchio crank angle over the first 2 s (rad)",
+          np.max(np.abs(mj["input_angle"] - ref["input_angle"])[mj.t <= 2.0]), 0.05)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+
+
+def _iftomm_bricard(ck: Checker) -> None:
+    from . import load_scene, run
+    from .models.iftomm.mechanisms import closure_jacobian_rank, mujoco_model
+
+    sc = load_scene("iftomm/bricard")
+    mj = run(sc)
+    ref = run(sc.replace(solver={"engine": "reference"}))
+    m = mujoco_model("bricard", 1e-3, "rk4", 0.004, 9.81)
+    rank0, s0 = closure_jacobian_rank(m, np.zeros(m.nq))
+    ck.true("closure Jacobian: 6 rows, rank 4 on 5 joints -> 1 DOF (Gruebler: 0), detected by SVD",
+            rank0 == 4 and m.nv - rank0 == 1, (rank0, np.round(s0, 6).tolist()))
+    ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
+    ck.ge("it moves: range of joint 1 (rad)", np.ptp(ref["input_angle"]), 0.5)
+    ck.le("Pinocchio closure residual (m)", ref.stats["closure_residual_max"], 1e-6)
+    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-3)
+    ck.le("MuJoCo closure residual with redundant rows (m)", mj.stats["closure_residual_max"], 5e-4)
+    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.1)
+    ck.le("MuJoCo vs Pinocchio joint 1 over 10 s (rad)", np.max(np.abs(mj["input_angle"] - ref["input_angle"])), 0.15)
+    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.stats["branch_angle_max"], 1e-5)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+
+
+def _iftomm_drift_100s(ck: Checker) -> None:
+    import mujoco
+
+    from .analysis.sweep import get_state, rollout_sweep
+    from .models.iftomm.mechanisms import initial_velocity, mujoco_model
+
+    for mech, rate in (("fourbar", 6.0), ("bricard", 0.0)):
+        m = mujoco_model(mech, 1e-3, "rk4", 0.004, 9.81)
+        d = mujoco.MjData(m)
+        d.qvel[:] = initial_velocity(m, rate)
+        mujoco.mj_forward(m, d)
+        E0 = float(d.energy.sum())
+        state, _ = rollout_sweep(m, get_state(m, d)[None, :], np.zeros((1, 100_000, m.nu)), workers=1)
+        qs = state[0, ::100, 1:1 + m.nq]
+        res, en = [], []
+        for x in state[0, ::100]:
+            mujoco.mj_setState(m, d, x, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+            mujoco.mj_forward(m, d)
+            rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+            res.append(float(np.max(np.abs(d.efc_pos[rows]))))
+            en.append(float(d.energy.sum()) - E0)
+        res, en = np.array(res), np.array(en)
+        ck.finite(f"{mech}: 100 s state", state[0, -1])
+        ck.le(f"{mech}: closure residual over 100 s (m)", res.max(), 5e-4)
+        ck.le(f"{mech}: closure residual last 10 s / first 10 s (no drift)", res[-100:].max() / res[:100].max(), 2.0)
+        ck.true(f"{mech}: energy only dissipated (soft closure damping), never gained beyond 1e-6 J",
+                bool(en.max() <= 1e-6), float(en.max()))
+        if mech == "fourbar":
+            ck.le("fourbar: branch kept for 100 s, max |coupler angle| (rad)", float(np.max(np.abs(
+                qs[:, 0] + qs[:, 1]))), 0.02)
+
+
+# ================================================================================================ catenary
+def _catenary_critical_speed(ck: Checker) -> None:
+    from .models.catenary.analysis import CriticalSpeedWarning, speed_regime
+    from .models.catenary.params import CatenaryParams
+
+    p = CatenaryParams()
+    c = p.cw_wave_speed
+    ck.raises("speed at the wave speed sqrt(T/rho)", lambda: speed_regime(p, c), ParameterError, "wave speed")
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        info = speed_regime(p, 0.95 * c)
+    ck.true("95 % of c: CriticalSpeedWarning, regime near-critical",
+            any(issubclass(x.category, CriticalSpeedWarning) for x in w) and info["regime"] == "near-critical")
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        info = speed_regime(p, 0.5 * c)
+    ck.true("50 % of c: no warning, subcritical", not w and info["regime"] == "subcritical")
+
+
+REGISTRY: tuple[HardCase, ...] = (
+    HardCase("pantograph_stick_slip_2hz", "pantograph",
+             "Coulomb stick/slip every half cycle: sign() chatter stalls adaptive solvers",
+             "pantograph/lab at 2 Hz, 4 s, both engines",
+             "no NaN; >= 8 stick events; reference RHS calls <= 5e4, segments <= 500; no MuJoCo warning; "
+             "|F1| MuJoCo vs exact within 2 %", _pantograph_stick_slip),
+    HardCase("pantograph_orifice_dp0", "pantograph",
+             "orifice law at dp -> 0: unbounded slope of the turbulent law at P = Ps",
+             "pantograph/nonlinear_cylinder from P = Ps, 2 s, both engines",
+             "no NaN; reference RHS calls <= 5e4; pressure > 0; no MuJoCo warning", _pantograph_orifice_dp0),
+    HardCase("pantograph_orifice_choked", "pantograph",
+             "choked flow below Pd/Pu = 0.528 and the laminar band: branch switches of the orifice law",
+             "PantographODE(cylinder='nonlinear').orifice_mass_flow over 0.05-1.5 Ps",
+             "finite flow and slope; flow sign; choked plateau flat to 1e-12; continuous at 0.528 and the band edge",
+             _pantograph_orifice_choked),
+    HardCase("pantograph_unilateral_contact", "pantograph",
+             "push-only contact: non-smooth force, repeated contact loss and impact",
+             "pantograph/unilateral (2.5 mm at 4.25 Hz), 4 s, both engines",
+             "losses detected (>= 8), counts agree within 1, total loss time within 10 %, force >= 0",
+             _pantograph_unilateral),
+    HardCase("pantograph_over_large_timestep", "pantograph",
+             "explicit/semi-implicit integration far above the stable step",
+             "pantograph/lab at h = 0.02 s with euler, implicitfast, rk4",
+             "euler/implicitfast: SolverError 'reduce solver.timestep' (not garbage); rk4 finite",
+             _pantograph_big_step),
+    HardCase("pantograph_energy_drift_100s", "pantograph",
+             "long-time energy drift of a conservative 3-DOF system with callbacks",
+             "pantograph, constant cylinder, no damping/friction, RK4 1 ms, 100 s",
+             "energy drift <= 1e-3 J; growth no faster than linear", _pantograph_energy_100s),
+    HardCase("coupler_ey_to_zero", "coupler",
+             "coplanar platforms e_y -> 0: the mechanism Jacobian loses rank (cond ~ 1/e_y)",
+             "single coupler Jacobian at e_y = 1e-1 ... 1e-8 and 0",
+             "cond = R cos(2 gamma)/e_y within 1e-3; rank 4 down to 1e-8; rank 3 and cond = inf at 0; free axial "
+             "translation reported", _coupler_ey_to_zero),
+    HardCase("coupler_ey_below_R_alpha", "coupler",
+             "e_y < R alpha: no physical pose (platform B would cross A); Gauss-Newton may converge to garbage",
+             "single coupler FPP, e_y = 0.02, alpha_bx = 0.07 (and e_y = 0)",
+             "GeometryError naming the cause; the physical case e_y = 0.1 closes after a turn to 1e-9",
+             _coupler_ey_below_alpha),
+    HardCase("coupler_double_phibc90", "coupler",
+             "double coupler with phi_bc = pi/2: fluctuations add, continuation through large swings",
+             "coupler/double_phibc90 (MuJoCo 1 s) and its FPP revolution",
+             "FPP closes to 1e-9; no NaN, no MuJoCo warning; closure residual <= 1e-4 m; phi_c error <= 1e-3 rad",
+             _coupler_phibc90),
+    HardCase("coupler_over_large_timestep", "coupler",
+             "soft closures at a timestep far above solref/2",
+             "coupler/double_lateral at h = 5 ms and 20 ms",
+             "either a clear SolverError, or finite results whose closure residual is reported (<= 5 cm)",
+             _coupler_big_step,
+             known="the coupler accepts timestep > solref_timeconst/2 silently: at 5 ms the closure residual is "
+                   "1.3e-2 m (300x the default); a SceneError there (as the iftomm model raises) would be clearer"),
+    HardCase("coupler_rk4_at_solref_limit", "coupler",
+             "explicit RK4 at h = 1 ms: stiff input servo (kv/J = 2e4 /s) and closures at exactly 2 timesteps",
+             "coupler/double_lateral with integrator rk4, h = 1 ms, 1 s",
+             "a clear SolverError, or finite results with closure <= 1 mm, phi_c error <= 0.01 rad, mean input "
+             "torque = load within 1 %, ripple <= 100 N m",
+             _coupler_rk4_limit,
+             expected_failure="the run ends without error but the input torque is garbage: mean 684 kN m for a "
+                              "1 kN m load, ripple 4.4 kN m p-p (the stiff velocity servo, kv = 2e5, is unstable "
+                              "under RK4 at 1 ms; 0.5 ms is fine); check_finite does not see it (finite values) - "
+                              "same in 4 of 5 coupler scenes (work-precision state error ~690)"),
+    HardCase("coupler_closure_drift_100s", "coupler",
+             "long-time drift of 8 soft closures", "coupler/double_lateral, 100 s",
+             "residual <= 1e-4 m, last 10 s <= 1.5x the first 10 s; phi_c error <= 1e-3 rad",
+             _coupler_drift_100s, slow=True,
+             expected_failure="coupler.mujoco.kinematic_output: the FPP at phi_a = 1025.69 rad (163 turns, t = 82 s) "
+                              "stops at |r| = 1.32e-13 > tol 1e-13 (an absolute tolerance that sin/cos of an unwrapped "
+                              "angle cannot reach) -> SolverError; wrapping phi_a or a relative tolerance fixes it"),
+    HardCase("drives_clutch_lock_unlock", "drives",
+             "clutch stick/slip with nested mode changes (Modelica CoupledClutches)",
+             "drives/coupled_clutches machinery, both paths vs the Dymola result",
+             "same mode sequence; event times within 1e-5 s (hand) / 2e-4 s (MuJoCo); hand RHS calls <= 5e4",
+             _drives_coupled_clutches),
+    HardCase("drives_load_reversal", "drives",
+             "Coulomb load on a spring reversing direction: chatter or stall at every reversal",
+             "rotor system: load with 0.05 N m Coulomb friction on a 1 N m/rad spring, 2 s",
+             "9 reversals then stuck; hand RHS calls <= 2e4; MuJoCo reversals within 1, ends inside the stiction band",
+             _drives_load_reversal),
+    HardCase("drives_both_clutches_locked", "drives",
+             "both clutches locked (one rigid group) then a brake holds the group: nested locks",
+             "three rotors, clutches a/b, brake at 0.3 s, both paths",
+             "all rotors held; same events in both paths within 1e-4 s; MuJoCo speeds <= 1e-6 rad/s",
+             _drives_both_locked),
+    HardCase("drives_engagement_mismatch", "drives",
+             "engagement with a 50 rad/s speed mismatch: plastic lock, energy bookkeeping",
+             "two free inertias and a clutch, both paths",
+             "slip loss = 1/2 J1 J2/(J1+J2) dw^2 within 1 %; common speed within 1e-4; one lock event",
+             _drives_mismatch),
+    HardCase("drives_over_large_timestep", "drives",
+             "MuJoCo step not aligned with the controller, or as long as the controller period",
+             "drives/step_up_pwm on MuJoCo at 0.3 ms and 2 ms",
+             "SceneError 'must divide' for 0.3 ms; 2 ms finite with energy balance <= 1e-3", _drives_big_step),
+    HardCase("drives_energy_balance", "drives",
+             "energy bookkeeping through locks, slips and controller switching",
+             "drives/step_up_pwm and drives/susd_500w_open, 0.5 s, both paths",
+             "|input - output - losses - stored| <= 1e-4 of the input; no NaN", _drives_energy_balance),
+    HardCase("iftomm_fourbar_singular", "iftomm",
+             "A02: all bars collinear twice per turn; the closure Jacobian loses rank and the parallelogram may "
+             "switch to the anti-parallelogram branch",
+             "iftomm/fourbar, 10 s, MuJoCo and Pinocchio",
+             ">= 10 turns; stays on branch (|coupler angle| <= 0.01 rad); closure <= 2e-4 m; energy drift <= 0.5 J "
+             "(MuJoCo) / 1e-6 J (Pinocchio); Pinocchio = closed form to 1e-6 rad", _iftomm_fourbar),
+    HardCase("iftomm_bricard_overconstrained", "iftomm",
+             "A04: over-constrained loop (Gruebler 0 DOF, real 1 DOF): redundant closure rows",
+             "iftomm/bricard, 10 s, MuJoCo and Pinocchio",
+             "rank 4 of 6 rows detected; closure <= 5e-4 m (MuJoCo) / 1e-6 m (Pinocchio); energy drift <= 0.1 / "
+             "1e-3 J; paths agree within 0.15 rad", _iftomm_bricard),
+    HardCase("iftomm_drift_100s", "iftomm",
+             "100 s of soft closures through singular positions and redundant rows",
+             "iftomm fourbar and bricard, MuJoCo RK4 1 ms via mujoco.rollout, 100 s",
+             "closure <= 5e-4 m without growth; energy never gained; four-bar stays on its branch",
+             _iftomm_drift_100s),
+    HardCase("catenary_critical_speed", "catenary",
+             "train speed approaching the contact wire's wave speed: no steady solution",
+             "catenary speed regime at 50 %, 95 %, 100 % of sqrt(T/rho)",
+             "ParameterError at c; CriticalSpeedWarning near c; nothing at 50 %", _catenary_critical_speed),
+)
+
+
+def cases(model: str | None = None, include_slow: bool = True) -> list[HardCase]:
+    out = [c for c in REGISTRY if (model is None or c.model == model) and (include_slow or not c.slow)]
+    if model is not None and not out:
+        raise MbsuiteError(f"no hard cases for model {model!r}; models: {sorted({c.model for c in REGISTRY})}")
+    return out
+
+
+def get(name: str) -> HardCase:
+    for c in REGISTRY:
+        if c.name == name:
+            return c
+    raise MbsuiteError(f"unknown hard case {name!r}; valid: {[c.name for c in REGISTRY]}")

@@ -1,0 +1,25 @@
+"""Two gates of the IFToMM multibody benchmark (A02-type four-bar through its singular positions, A04-type
+over-constrained Bricard mechanism) built with mbsuite's MuJoCo and Pinocchio machinery. See README.md."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...registry import Effect, ModelSpec
+from .analysis import OUTPUTS, run
+from .params import IftommParams
+
+SPEC = ModelSpec(
+    name="iftomm",
+    summary="IFToMM benchmark gates: four-bar through singular positions (A02), over-constrained Bricard (A04)",
+    params_cls=IftommParams,
+    effects={"mechanism": Effect(("fourbar", "bricard"), "fourbar", "which benchmark mechanism")},
+    inputs={"initial": {"rate": "initial rate of the first (input) joint on the free motion [rad/s]"}},
+    outputs=OUTPUTS,
+    engines=("mujoco", "reference"),
+    scenes_dir=Path(__file__).parent / "scenes",
+    default_scene="fourbar",
+    run=run,
+    extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3, "method": "DOP853",
+                               "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "sample_dt": 1e-2}},
+)

@@ -1,0 +1,69 @@
+"""CLI: `mbsuite hardcases`, `mbsuite workprecision`, and --executor/--scheduler/--store on sweeps."""
+
+from __future__ import annotations
+
+import json
+
+from mbsuite import hardcases
+from mbsuite.cli import main
+
+
+def test_hardcases_listing_json(capsys):
+    assert main(["hardcases", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["counts"]["total"] == len(hardcases.REGISTRY) == len(data["cases"])
+    assert sum(data["counts"]["by_model"].values()) == len(hardcases.REGISTRY)
+    assert {"name", "hard", "scene", "asserts"} <= set(data["cases"][0])
+
+
+def test_hardcases_run_one_and_model_filter(capsys):
+    assert main(["hardcases", "--run", "--name", "coupler_ey_to_zero", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    (case,) = data["cases"]
+    assert case["passed"] and all(c["ok"] for c in case["checks"]) and data["counts"]["passed"] == 1
+    assert main(["hardcases", "--model", "nosuch"]) == 2
+    assert "no hard cases" in capsys.readouterr().err
+
+
+def test_workprecision_writes_table_csv_png(tmp_path, capsys):
+    out = tmp_path / "wp"
+    assert main(["workprecision", "drives/coupled_clutches", "--quick", "--repeats", "1", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "cheapest setting" in text and "event-exact DOP853" in text
+    assert (out / "workprecision.csv").stat().st_size > 0 and (out / "workprecision.png").stat().st_size > 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["results"]["rows"] and summary["scene"]["model"] == "drives"
+    assert main(["workprecision", "drives/coupled_clutches", "--repeats", "0"]) == 2
+
+
+def test_freqresp_store_resumes_and_dask_needs_scheduler(tmp_path, capsys):
+    store = tmp_path / "fr.jsonl"
+    argv = ["freqresp", "pantograph", "--methods", "mujoco", "--f-min", "4", "--f-max", "4.5", "--workers", "1",
+            "--store", str(store), "--json"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    lines = store.read_text().splitlines()
+    assert len(lines) >= 2 and len(lines) % 2 == 0  # one line per (frequency, method) point
+    assert main(argv) == 0  # everything is in the store: nothing recomputed, same answer
+    again = json.loads(capsys.readouterr().out)
+    assert store.read_text().splitlines() == lines
+    assert again["response"] == first["response"]
+    assert main(["freqresp", "pantograph", "--executor", "dask"]) == 2
+    assert "scheduler" in capsys.readouterr().err
+
+
+def test_sweep_command_grid_store_and_errors(tmp_path, capsys):
+    store = tmp_path / "s.jsonl"
+    argv = ["sweep", "iftomm/fourbar", "--vary", "input.rate=4,6", "--vary", "solver.duration=0.5",
+            "--signals", "input_angle", "--workers", "2", "--store", str(store), "--json"]
+    assert main(argv) == 0
+    data = json.loads(capsys.readouterr().out)
+    pts = data["points"]
+    assert [p["values"]["input.rate"] for p in pts] == [4.0, 6.0]
+    # a faster start turns the crank further in the same time
+    assert pts[1]["signals"]["input_angle"]["max"] > pts[0]["signals"]["input_angle"]["max"]
+    assert len(store.read_text().splitlines()) == 2
+    assert main(["sweep", "iftomm/fourbar", "--vary", "rate=1,2"]) == 2
+    assert "SECTION.KEY" in capsys.readouterr().err
+    assert main(["sweep", "iftomm/fourbar", "--vary", "params.nosuch=1"]) == 2
+    assert "unknown parameter" in capsys.readouterr().err

@@ -27,8 +27,12 @@ test-slow: $(STAMP)  ## long studies only
 lint: $(STAMP)
 	$(BIN)/ruff check mbsuite tests scripts
 
-bench: $(STAMP)
+bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tests)
 	$(BIN)/python scripts/bench_callbacks.py
+	$(BIN)/python scripts/bench_step_cost.py
+	$(BIN)/python scripts/bench_effects_off.py
+	$(BIN)/python scripts/bench_paths.py
+	$(BIN)/python scripts/bench_sweep.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

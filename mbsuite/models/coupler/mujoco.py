@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from ...engines import mujoco_engine as me
-from ...errors import SceneError
+from ...errors import SceneError, SolverError
 from ...results import SimResult
 from . import reference as ref
 from .modelfiles import PHI_B_OFFSET, _mounted, _quat_z_to, link_inertia, mjspec_variant, phi_c_offset
@@ -47,6 +47,11 @@ def _id(m, kind, name: str) -> int:
 
 def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: float, integrator: str):
     """Compile the dynamics model and return (model, data, info) with data at the assembled initial pose (rest)."""
+    if p.solref_timeconst < 2.0 * timestep:
+        raise SceneError(
+            f"solver.timestep = {timestep:g} s is too large for the soft link closures: MuJoCo needs solref_timeconst "
+            f"({p.solref_timeconst:g} s) >= 2 timestep and would silently stiffen it (closure residual 300x larger at "
+            f"5 ms); use timestep <= {p.solref_timeconst / 2:g} s or raise params.solref_timeconst")
     spec = mjspec_variant(p, "double")
     massless = effects["link_inertia"] == "massless"
     scale = p.massless_factor if massless else 1.0
@@ -146,6 +151,8 @@ def run(scene) -> SimResult:
     n = int(round(sv.duration / sv.timestep))
     every = max(1, int(round(sv.sample_dt / sv.timestep))) if sv.sample_dt > 0 else 1
     ia = m.jnt_qposadr[_id(m, mujoco.mjtObj.mjOBJ_JOINT, "phi_a")]
+    va = m.jnt_dofadr[_id(m, mujoco.mjtObj.mjOBJ_JOINT, "phi_a")]
+    servo_tol = max(0.05 * abs(inp["omega"]), 1.0)  # a stable servo tracks to load/kv ~ 5e-3 rad/s
     ic = m.jnt_qposadr[_id(m, mujoco.mjtObj.mjOBJ_JOINT, "phi_c")]
     vc = m.jnt_dofadr[_id(m, mujoco.mjtObj.mjOBJ_JOINT, "phi_c")]
     eq_ids = [_id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"link{k + 1}") for k in range(8)]
@@ -179,6 +186,12 @@ def run(scene) -> SimResult:
         d.ctrl[1] = -inp["load_torque"] * s
         mujoco.mj_step(m, d)
         me.check_finite(m, d, f"coupler scene {scene.name or '(unnamed)'}")
+        if abs(d.qvel[va] - d.ctrl[0]) > servo_tol:  # finite but garbage: the stiff input servo went unstable
+            raise SolverError(
+                f"coupler scene {scene.name or '(unnamed)'}: the input velocity servo (kv = {p.kv_drive:g} N m s/rad) "
+                f"is unstable with integrator {sv.integrator} at timestep {sv.timestep:g} s (speed error "
+                f"{abs(d.qvel[va] - d.ctrl[0]):.3g} rad/s at t = {d.time:.4g} s); reduce solver.timestep or use "
+                "implicitfast/implicit, which treat the servo's damping implicitly")
     t = np.array(rec["t"])
     phi_a, phi_c = np.array(rec["phi_a"]), np.array(rec["phi_c"])
     phi_kin = kinematic_output(p, inp, phi_a, info["u0"])
@@ -202,12 +215,17 @@ def kinematic_output(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray,
     out = np.empty_like(phi_a)
     u = u0
     rest = [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]
+    turn = np.zeros(8)
+    turn[[0, 5]] = 2 * math.pi  # phi_c and phi_b advance with phi_a
     for i, pa in enumerate(phi_a):
         guess = u.copy()
         if i:
             guess[0] += pa - phi_a[i - 1]
             guess[5] += pa - phi_a[i - 1]
-        u = ref.solve_double(p, np.array([pa, *rest]), guess)
+        # solve at phi_a wrapped to one turn: the FPP's absolute tolerance cannot be met by sin/cos of an angle of
+        # 1000 rad (long runs), and the pose is 2 pi-periodic in phi_a, phi_b, phi_c
+        k = round(pa / (2 * math.pi))
+        u = ref.solve_double(p, np.array([pa - 2 * math.pi * k, *rest]), guess - k * turn) + k * turn
         out[i] = u[0]
     return out
 

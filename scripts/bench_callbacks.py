@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from mbsuite.engines.mujoco_engine import callbacks
+from mbsuite.engines.mujoco_engine import step_cost
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.reference import PantographConfig
 from mbsuite.paths import mjcf_path
@@ -26,19 +26,8 @@ from mbsuite.results import format_table
 
 
 def loop_cost(model, cbs: dict, q0: np.ndarray, steps: int, repeats: int) -> float:
-    d = mujoco.MjData(model)
     ctrl = 1.58 + 1.85e-3 * (1 - np.cos(2 * np.pi * 4.25 * np.arange(steps) * model.opt.timestep))
-    best = np.inf
-    with callbacks(**cbs):
-        for _ in range(repeats):
-            mujoco.mj_resetData(model, d)
-            d.qpos[:] = q0
-            t0 = time.perf_counter()
-            for k in range(steps):
-                d.ctrl[0] = ctrl[k]
-                mujoco.mj_step(model, d)
-            best = min(best, time.perf_counter() - t0)
-    return best / steps
+    return step_cost(model, cbs, q0, steps, repeats, ctrl)
 
 
 def rollout_cost(model, q0: np.ndarray, steps: int, repeats: int) -> float:

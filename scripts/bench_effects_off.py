@@ -15,13 +15,12 @@ Each variant steps the same number of steps in the same Python loop (ctrl writte
 from __future__ import annotations
 
 import argparse
-import time
 
 import mujoco
 import numpy as np
 
 from mbsuite import load_scene
-from mbsuite.engines.mujoco_engine import callbacks
+from mbsuite.engines.mujoco_engine import step_cost
 from mbsuite.models.coupler.mujoco import _inputs, build
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.reference import PantographConfig
@@ -30,20 +29,7 @@ from mbsuite.results import format_table
 
 
 def loop_cost(model, cbs: dict, q0: np.ndarray | None, steps: int, repeats: int, ctrl: float | None = None) -> float:
-    d = mujoco.MjData(model)
-    best = np.inf
-    with callbacks(**cbs):
-        for _ in range(repeats):
-            mujoco.mj_resetData(model, d)
-            if q0 is not None:
-                d.qpos[:] = q0
-            t0 = time.perf_counter()
-            for _ in range(steps):
-                if ctrl is not None:
-                    d.ctrl[0] = ctrl
-                mujoco.mj_step(model, d)
-            best = min(best, time.perf_counter() - t0)
-    return best / steps
+    return step_cost(model, cbs, q0, steps, repeats, ctrl)
 
 
 def main() -> None:

@@ -112,3 +112,28 @@ def full_inertia(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     M = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, M)
     return M
+
+
+def step_cost(model: mujoco.MjModel, cbs: dict[str, Callable | None], q0: np.ndarray | None, steps: int,
+              repeats: int, ctrl: float | np.ndarray | None = None) -> float:
+    """Seconds per `mj_step` in a Python loop (best of `repeats`), with the given callbacks installed.
+
+    `ctrl`: None, a constant for ctrl[0], or one value per step for ctrl[0] (written before every step, so that the
+    loop overhead is the same for the variants a benchmark compares)."""
+    import time
+
+    d = mujoco.MjData(model)
+    seq = None if ctrl is None else np.broadcast_to(np.asarray(ctrl, dtype=float), (steps,))
+    best = np.inf
+    with callbacks(**cbs):
+        for _ in range(repeats):
+            mujoco.mj_resetData(model, d)
+            if q0 is not None:
+                d.qpos[:] = q0
+            t0 = time.perf_counter()
+            for k in range(steps):
+                if seq is not None:
+                    d.ctrl[0] = seq[k]
+                mujoco.mj_step(model, d)
+            best = min(best, time.perf_counter() - t0)
+    return best / steps

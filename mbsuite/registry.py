@@ -43,6 +43,14 @@ class ModelSpec:
     - `run(scene, engine) -> SimResult`
     - `equilibrium(scene) -> dict`, `modes(scene) -> dict`, `freqresp(scene, freqs, progress) -> dict`
     Any hook may be None: the CLI then says the model does not support that analysis.
+
+    Suite declarations (read by the model-agnostic suite layer, which names no model):
+    - `cases`: dotted name of the module holding the model's `HARD_CASES` (a tuple of `mbsuite.hardcases.HardCase`),
+      `workprecision_study(scene, quick) -> mbsuite.analysis.workprecision.Study` and
+      `random_input(scene, rng) -> dict` (admissible random scene sections for the random-input test of every scene);
+      imported only when the suite asks.
+    - `under_wire(params, effects, engine, timestep) -> pantograph`: a pantograph of this model that the catenary can
+      drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     """
 
     name: str
@@ -59,6 +67,12 @@ class ModelSpec:
     modes: Callable[..., Any] | None = None
     freqresp: Callable[..., Any] | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
+    cases: str | None = None
+    under_wire: Callable[..., Any] | None = None
+
+    def suite(self) -> Any:
+        """The model's suite module (`cases`), or None if it declares none."""
+        return importlib.import_module(self.cases) if self.cases else None
 
     def param_names(self) -> list[str]:
         return [f.name for f in dataclasses.fields(self.params_cls)]

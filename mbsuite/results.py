@@ -62,6 +62,23 @@ class SimResult:
         return Report(self.summary(), table, lambda out: [self.write_csv(Path(out) / "run.csv")])
 
 
+def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, engine: str,
+             events: Sequence[dict[str, Any]] = (), stats: Mapping[str, Any] | None = None,
+             always: Sequence[str] = ()) -> SimResult:
+    """The one place that turns a model's signals into a `SimResult`: keeps the signals the scene asks for (its
+    `outputs`; all when it names none) plus `always`, takes their units from the model's declared output table
+    (`scene.spec.outputs`, SI) and attaches the scene. A signal missing from the table is an error, not a unitless
+    column."""
+    table = scene.spec.outputs
+    wanted = set(scene.outputs) | set(always) if scene.outputs else set(signals)
+    keep = {k: np.asarray(v) for k, v in signals.items() if k in wanted}
+    missing = sorted(k for k in keep if k not in table)
+    if missing:
+        raise KeyError(f"model '{scene.model}' declares no unit for signal(s) {missing}; add them to its outputs")
+    return SimResult(np.asarray(t), keep, {k: table[k] for k in keep}, engine, events=list(events),
+                     stats=dict(stats or {}), scene=scene.to_dict())
+
+
 def write_csv(path: str | Path, columns: Sequence[tuple[str, str, Any]]) -> Path:
     """Write columns `(name, unit, values)` as CSV; the header reads `name [unit]`."""
     path = Path(path)

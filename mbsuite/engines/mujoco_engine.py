@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from ..errors import ModelFileError, SceneError, SolverError
+from . import native
 
 INTEGRATOR = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -35,8 +36,9 @@ _active: dict[str, Callable] = {}
 
 
 def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False) -> mujoco.MjModel:
-    """Compile an MJCF file/string/MjSpec; any parse or compile error is re-raised as ModelFileError naming the
-    source."""
+    """Compile an MJCF file/string/MjSpec (mbsuite's engine plugins registered first); any parse or compile error is
+    re-raised as ModelFileError naming the source."""
+    native.load()
     try:
         if isinstance(source, mujoco.MjSpec):
             return source.compile()

@@ -10,6 +10,7 @@ from mbsuite.engines.mujoco_engine import callbacks, full_inertia
 from mbsuite.models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.pinocchio import PinocchioPantograph, reference_in_q
+from mbsuite.models.pantograph.python_effects import PythonEffects
 from mbsuite.models.pantograph.reference import PantographConfig, PantographODE
 
 REL = 1e-10
@@ -41,18 +42,21 @@ def test_mujoco_mass_matrix_matches_hand_derived(ode, random_thetas):
         assert d.actuator_length[mp.i_cat] == pytest.approx(ode.contact_height(np.r_[th, 0, 0, 0]), rel=REL)
 
 
+@pytest.mark.parametrize("impl", ["native", "python"])
 @pytest.mark.parametrize("cylinder", ["constant", "linear", "nonlinear"])
 @pytest.mark.parametrize("elbow_kinematics", ["B6", "exact"])
-def test_mujoco_accelerations_match_hand_derived(random_thetas, cylinder, elbow_kinematics):
+def test_mujoco_accelerations_match_hand_derived(random_thetas, cylinder, elbow_kinematics, impl):
     """Full right-hand side at random states (q, q', P, y_w): every force term of both paths (gravity, contact spring,
-    head spring, elbow callback, cylinder force and its user dynamics, joint damping). Coulomb friction off, since
-    MuJoCo's frictionloss is a constraint, not a force law."""
+    head spring, elbow spring, cylinder force and its dynamics, joint damping), with the effects as the engine
+    plugins (native) and as their Python twins (callbacks). Coulomb friction off, since MuJoCo's frictionloss is a
+    constraint, not a force law."""
     cfg = PantographConfig(cylinder=cylinder, coulomb=False, elbow_kinematics=elbow_kinematics)
     ode = PantographODE(config=cfg)
-    mp = MujocoPantograph(config=cfg)
+    mp = MujocoPantograph(config=cfg, plugins=impl == "native")
     m, d = mp.model, mp.data
     rng = np.random.default_rng(7)
-    with callbacks(**mp.callback_set()):
+    cbs = PythonEffects(ode.p, cfg).callbacks() if impl == "python" else {}
+    with callbacks(**cbs):
         for th in random_thetas[:40]:
             thd = rng.normal(0.0, 0.3, 3)
             y_w = 1.58 + rng.uniform(-0.05, 0.05)

@@ -10,6 +10,14 @@ from mbsuite.models.pantograph.params import PantographParams
 from mbsuite.paths import mjcf_path, urdf_path
 
 FRAMES = ("contact_point", "elbow_pinion", "cylinder_lever")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _plugins():
+    """The shipped MJCF holds the lab effects as mbsuite engine plugins: the one documented call registers them."""
+    import mbsuite.native
+
+    mbsuite.native.load()
 # Pinocchio 4.1's MJCF parser keeps no sites of the fixed root body ("origin", "chain_base"): those are compared
 # between the URDF and MuJoCo only.
 

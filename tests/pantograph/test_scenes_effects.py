@@ -7,74 +7,63 @@ import numpy as np
 import pytest
 
 from mbsuite import SceneError, load_scene, run, scene_from_dict
-from mbsuite.engines.mujoco_engine import active_callbacks, callbacks
+from mbsuite.engines import native
+from mbsuite.engines.core import Channel, Stepper
 from mbsuite.models.pantograph.analysis import InputSignal
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.reference import PantographConfig
 from mbsuite.paths import mjcf_path
 
 
-def _step_raw(model, n, callbacks_kw, q0):
+def _steps(model, n, q0):
+    """n steps of the native core from q0 at rest under a slowly varying ram; every state recorded."""
     d = mujoco.MjData(model)
     d.qpos[:] = q0
-    d.ctrl[0] = 1.58
-    out = []
-    with callbacks(**callbacks_kw):
-        for k in range(n):
-            d.ctrl[0] = 1.58 + 1e-3 * np.sin(0.01 * k)
-            mujoco.mj_step(model, d)
-            out.append(d.qpos.copy())
-    return np.array(out)
+    ctrl = 1.58 + 1e-3 * np.sin(0.01 * np.arange(n))
+    st = Stepper(model, d, [Channel("q", "qpos", 0, 3), Channel("v", "qvel", 0, 3)])
+    tr = st.run(n, ctrl=ctrl, ctrl_idx=[0])
+    return np.hstack([tr["q"], tr["v"]])
 
 
-def test_callbacks_only_for_effects_that_need_them():
-    assert MujocoPantograph(config=PantographConfig(cylinder="constant", elbow="rigid")).callback_set() == {
-        "passive": None, "act_dyn": None}
+def test_plugins_only_for_effects_that_need_them():
+    """The effects that need code are engine plugins, present only when the scene asks for them; an effect that is
+    off adds no plugin and no state."""
+    off = MujocoPantograph(config=PantographConfig(cylinder="constant", elbow="rigid"))
+    assert off.model.nplugin == 0 and off.model.na == 0
     lab = MujocoPantograph(config=PantographConfig())
-    assert lab.callback_set()["act_dyn"] is not None and lab.callback_set()["passive"] is not None
+    names = {mujoco.mj_id2name(lab.model, mujoco.mjtObj.mjOBJ_PLUGIN, i) for i in range(lab.model.nplugin)}
+    assert names == {"cylinder", "elbow"} and lab.model.na == 1
     assert MujocoPantograph(config=PantographConfig(cylinder="constant")).model.na == 0  # no state added
-    assert lab.model.na == 1
+    assert MujocoPantograph(config=PantographConfig(elbow="rigid")).model.nplugin == 1
 
 
-def test_no_callback_left_installed_after_runs(lab_scene):
-    run(lab_scene.replace(solver={"duration": 0.2, "t_settle": 0.1}))
-    assert active_callbacks() == {}
+def test_shipped_scene_runs_install_no_python_callback(lab_scene, monkeypatch):
+    """No MuJoCo Python callback is ever installed by a run (they are process-global and hold the GIL)."""
+    calls = []
+    for name in ("passive", "act_dyn", "act_gain", "act_bias", "control", "sensor"):
+        setter = f"set_mjcb_{name}"
+        monkeypatch.setattr(mujoco, setter, lambda fn, name=name: calls.append(name))
+    for eff in ({}, {"cylinder": "nonlinear"}, {"elbow": "rigid", "cylinder": "constant"}):
+        run(lab_scene.replace(effects=eff, solver={"duration": 0.2, "t_settle": 0.1}))
+    assert calls == []
     assert mujoco.get_mjcb_passive() is None and mujoco.get_mjcb_act_dyn() is None
 
 
-def test_rigid_constant_scene_runs_with_no_callback_installed(lab_scene, monkeypatch):
-    seen = []
-    orig = mujoco.mj_step
-
-    def spy(m, d, *a):
-        seen.append((mujoco.get_mjcb_passive(), mujoco.get_mjcb_act_dyn()))
-        return orig(m, d, *a)
-
-    monkeypatch.setattr(mujoco, "mj_step", spy)
-    sc = lab_scene.replace(effects={"elbow": "rigid", "cylinder": "constant"}, solver={"duration": 0.05, "t_settle":
-    0.0})
-    run(sc)
-    assert seen and all(s == (None, None) for s in seen)
-
-
 @pytest.mark.parametrize("effect,edit", [
-    ("cylinder", None),  # the shipped file holds the constant cylinder: identical model
     ("gravity", lambda m: m.opt.gravity.__setitem__(slice(None), 0.0)),
     ("coulomb", lambda m: m.dof_frictionloss.__setitem__(slice(None), 0.0)),
     ("viscous", lambda m: m.dof_damping.__setitem__(slice(None), 0.0)),
 ])
 def test_off_effect_bit_identical_to_model_built_without_it(effect, edit):
     """Builder with the effect off vs the shipped MJCF compiled directly and edited by hand: bit-identical steps."""
-    off = {"cylinder": "constant", "gravity": False, "coulomb": False, "viscous": False}[effect]
-    cfg = PantographConfig(**{"cylinder": "constant", effect: off})
+    cfg = PantographConfig(**{effect: False})
     mp = MujocoPantograph(config=cfg)
+    native.load()
     raw = mujoco.MjModel.from_xml_path(str(mjcf_path("pantograph")))
-    if edit:
-        edit(raw)
+    raw.opt.integrator = mp.model.opt.integrator
+    edit(raw)
     q0 = mp.equilibrium()
-    a = _step_raw(mp.model, 400, mp.callback_set(), q0)
-    b = _step_raw(raw, 400, {"passive": mp._elbow_passive}, q0)
-    assert np.array_equal(a, b)
+    assert np.array_equal(_steps(mp.model, 400, q0), _steps(raw, 400, q0))
 
 
 def test_unknown_effect_and_keys_list_valid_ones(lab_scene):

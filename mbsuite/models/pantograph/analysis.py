@@ -18,10 +18,11 @@ import numpy as np
 from ...analysis.harmonic import fundamental
 from ...analysis.sweep import run_sweep
 from ...errors import SceneError
-from ...results import Report, SimResult, format_table, write_csv
+from ...results import Report, SimResult, assemble, format_table, write_csv
 from ...scenes import Scene, scene_from_dict
+from .elbow import theta_e_array
 from .modelfiles import q_to_theta, theta_to_q
-from .mujoco import MujocoPantograph
+from .mujoco import MujocoPantograph, thetas
 from .params import PantographParams
 from .reference import PantographConfig, PantographODE, simulate
 
@@ -43,18 +44,24 @@ def config_of(scene: Scene) -> PantographConfig:
 
 @dataclass(frozen=True)
 class InputSignal:
+    """The ram height y_w(t) (m): sine y_op + A (1 - cos 2 pi f t), step y_op + h (t >= t_step), or static y_op.
+    Accepts a float or an array of times."""
+
     kind: str
     y_op: float
     amplitude: float = 0.0
     frequency: float = 0.0
     t_step: float = 0.0
 
-    def __call__(self, t: float) -> float:
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
         if self.kind == "sine":
-            return self.y_op + self.amplitude * (1.0 - math.cos(2.0 * math.pi * self.frequency * t))
-        if self.kind == "step":
-            return self.y_op + (self.amplitude if t >= self.t_step else 0.0)
-        return self.y_op
+            y = self.y_op + self.amplitude * (1.0 - np.cos(2.0 * math.pi * self.frequency * t))
+        elif self.kind == "step":
+            y = self.y_op + np.where(t >= self.t_step, self.amplitude, 0.0)
+        else:
+            y = np.full_like(t, self.y_op)
+        return float(y) if y.ndim == 0 else y
 
 
 def input_of(scene: Scene, p: PantographParams) -> InputSignal:
@@ -85,16 +92,21 @@ def initial_theta(scene: Scene, ode: PantographODE, u: InputSignal) -> np.ndarra
 
 
 def signals(ode: PantographODE, theta: np.ndarray, y_w: np.ndarray, P: np.ndarray | None) -> dict[str, np.ndarray]:
-    """Output signals from absolute angles theta (N, 3), ram height and cylinder state (shared by both engines)."""
+    """Output signals from absolute angles theta (N, 3), ram height and cylinder state (shared by both engines;
+    vectorised)."""
     p = ode.p
     F1, F2, HD = p.l1 * np.sin(theta[:, 0]), p.l2 * np.sin(theta[:, 1]), p.lh * np.sin(theta[:, 2])
     y_d = F1 + F2 + HD
     fc = p.ks * (y_d - y_w)
     if ode.cfg.contact == "unilateral":
         fc = np.maximum(fc, 0.0)
-    te = np.array([ode.elbow(a).theta_e for a in theta[:, 0]])
-    cyl = np.array([ode.cylinder_force(a, None if P is None else Pk)
-                    for a, Pk in zip(theta[:, 0], P if P is not None else [None] * len(theta), strict=True)])
+    te, _ = theta_e_array(p, theta[:, 0], ode.cfg.elbow_kinematics == "exact")
+    if ode.cfg.cylinder == "constant" or P is None:
+        cyl = np.full_like(F1, p.Pg * p.Ap)
+    elif ode.cfg.cylinder == "linear":
+        cyl = p.Pg * p.Ap + p.kc * (P - p.lb * np.cos(p.alpha - theta[:, 0]))  # 3.26
+    else:
+        cyl = (P - p.Pa) * p.Ap  # 3.22
     out = {"F1": F1, "F2": F2, "HD": HD, "y_d": y_d, "y_w": y_w, "theta1": theta[:, 0], "theta2": theta[:, 1],
            "thetah": theta[:, 2], "theta_e": te, "elbow_windup": te - theta[:, 1], "contact_force": fc,
            "cylinder_force": cyl}
@@ -171,26 +183,19 @@ def run(scene: Scene) -> SimResult:
                        t_eval=t_eval)
         th = np.array([ode.theta(sol.x[: ode.nq, k]) for k in range(sol.t.size)])
         P = sol.x[-1] if ode.has_P else None
-        sig = signals(ode, th, np.array([u(t) for t in sol.t]), P)
-        res = SimResult(sol.t, sig, {k: UNITS[k] for k in sig}, "reference", events=sol.events,
+        return assemble(scene, sol.t, signals(ode, th, u(sol.t), P), engine="reference", events=sol.events,
                         stats={"nfev": sol.nfev, "segments": sol.nsegments, "method": s.method, "rtol": s.rtol})
     else:
         mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
         q0 = None if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
-        r = mp.simulate(u, s.duration, q0)
-        th = mp.thetas(r.qpos)
-        P = r.act[:, 0] if mp.model.na else None
-        sig = signals(ode, th, r.y_w, P)
-        ev = _contact_losses(r.t, sig["contact_force"]) if cfg.contact == "unilateral" else []  # at every step
         every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
-        t = r.t[::every]
-        sig = {k: v[::every] for k, v in sig.items()}
-        res = SimResult(t, sig, {k: UNITS[k] for k in sig}, "mujoco", events=ev,
-                        stats={"steps": int(r.t.size - 1), "integrator": s.integrator, "timestep": s.timestep,
-                               "warnings": r.warnings})
-    res.signals = {k: v for k, v in res.signals.items() if k in scene.outputs or not scene.outputs}
-    res.scene = scene.to_dict()
-    return res
+        tr = mp.simulate(u, s.duration, q0, every=every, what=f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)")
+        P = tr["act"].reshape(tr.t.size, -1)[:, 0] if mp.model.na else None
+        sig = signals(ode, thetas(tr["qpos"]), u(tr.t), P)
+        ev = _contact_losses(tr.t, sig["contact_force"]) if cfg.contact == "unilateral" else []
+        return assemble(scene, tr.t, sig, engine="mujoco", events=ev,
+                        stats={"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep,
+                               "warnings": tr.warnings})
 
 
 # ------------------------------------------------------------------------------------------------ linearisation
@@ -244,9 +249,7 @@ def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
     """Modes from MuJoCo's own finite-difference linearisation (mjd_transitionFD), mapped to continuous time."""
     import mujoco
 
-    from ...engines import mujoco_engine as mje
-
-    m, d = mp.model, mp.data
+    m, d = mp.model, mp.data  # the MujocoPantograph's own copy of the model: edited here, restored after
     if m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:  # mjd_transitionFD does not support RK4
         raise SceneError("MuJoCo modes: mjd_transitionFD does not support the rk4 integrator; use another integrator")
     nx = 2 * m.nv + m.na
@@ -254,9 +257,8 @@ def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
     saved = m.dof_frictionloss.copy()
     m.dof_frictionloss[:] = 0.0  # Coulomb friction is not linearisable: excluded, as in the reference linearisation
     try:
-        with mje.callbacks(**mp.callback_set()):
-            mp._set_static(q0, mp.p.y_op)
-            mujoco.mjd_transitionFD(m, d, 1e-7, True, A, None, None, None)
+        mp.set_static(q0, mp.p.y_op)
+        mujoco.mjd_transitionFD(m, d, 1e-7, True, A, None, None, None)
     finally:
         m.dof_frictionloss[:] = saved
     mu = np.linalg.eigvals(A)

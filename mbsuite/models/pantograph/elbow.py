@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ...errors import GeometryError
 from .params import PantographParams
 
@@ -106,3 +108,33 @@ class Elbow:
     def second_derivative(self, theta1: float, h: float = 1e-5) -> float:
         """d^2 theta_e / d theta_1^2 by a central difference of the analytic first derivative (error O(h^2) ~ 1e-10)."""
         return (self(theta1 + h).dtheta_e - self(theta1 - h).dtheta_e) / (2.0 * h)
+
+
+def theta_e_array(p: PantographParams, theta1: np.ndarray, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(theta_e, d theta_e / d theta_1) for an array of theta_1: the formulas of `Elbow.__call__`, vectorised (for
+    post-processing recorded trajectories). Raises GeometryError where the chain has no tangent line."""
+    th = np.asarray(theta1, dtype=float)
+    c1, s1 = np.cos(th), np.sin(th)
+    X = p.l1 * c1 - p.xf
+    Y = p.l1 * s1 + p.yf
+    A = X * X - p.le**2
+    B = -2.0 * X * Y
+    C = Y * Y - p.le**2
+    disc = B * B - 4.0 * A * C
+    bad = (disc <= 0.0) | (A == 0.0)
+    if np.any(bad):
+        Elbow(p, exact)(float(th[np.argmax(bad)]))  # raises GeometryError with the full message
+    sq = np.sqrt(disc)
+    phi1 = np.arctan2(-B - sq, 2.0 * A)
+    t = (-B - sq) / (2.0 * A)
+    dX, dY = -p.l1 * s1, p.l1 * c1
+    dt = -(2 * X * dX * t * t - 2.0 * (dX * Y + X * dY) * t + 2 * Y * dY) / (2.0 * A * t + B)
+    dphi1 = dt / (1.0 + t * t)
+    sp, cp = np.sin(phi1), np.cos(phi1)
+    gx, gy = X + p.le * sp, Y - p.le * cp
+    lfb = np.sqrt(gx * gx + gy * gy)
+    dlfb = (gx * (dX + p.le * cp * dphi1) + gy * (dY + p.le * sp * dphi1)) / lfb
+    e0 = Elbow(p, exact)
+    if exact:
+        return p.theta_e0 + (lfb - e0.lfb0) / p.le - (phi1 - e0.phi1_0), dlfb / p.le - dphi1
+    return p.theta_e0 + (lfb - e0.lfb0) / p.le - th, dlfb / p.le - 1.0

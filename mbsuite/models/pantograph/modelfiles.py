@@ -122,27 +122,119 @@ def urdf_text(p: PantographParams | None = None) -> str:
     )
 
 
-def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None = None, timestep: float = 5e-4) -> str:
-    p = p or PantographParams()
-    lx, lz = lever_local(p)
-    if q_operating is None:
-        from .reference import PantographODE
+def _cfg_default():
+    from .reference import PantographConfig
 
-        q_operating = theta_to_q(PantographODE(p).equilibrium()[:3])
-    qkey = " ".join(_f(v) for v in q_operating)
+    return PantographConfig()
+
+
+def _operating_state(p: PantographParams, cfg) -> tuple[np.ndarray, list[float]]:
+    """(qpos, act) of the static equilibrium at y_op (hand-derived path); act holds the cylinder state at rest."""
+    from .reference import PantographConfig, PantographODE
+
+    ode = PantographODE(p, PantographConfig(**{**cfg.__dict__, "elbow": "compliant"}))
+    x = ode.equilibrium()
+    if cfg.elbow == "compliant":
+        q = theta_to_q(x[:3])
+    else:
+        rigid = PantographODE(p, cfg)
+        xr = rigid.equilibrium()
+        q = theta_to_q(rigid.theta(xr[:2]))
+    act = []
+    if cfg.cylinder == "linear":
+        act = [ode.cylinder_lever(q[0])[0]]
+    elif cfg.cylinder == "nonlinear":
+        act = [p.Ps]
+    return q, act
+
+
+def _config(values: dict[str, object]) -> str:
+    return "\n".join(f'        <config key="{k}" value="{v if isinstance(v, str) else _f(v)}"/>'
+                      for k, v in values.items())
+
+
+def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None = None, timestep: float = 5e-4,
+              cfg=None, plugins: bool = True) -> str:
+    """The MJCF of the pantograph with exactly the effects of `cfg` (a `PantographConfig`; default: the lab scene's
+    compliant elbow, linear cylinder, gravity, viscous and Coulomb friction, bilateral contact). The shipped
+    `mjcf/pantograph.xml` is this text for the Table 3-I parameters and the default effects.
+
+    Effects that need code are mbsuite engine plugins with their parameters as config attributes (load them with
+    `mbsuite.native.load()` before compiling): the linear or nonlinear cylinder is the actuator plugin
+    `mbsuite.pantograph.cylinder` on the base joint (one activation: x-coordinate P of the linear model in m, or the
+    absolute pressure in Pa; its actuator force is the torque F lb sin(alpha - theta_1) of the cylinder force F on the
+    lever), the compliant elbow the passive plugin `mbsuite.pantograph.elbow`. The constant cylinder is a plain
+    actuator with the affine bias Pg Ap, the rigid elbow a joint equality q2 = poly(q1) (quartic fit of
+    pi - q1 - theta_e(q1)); an effect that is off adds nothing.
+
+    `plugins=False` writes the model the Python implementation of the effects needs instead
+    (`python_effects.py`, the readable reference of the plugins): no plugin, the cylinder a `user`-dynamics actuator
+    on the lever site (force gain * act + bias), the elbow spring left to a passive callback."""
+    p = p or PantographParams()
+    cfg = cfg or _cfg_default()
+    lx, lz = lever_local(p)
+    q_key, act_key = _operating_state(p, cfg)
+    if q_operating is not None:
+        q_key = np.asarray(q_operating, float)
+    qkey = " ".join(_f(v) for v in q_key)
+    g = p.g if cfg.gravity else 0.0
+    b1, b2, bh = (p.b1, p.b2, p.bh) if cfg.viscous else (0.0, 0.0, 0.0)
+    c1, c2, ch = (p.c1, p.c2, p.ch) if cfg.coulomb else (0.0, 0.0, 0.0)
+    sf = _f(2 * timestep)
 
     def inertial(m: float, d: float, I: float) -> str:
         ixx, iyy, izz = _inertia(I)
         return f'<inertial pos="{_f(d)} 0 0" mass="{_f(m)}" diaginertia="{_f(ixx)} {_f(iyy)} {_f(izz)}"/>'
 
+    ext = []
+    if plugins and cfg.cylinder in ("linear", "nonlinear"):
+        conf = {"model": cfg.cylinder, "lb": p.lb, "alpha": p.alpha, "kc": p.kc, "bc": p.bc, "Pg": p.Pg, "Pa": p.Pa,
+                "Ap": p.Ap, "V0": p.V0,
+                "R_gas": p.R_gas, "T": p.T, "gamma": p.gamma, "cd": p.cd, "Ao": p.Ao, "r_laminar": p.r_laminar}
+        ext.append(f"""    <plugin plugin="mbsuite.pantograph.cylinder">
+      <instance name="cylinder">
+{_config(conf)}
+      </instance>
+    </plugin>""")
+    if plugins and cfg.elbow == "compliant":
+        conf = {"l1": p.l1, "xf": p.xf, "yf": p.yf, "le": p.le, "theta_e0": p.theta_e0, "ke": p.ke, "be": p.be,
+                "kinematics": cfg.elbow_kinematics, "joint1": "base_joint", "joint2": "knuckle_joint"}
+        ext.append(f"""    <plugin plugin="mbsuite.pantograph.elbow">
+      <instance name="elbow">
+{_config(conf)}
+      </instance>
+    </plugin>""")
+    extension = ("  <extension>\n" + "\n".join(ext) + "\n  </extension>\n") if ext else ""
+    if not plugins and cfg.cylinder != "constant":
+        gain, bias = ((p.kc, f"{_f(p.Pg * p.Ap)} {_f(-p.kc)} 0") if cfg.cylinder == "linear"
+                      else (p.Ap, f"{_f(-p.Pa * p.Ap)} 0 0"))
+        cylinder = (f'<general name="cylinder" site="cylinder_lever" refsite="origin" gear="1 0 0 0 0 0"\n'
+                    f'             dyntype="user" actdim="1" gaintype="fixed" gainprm="{_f(gain)}" '
+                    f'biastype="affine" biasprm="{bias}"/>')
+    elif cfg.cylinder == "constant":
+        cylinder = (f'<general name="cylinder" site="cylinder_lever" refsite="origin" gear="1 0 0 0 0 0"\n'
+                    f'             gaintype="fixed" gainprm="0" biastype="affine" biasprm="{_f(p.Pg * p.Ap)} 0 0"/>')
+    else:
+        cylinder = '<plugin name="cylinder" instance="cylinder" joint="base_joint" actdim="1"/>'
+    limit = ' forcelimited="true" forcerange="-1e+15 0"' if cfg.contact == "unilateral" else ""
+    equality = ""
+    if cfg.elbow == "rigid":
+        from .mujoco import rigid_elbow_fit
+
+        coef, _ = rigid_elbow_fit(p, cfg.elbow_kinematics == "exact")
+        equality = (f'  <equality>\n    <joint name="rigid_elbow" joint1="knuckle_joint" joint2="base_joint"\n'
+                    f'           polycoef="{" ".join(_f(c) for c in coef)}" solref="{sf} 1"/>\n  </equality>\n')
+    act = f' act="{" ".join(_f(a) for a in act_key)}"' if act_key else ""
+    effects = ", ".join(f"{k}={v}" for k, v in cfg.__dict__.items())
     return f"""<!-- Brecknell-Willis asymmetric pantograph, Eppinger (1984) Table 3-I. Generated by
-     mbsuite.models.pantograph.modelfiles (do not edit by hand). Planar chain in x-z (z up), hinges about -y;
-     q1 = theta_1, q2 = pi - theta_1 - theta_2, q3 = theta_h + theta_2 - pi. One root body (Pinocchio reads only the
-     first top-level body). ctrl[catenary] = ram/wire height y_w (m). The elbow spring is added by mbsuite. -->
+     mbsuite.models.pantograph.modelfiles (do not edit by hand). Effects: {effects}.
+     Planar chain in x-z (z up), hinges about -y; q1 = theta_1, q2 = pi - theta_1 - theta_2,
+     q3 = theta_h + theta_2 - pi. One root body (Pinocchio reads only the first top-level body).
+     ctrl[catenary] = ram/wire height y_w (m). Engine plugins: call mbsuite.native.load() before compiling. -->
 <mujoco model="pantograph">
   <compiler angle="radian" autolimits="true"/>
-  <option timestep="{_f(timestep)}" integrator="implicitfast" gravity="0 0 {_f(-p.g)}"/>
-  <default>
+  <option timestep="{_f(timestep)}" integrator="implicitfast" gravity="0 0 {_f(-g)}"/>
+{extension}  <default>
     <geom contype="0" conaffinity="0" rgba="0.75 0.75 0.8 1"/>
   </default>
   <worldbody>
@@ -153,20 +245,20 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
       <site name="origin" pos="0 0 0"/>
       <site name="chain_base" pos="{_f(p.xf)} 0 {_f(-p.yf)}" size="0.02"/>
       <body name="lower_arm">
-        <joint name="base_joint" type="hinge" axis="{AXIS}" damping="{_f(p.b1)}" frictionloss="{_f(p.c1)}"
-               solreffriction="{_f(2 * timestep)} 1"/>
+        <joint name="base_joint" type="hinge" axis="{AXIS}" damping="{_f(b1)}" frictionloss="{_f(c1)}"
+               solreffriction="{sf} 1"/>
         {inertial(p.m1, p.d1, p.I1)}
         <geom name="lower_arm" type="capsule" fromto="0 0 0 {_f(p.l1)} 0 0" size="0.03"/>
         <site name="elbow_pinion" pos="{_f(p.l1)} 0 0" size="{_f(p.le)}"/>
         <site name="cylinder_lever" pos="{_f(lx)} 0 {_f(lz)}" size="0.02"/>
         <body name="upper_arm" pos="{_f(p.l1)} 0 0">
-          <joint name="knuckle_joint" type="hinge" axis="{AXIS}" damping="{_f(p.b2)}" frictionloss="{_f(p.c2)}"
-               solreffriction="{_f(2 * timestep)} 1"/>
+          <joint name="knuckle_joint" type="hinge" axis="{AXIS}" damping="{_f(b2)}" frictionloss="{_f(c2)}"
+               solreffriction="{sf} 1"/>
           {inertial(p.m2, p.d2, p.I2)}
           <geom name="upper_arm" type="capsule" fromto="0 0 0 {_f(p.l2)} 0 0" size="0.025"/>
           <body name="head" pos="{_f(p.l2)} 0 0">
-            <joint name="head_joint" type="hinge" axis="{AXIS}" damping="{_f(p.bh)}" frictionloss="{_f(p.ch)}"
-               solreffriction="{_f(2 * timestep)} 1"/>
+            <joint name="head_joint" type="hinge" axis="{AXIS}" damping="{_f(bh)}" frictionloss="{_f(ch)}"
+               solreffriction="{sf} 1"/>
             {inertial(p.mh, p.dh, p.Ih)}
             <geom name="head" type="capsule" fromto="0 0 0 {_f(p.lh)} 0 0" size="0.02"/>
             <geom name="collector" type="box" size="0.04 0.6 0.02" pos="{_f(p.lh)} 0 0" rgba="0.2 0.2 0.2 1"/>
@@ -183,14 +275,13 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
       <joint joint="head_joint" coef="1"/>
     </fixed>
   </tendon>
-  <actuator>
-    <general name="catenary" site="contact_point" refsite="origin" gear="0 0 1 0 0 0"
+{equality}  <actuator>
+    <general name="catenary" site="contact_point" refsite="origin" gear="0 0 1 0 0 0"{limit}
              gaintype="fixed" gainprm="{_f(p.ks)}" biastype="affine" biasprm="0 {_f(-p.ks)} 0"/>
-    <general name="cylinder" site="cylinder_lever" refsite="origin" gear="1 0 0 0 0 0"
-             gaintype="fixed" gainprm="0" biastype="affine" biasprm="{_f(p.Pg * p.Ap)} 0 0"/>
+    {cylinder}
   </actuator>
   <keyframe>
-    <key name="operating" qpos="{qkey}" ctrl="{_f(p.y_op)} 0"/>
+    <key name="operating" qpos="{qkey}"{act} ctrl="{_f(p.y_op)} 0"/>
   </keyframe>
 </mujoco>
 """

@@ -1,0 +1,278 @@
+"""The one step-and-record loop of every MuJoCo path in mbsuite.
+
+A `Stepper` holds a compiled model, its data and what to record; `Stepper.run(nstep, ...)` hands the whole loop to
+the native core (`native/core.c`): per step, the input row goes into `d.ctrl`, MuJoCo's forward dynamics runs, an
+optional native stepper (a model's compiled state machine) acts on the forward, the declared channels are recorded
+every `every` steps into one preallocated array, the state is integrated with the model's own integrator, and the
+run is checked: MuJoCo's bad-acceleration warning and the faults of mbsuite's plugins every step, finite
+qpos/qvel/act every `check_every` steps and at every recorded row, and every recorded value against the plausibility
+bounds its channel declares. The trajectory is bitwise that of `mj_step` (the core calls what `mj_step` calls).
+
+Inputs:
+- an array: `ctrl` of shape (nstep, len(ctrl_idx)), row k written into `d.ctrl[ctrl_idx]` before step k;
+- a callable: `between(k, data)` called in Python before step k for every k that is a multiple of `period` (a
+  discrete controller at its sample rate; `period=1` makes any Python input possible, at Python's cost);
+- native code: a `NativeHook`, a compiled stepper called by the core at every step (no Python at all).
+
+The core holds no global state and releases the GIL while it runs, so steppers in different threads run in
+parallel and never mix (`map_threads`). A failure raises `SolverError` naming the run, the time and the cause.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from ..errors import SolverError
+from . import native
+
+#: recordable MjData quantities (order mirrors the MBS_F_* enum of native/mbsuite.h)
+FIELDS = ("time", "qpos", "qvel", "act", "ctrl", "actuator_force", "actuator_length", "actuator_velocity",
+          "sensordata", "qfrc_passive", "qfrc_actuator", "energy", "eq_pos", "eq_force", "hook", "site_xpos")
+_FIELD_ID = {f: i for i, f in enumerate(FIELDS)}
+_STATUS = {0: "ok", 1: "non-finite state", 2: "bad acceleration", 3: "plugin fault", 4: "implausible value",
+           5: "native stepper error", 6: "invalid arguments"}
+DEFAULT_HINT = "reduce solver.timestep or use an implicit integrator"
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One recorded quantity: `size` values of MjData `field` from index `start` (for `eq_pos`/`eq_force`: the
+    constraint rows of equality `start`; for `site_xpos`: 3 values from 3*site). Every recorded value must lie in
+    [lo, hi] (a plausibility bound; NaN never does), else the run stops with an error naming the channel."""
+
+    name: str
+    field: str
+    start: int = 0
+    size: int = 1
+    lo: float = -math.inf
+    hi: float = math.inf
+
+    def __post_init__(self) -> None:
+        if self.field not in _FIELD_ID:
+            raise ValueError(f"unknown channel field {self.field!r}; valid: {list(FIELDS)}")
+        if self.size < 1 or self.start < 0:
+            raise ValueError(f"channel {self.name!r}: start must be >= 0 and size >= 1")
+
+
+@dataclass
+class NativeHook:
+    """A compiled stepper: C function `fn` (mbs_hook_fn), its user data `ud`, and the array the `hook` channel
+    records from. `keep` holds whatever must outlive the run (buffers the C side points into). `describe(code)`
+    turns a negative return code into words."""
+
+    fn: Any
+    ud: Any
+    record: np.ndarray | None = None
+    keep: tuple = ()
+    describe: Callable[[int], str] = field(default=lambda code: f"native stepper error {code}")
+
+
+class _Job(ctypes.Structure):
+    _fields_ = [
+        ("nstep", ctypes.c_long), ("k0", ctypes.c_long), ("final", ctypes.c_int),
+        ("ctrl", ctypes.c_void_p), ("ctrl_idx", ctypes.c_void_p), ("ctrl_ncol", ctypes.c_int),
+        ("ctrl_rows", ctypes.c_long),
+        ("every", ctypes.c_int), ("rec", ctypes.c_void_p), ("rec_cap", ctypes.c_long), ("rec_row", ctypes.c_long),
+        ("rec_ncol", ctypes.c_int), ("nchan", ctypes.c_int), ("chan_field", ctypes.c_void_p),
+        ("chan_start", ctypes.c_void_p), ("chan_size", ctypes.c_void_p), ("lo", ctypes.c_void_p),
+        ("hi", ctypes.c_void_p), ("check_every", ctypes.c_int),
+        ("hook", ctypes.c_void_p), ("hook_ud", ctypes.c_void_p), ("hook_rec", ctypes.c_void_p),
+        ("status", ctypes.c_int), ("fail_step", ctypes.c_long), ("fail_time", ctypes.c_double),
+        ("fail_col", ctypes.c_int), ("fail_value", ctypes.c_double), ("fail_plugin", ctypes.c_int),
+        ("fail_code", ctypes.c_int), ("steps_done", ctypes.c_long),
+    ]
+
+
+@dataclass
+class Trajectory:
+    """What a run recorded: times `t` (rows) and one array per channel ((rows,) for size 1, else (rows, size))."""
+
+    t: np.ndarray
+    channels: dict[str, np.ndarray]
+    steps: int
+    warnings: dict[str, int]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.channels[name]
+
+
+def _ptr(a: np.ndarray | None) -> int | None:
+    return None if a is None else a.ctypes.data
+
+
+def rows_for(nstep: int, every: int) -> int:
+    """Recorded rows of a run of `nstep` steps sampled every `every` steps (the final state always included)."""
+    return nstep // every + 1 + (1 if nstep % every else 0)
+
+
+def warnings_raised(data: mujoco.MjData) -> dict[str, int]:
+    """Non-zero MuJoCo warning counters by name."""
+    return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(data.warning) if w.number > 0}
+
+
+class Stepper:
+    """A model and its data, stepped by the native core (module docstring).
+
+    `what` names the run in error messages (e.g. "pantograph scene lab (MuJoCo)"); `hint` is the advice appended to
+    numerical failures."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData | None = None, channels: Sequence[Channel] = (), *,
+                 every: int = 1, check_every: int = 64, hook: NativeHook | None = None, what: str = "MuJoCo run",
+                 hint: str = DEFAULT_HINT):
+        self.lib = native.load()
+        self.model = model
+        self.data = data if data is not None else mujoco.MjData(model)
+        self.channels = tuple(channels)
+        if len({c.name for c in self.channels}) != len(self.channels):
+            raise ValueError("channel names must be unique")
+        self.every = int(every)
+        self.check_every = int(check_every)
+        if self.every < 1 or self.check_every < 1:
+            raise ValueError("every and check_every must be >= 1")
+        self.hook = hook
+        self.what = what
+        self.hint = hint
+        self._field = np.array([_FIELD_ID[c.field] for c in self.channels], np.int32)
+        self._start = np.array([3 * c.start if c.field == "site_xpos" else c.start for c in self.channels], np.int32)
+        self._size = np.array([c.size for c in self.channels], np.int32)
+        self.ncol = 1 + int(self._size.sum())
+        self._lo = np.full(self.ncol, -np.inf)
+        self._hi = np.full(self.ncol, np.inf)
+        col = 1
+        for c in self.channels:
+            self._lo[col:col + c.size] = c.lo
+            self._hi[col:col + c.size] = c.hi
+            col += c.size
+        self._check_sizes()
+
+    def _check_sizes(self) -> None:
+        m = self.model
+        avail = {"time": 1, "qpos": m.nq, "qvel": m.nv, "act": m.na, "ctrl": m.nu, "actuator_force": m.nu,
+                 "actuator_length": m.nu, "actuator_velocity": m.nu, "sensordata": m.nsensordata,
+                 "qfrc_passive": m.nv, "qfrc_actuator": m.nv, "energy": 2, "site_xpos": 3 * m.nsite,
+                 "hook": 0 if self.hook is None or self.hook.record is None else self.hook.record.size}
+        for c, start in zip(self.channels, self._start, strict=True):
+            if c.field in ("eq_pos", "eq_force"):
+                if c.start >= m.neq:
+                    raise ValueError(f"channel {c.name!r}: model has no equality {c.start}")
+                continue
+            if start + c.size > avail[c.field]:
+                raise ValueError(f"channel {c.name!r}: {c.field}[{start}:{start + c.size}] is out of range "
+                                 f"({avail[c.field]} values)")
+
+    # ------------------------------------------------------------------------------------------------ running
+    def run(self, nstep: int, *, ctrl: np.ndarray | None = None, ctrl_idx: Sequence[int] | None = None,
+            between: Callable[[int, mujoco.MjData], None] | None = None, period: int = 1,
+            record: bool = True) -> Trajectory:
+        """Step `nstep` times from the data's current state; returns the recorded trajectory (rows at every
+        `every`-th step and the final state). See the module docstring for the inputs."""
+        nstep = int(nstep)
+        if nstep < 0:
+            raise ValueError(f"nstep must be >= 0, got {nstep}")
+        m, d = self.model, self.data
+        if ctrl is not None:
+            ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
+            if ctrl.ndim == 1:
+                ctrl = ctrl[:, None]
+            idx = np.arange(m.nu, dtype=np.int32) if ctrl_idx is None else np.asarray(ctrl_idx, np.int32)
+            if ctrl.shape[1] != idx.size or ctrl.shape[0] < nstep or np.any((idx < 0) | (idx >= m.nu)):
+                raise ValueError(f"ctrl must have shape (>= {nstep}, {idx.size}) with actuator indices < {m.nu}; "
+                                 f"got {ctrl.shape}")
+        else:
+            idx = None
+        rows = rows_for(nstep, self.every) if record else 0
+        rec = np.empty((max(rows, 1), self.ncol))
+        job = _Job()
+        job.ctrl, job.ctrl_idx = _ptr(ctrl), _ptr(idx)
+        job.ctrl_ncol = 0 if ctrl is None else ctrl.shape[1]
+        job.ctrl_rows = 0 if ctrl is None else ctrl.shape[0]
+        job.every = self.every if record else nstep + 2
+        job.rec, job.rec_cap, job.rec_row, job.rec_ncol = _ptr(rec), rows, 0, self.ncol
+        job.nchan = len(self.channels)
+        job.chan_field, job.chan_start, job.chan_size = _ptr(self._field), _ptr(self._start), _ptr(self._size)
+        job.lo, job.hi = _ptr(self._lo), _ptr(self._hi)
+        job.check_every = self.check_every
+        if self.hook is not None:
+            job.hook = ctypes.cast(self.hook.fn, ctypes.c_void_p)
+            job.hook_ud = self.hook.ud if isinstance(self.hook.ud, int) else ctypes.cast(self.hook.ud, ctypes.c_void_p)
+            job.hook_rec = _ptr(self.hook.record)
+        ma, da = ctypes.c_void_p(m._address), ctypes.c_void_p(d._address)
+        steps = 0
+        chunk = nstep if between is None else max(1, int(period))
+        k = 0
+        while True:
+            n = min(chunk, nstep - k)
+            if between is not None and k < nstep:
+                between(k, d)
+            job.nstep, job.k0, job.final = n, k, int(record and k + n >= nstep)
+            self.lib.mbs_run(ma, da, ctypes.byref(job))
+            steps += job.steps_done
+            if job.status != 0:
+                raise self._error(job)
+            k += n
+            if k >= nstep:
+                break
+        return self._trajectory(rec[:job.rec_row] if record else rec[:0], steps)
+
+    def _trajectory(self, rec: np.ndarray, steps: int) -> Trajectory:
+        out, col = {}, 1
+        for c in self.channels:
+            a = rec[:, col:col + c.size]
+            out[c.name] = a[:, 0].copy() if c.size == 1 else a.copy()
+            col += c.size
+        return Trajectory(rec[:, 0].copy(), out, steps, warnings_raised(self.data))
+
+    def _column_name(self, col: int) -> str:
+        c0 = 1
+        for c in self.channels:
+            if col < c0 + c.size:
+                return c.name if c.size == 1 else f"{c.name}[{col - c0}]"
+            c0 += c.size
+        return f"column {col}"
+
+    def _error(self, job: _Job) -> SolverError:
+        m = self.model
+        setting = (f"integrator {mujoco.mjtIntegrator(m.opt.integrator).name[6:].lower()}, timestep "
+                   f"{m.opt.timestep:g} s")
+        at = f"at t = {job.fail_time:.6g} s"
+        if job.status == 3:
+            inst = job.fail_plugin
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PLUGIN, inst) or f"instance {inst}"
+            text = self.lib.mbs_fault_text(job.fail_code).decode()
+            return SolverError(f"{self.what}: effect '{name}': {text} (value {job.fail_value:.6g}) {at} ({setting}); "
+                               "the state is non-physical: check the parameters and the input, or " + self.hint)
+        if job.status == 4:
+            c = self.channels_flat_bound(job.fail_col)
+            return SolverError(f"{self.what}: {self._column_name(job.fail_col)} = {job.fail_value:.6g} is outside its "
+                               f"plausible range [{c[0]:g}, {c[1]:g}] {at} ({setting}); {self.hint}")
+        if job.status == 5 and self.hook is not None:
+            return SolverError(f"{self.what}: {self.hook.describe(job.fail_code)} {at} ({setting})")
+        if job.status == 6:
+            return SolverError(f"{self.what}: invalid arguments to the native core")
+        return SolverError(f"{self.what}: MuJoCo diverged ({_STATUS.get(job.status, job.status)}) {at} ({setting}); "
+                           f"{self.hint}")
+
+    def channels_flat_bound(self, col: int) -> tuple[float, float]:
+        return float(self._lo[col]), float(self._hi[col])
+
+
+def map_threads(fn: Callable[[Any], Any], items: Iterable[Any], workers: int = 0) -> list[Any]:
+    """`[fn(x) for x in items]` on `workers` threads (0 = all cores). For functions whose work is native-core runs
+    (the GIL is released while the core steps), this is a parallel sweep in C threads; results keep the order of
+    `items` and are identical to a serial run."""
+    from ..analysis.sweep import n_workers
+
+    items = list(items)
+    nw = min(n_workers(workers), len(items)) or 1
+    if nw <= 1:
+        return [fn(x) for x in items]
+    with ThreadPoolExecutor(max_workers=nw) as ex:
+        return list(ex.map(fn, items))

@@ -1,0 +1,164 @@
+"""mbsuite's compiled layer: MuJoCo engine plugins (the models' effects) and the step-and-record core, in C.
+
+One documented call makes MuJoCo know mbsuite's plugins, in any script or viewer session:
+
+    >>> import mbsuite.native                  # the same module as mbsuite.engines.native
+    >>> mbsuite.native.load()                  # compiles once (cached), registers the plugins with MuJoCo
+    >>> m = mujoco.MjModel.from_xml_path(str(mbsuite.paths.mjcf_path("pantograph")))
+
+The sources are `core.c` here and every model package's `native/*.c`. They are compiled with the system
+C compiler (`cc`, or `$CC`) against the headers that the installed mujoco wheel ships (`mujoco/include`), linked to
+that wheel's `libmujoco`, and cached under `$MBSUITE_NATIVE_DIR` (default `$XDG_CACHE_HOME/mbsuite` or
+`~/.cache/mbsuite`) in a folder named by the hash of the sources, the compiler flags and the mujoco version: a new
+mujoco or an edited source compiles anew, nothing stale is ever loaded. Compiling against the installed wheel's own
+headers (rather than at wheel-build time against whatever mujoco the build environment held) is what keeps the plugin
+structs and `mjData` offsets right whatever mujoco 4.x a user has.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+from pathlib import Path
+
+from ...errors import MbsuiteError
+
+HERE = Path(__file__).resolve().parent
+MODELS_DIR = HERE.parents[1] / "models"
+LIB_NAME = "libmbsuite_native.so"
+CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-parameter", "-fno-fast-math")
+ABI_VERSION = 1
+
+_lock = threading.Lock()
+_lib: ctypes.CDLL | None = None
+
+
+class NativeBuildError(MbsuiteError, RuntimeError):
+    """The native library could not be compiled or loaded (no C compiler, a compile error, a stale ABI)."""
+
+
+def sources() -> list[Path]:
+    """The C sources of the library: the core here, then every model package's `native/*.c` (sorted)."""
+    return sorted(HERE.glob("*.c")) + sorted(MODELS_DIR.glob("*/native/*.c"))
+
+
+def _headers() -> list[Path]:
+    return sorted(HERE.glob("*.h")) + sorted(MODELS_DIR.glob("*/native/*.h"))
+
+
+def mujoco_dirs() -> tuple[Path, Path]:
+    """(include directory, libmujoco shared object) of the installed mujoco wheel."""
+    import mujoco
+
+    root = Path(mujoco.__file__).resolve().parent
+    inc = root / "include"
+    libs = sorted(root.glob("libmujoco.so*")) or sorted(root.glob("libmujoco*.dylib"))
+    if not (inc / "mujoco" / "mujoco.h").is_file() or not libs:
+        raise NativeBuildError(f"the mujoco wheel at {root} ships no headers or no libmujoco; mbsuite's native layer "
+                               "needs both (mujoco >= 4 from PyPI has them)")
+    return inc, libs[0]
+
+
+def _compiler() -> str:
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if not cc:
+        raise NativeBuildError("mbsuite's native layer needs a C compiler (cc, gcc or clang, or $CC) to compile its "
+                               "MuJoCo plugins once per mujoco version; install one (e.g. apt install gcc)")
+    return cc
+
+
+def cache_root() -> Path:
+    env = os.environ.get("MBSUITE_NATIVE_DIR")
+    if env:
+        return Path(env)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "mbsuite"
+
+
+def build_key() -> str:
+    """Hash of everything the binary depends on: sources, headers, flags, compiler, mujoco version and library."""
+    import mujoco
+
+    inc, lib = mujoco_dirs()
+    h = hashlib.sha256()
+    for p in sources() + _headers():
+        h.update(p.name.encode())
+        h.update(p.read_bytes())
+    h.update(" ".join(CFLAGS).encode())
+    h.update(_compiler().encode())
+    h.update(mujoco.__version__.encode())
+    h.update(str(lib).encode())
+    h.update((inc / "mujoco" / "mjdata.h").read_bytes())
+    h.update((inc / "mujoco" / "mjmodel.h").read_bytes())
+    h.update(sys.platform.encode())
+    return h.hexdigest()[:20]
+
+
+def library_path() -> Path:
+    """Where the library for the installed mujoco and the current sources lives (it may not be built yet)."""
+    return cache_root() / f"native-{build_key()}" / LIB_NAME
+
+
+def build(force: bool = False) -> Path:
+    """Compile the library if it is not cached (or `force`); returns its path. Atomic: concurrent builders never see a
+    half-written file."""
+    out = library_path()
+    if out.is_file() and not force:
+        return out
+    inc, lib = mujoco_dirs()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".build-", suffix=".so", dir=out.parent)
+    os.close(fd)
+    cmd = [_compiler(), *CFLAGS, f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),
+           f"-Wl,-rpath,{lib.parent}", "-lm"]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            raise NativeBuildError(f"compiling mbsuite's native layer failed ({cmd[0]}):\n{proc.stderr.strip()}")
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return out
+
+
+def load() -> ctypes.CDLL:
+    """Build (once, cached) and load the library; registers mbsuite's engine plugins with MuJoCo. Idempotent and
+    thread-safe. Returns the ctypes handle of the library (the core's entry points)."""
+    global _lib
+    with _lock:
+        if _lib is not None:
+            return _lib
+        import mujoco
+
+        path = build()
+        mujoco.mj_loadPluginLibrary(str(path))  # dlopen: its constructors register the plugins
+        lib = ctypes.CDLL(str(path))  # the same handle (dlopen is reference counted)
+        lib.mbs_abi_version.restype = ctypes.c_int
+        if lib.mbs_abi_version() != ABI_VERSION:
+            raise NativeBuildError(f"{path} has native ABI {lib.mbs_abi_version()}, mbsuite expects {ABI_VERSION}")
+        lib.mbs_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+        lib.mbs_run.restype = ctypes.c_int
+        lib.mbs_fault_text.argtypes = [ctypes.c_int]
+        lib.mbs_fault_text.restype = ctypes.c_char_p
+        lib.mbs_signal.argtypes = [ctypes.c_void_p, ctypes.c_double]
+        lib.mbs_signal.restype = ctypes.c_double
+        _lib = lib
+        return lib
+
+
+def plugin_names() -> list[str]:
+    """Names of mbsuite's registered MuJoCo plugins (after `load()`)."""
+    import re
+
+    load()
+    names = []
+    for p in sources():
+        names += re.findall(r'\.name\s*=\s*"(mbsuite\.[^"]+)"', p.read_text())
+    return sorted(names)

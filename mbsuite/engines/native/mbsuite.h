@@ -1,0 +1,127 @@
+/* mbsuite native layer: the shared declarations of the step-and-record core (core.c), the time signals
+ * (the signal evaluator) and the models' engine plugins and steppers (each model package's native folder).
+ *
+ * Everything here is compiled into one shared library against the headers of the installed mujoco wheel
+ * (mbsuite.engines.native.build). Nothing here keeps global mutable state: plugins keep theirs per instance in
+ * mjData.plugin_data, steppers in the user data the caller passes, so two models in two threads never mix. */
+#ifndef MBSUITE_NATIVE_H_
+#define MBSUITE_NATIVE_H_
+
+#include <mujoco/mujoco.h>
+
+/* ------------------------------------------------------------------------------------------------ plugins */
+/* Every mbsuite plugin instance's data starts with this header. A plugin that meets a non-physical state (a
+ * negative chamber volume, a geometry with no solution, a non-finite input) records the first fault here, returns a
+ * harmless value, and the core stops the run after the current step with an error naming the instance, the fault
+ * and the time. A plugin cannot raise: this is its only way out. */
+typedef struct {
+  int fault;          /* 0 = none; else a model-specific code, described by mbs_fault_text */
+  double fault_time;  /* d->time of the first fault */
+  double fault_value; /* the offending value */
+} mbs_plugin_header;
+
+/* Register a plugin and remember its slot, so that the core can find mbsuite's instances in any model. */
+int mbs_register_plugin(const mjpPlugin* plugin);
+/* 1 if the plugin instance `instance` of m is one of mbsuite's. */
+int mbs_is_own_instance(const mjModel* m, int instance);
+/* Record a fault on an instance (the first one wins). */
+void mbs_fault(mjData* d, int instance, int code, double value);
+/* Parse a numeric config attribute; `fallback` if absent. Sets *bad to 1 if present but not a finite number. */
+double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback, int* bad);
+
+/* Fault codes (all models); texts in core.c. */
+enum {
+  MBS_FAULT_NONE = 0,
+  MBS_FAULT_CONFIG = 1,          /* a config attribute is missing or not a number */
+  MBS_FAULT_NONFINITE = 2,       /* a non-finite input state */
+  MBS_FAULT_VOLUME = 3,          /* cylinder chamber volume <= 0 */
+  MBS_FAULT_PRESSURE = 4,        /* absolute pressure <= 0 */
+  MBS_FAULT_GEOMETRY = 5,        /* elbow chain has no tangent line */
+  MBS_FAULT_STATE_MACHINE = 6,   /* a stick/slip state machine does not settle */
+};
+const char* mbs_fault_text(int code);
+
+/* ------------------------------------------------------------------------------------------------ signals */
+/* A time signal as a flat array: [kind, p0, p1, ...]. Kinds and parameters (mbsuite.engines.signals mirrors them):
+ *  0 constant   [0, c]
+ *  1 step       [1, offset, height, t0]                          offset + height (t >= t0)
+ *  2 sine       [2, offset, amplitude, freq_hz, phase, t0]       offset + A sin(2 pi f (t - t0) + phase) (t >= t0)
+ *  3 ramp       [3, offset, height, t0, duration]                linear from offset to offset + height
+ *  4 pulse      [4, offset, amplitude, width, period, t0, n]     n = 0: unlimited periods; width as a fraction 0..1
+ *  5 table      [5, n, t_0..t_{n-1}, y_0..y_{n-1}]               piecewise linear, held outside
+ *  6 cosine_lift[6, offset, amplitude, freq_hz]                  offset + A (1 - cos 2 pi f t) (the pantograph ram)
+ */
+double mbs_signal(const double* spec, double t);
+/* length of a signal spec (number of doubles), or -1 for an unknown kind */
+int mbs_signal_size(const double* spec);
+
+/* ------------------------------------------------------------------------------------------------ the core */
+/* Recorded MjData quantities (mbsuite.engines.core.FIELDS mirrors them). */
+enum {
+  MBS_F_TIME = 0, MBS_F_QPOS, MBS_F_QVEL, MBS_F_ACT, MBS_F_CTRL, MBS_F_ACTUATOR_FORCE, MBS_F_ACTUATOR_LENGTH,
+  MBS_F_ACTUATOR_VELOCITY, MBS_F_SENSORDATA, MBS_F_QFRC_PASSIVE, MBS_F_QFRC_ACTUATOR, MBS_F_ENERGY,
+  MBS_F_EQ_POS, MBS_F_EQ_FORCE, MBS_F_HOOK, MBS_F_SITE_XPOS, MBS_NFIELD
+};
+
+/* Stages at which a native stepper (hook) is called. */
+enum { MBS_STAGE_POST_FORWARD = 0, MBS_STAGE_POST_STEP = 1 };
+
+/* A native stepper: called at MBS_STAGE_POST_FORWARD after mj_forward at the state of step k (it may change ctrl,
+ * qvel, eq_active, ...; return 1 to have the core recompute mj_forward), and at MBS_STAGE_POST_STEP after the
+ * integration. A negative return stops the run (status MBS_FAIL_HOOK, code in job.fail_code). */
+typedef int (*mbs_hook_fn)(const mjModel* m, mjData* d, void* ud, long k, int stage);
+
+/* Status of mbs_run. */
+enum {
+  MBS_OK = 0, MBS_FAIL_NONFINITE = 1, MBS_FAIL_BADQACC = 2, MBS_FAIL_PLUGIN = 3, MBS_FAIL_BOUNDS = 4,
+  MBS_FAIL_HOOK = 5, MBS_FAIL_ARGS = 6
+};
+
+/* One call of the core: run `nstep` steps from global step k0 (rows of `ctrl` are global step indices), record a
+ * row at every global step that is a multiple of `every` (and the final state when `final` is set), check at a
+ * cadence, stop at the first failure. Layout mirrored by mbsuite.engines.core._Job (ctypes). */
+typedef struct {
+  /* run */
+  long nstep;            /* steps in this call */
+  long k0;               /* global index of the first step */
+  int final;             /* 1: after the last step, forward and record the final state (no integration) */
+  /* input: d->ctrl[ctrl_idx[i]] = ctrl[k * ctrl_ncol + i] before step k (k global; rows up to ctrl_rows) */
+  const double* ctrl;
+  const int* ctrl_idx;
+  int ctrl_ncol;
+  long ctrl_rows;
+  /* recording: rows of rec_ncol doubles; column 0 is time */
+  int every;
+  double* rec;
+  long rec_cap;          /* rows allocated */
+  long rec_row;          /* next row to write (in/out) */
+  int rec_ncol;
+  int nchan;
+  const int* chan_field;
+  const int* chan_start;
+  const int* chan_size;
+  const double* lo;      /* per column plausibility bounds (column 0 unused); NULL = none */
+  const double* hi;
+  int check_every;       /* finite check of qpos, qvel, act every this many steps (>= 1) */
+  /* native stepper */
+  mbs_hook_fn hook;
+  void* hook_ud;
+  const double* hook_rec; /* MBS_F_HOOK reads here */
+  /* out: failure */
+  int status;
+  long fail_step;
+  double fail_time;
+  int fail_col;
+  double fail_value;
+  int fail_plugin;        /* plugin instance id (MBS_FAIL_PLUGIN) */
+  int fail_code;          /* plugin fault code or hook error */
+  long steps_done;        /* steps integrated in this call */
+} mbs_job;
+
+int mbs_run(const mjModel* m, mjData* d, mbs_job* job);
+
+/* Version of the job layout; the Python side refuses a library with another. */
+int mbs_abi_version(void);
+#define MBS_ABI_VERSION 1
+
+#endif  /* MBSUITE_NATIVE_H_ */

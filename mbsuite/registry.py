@@ -49,6 +49,8 @@ class ModelSpec:
       `workprecision_study(scene, quick) -> mbsuite.analysis.workprecision.Study` and
       `random_input(scene, rng) -> dict` (admissible random scene sections for the random-input test of every scene);
       imported only when the suite asks.
+    - `sections`: extra top-level scene sections of this model, name -> validator (takes the section's value,
+      returns the validated value or raises SceneError naming the bad key); e.g. the catenary's `[pantograph]`.
     - `under_wire(params, effects, engine, timestep) -> pantograph`: a pantograph of this model that the catenary can
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     """
@@ -67,6 +69,7 @@ class ModelSpec:
     modes: Callable[..., Any] | None = None
     freqresp: Callable[..., Any] | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
+    sections: Mapping[str, Callable[[Any], Any]] = field(default_factory=dict)
     cases: str | None = None
     under_wire: Callable[..., Any] | None = None
 

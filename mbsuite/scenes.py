@@ -95,6 +95,7 @@ class Scene:
     outputs: tuple[str, ...] = ()
     solver: SolverSettings = field(default_factory=SolverSettings)
     source: str | None = None
+    sections: Mapping[str, Any] = field(default_factory=dict)  # the model's own extra sections (ModelSpec.sections)
 
     @property
     def spec(self) -> ModelSpec:
@@ -114,6 +115,7 @@ class Scene:
             "input": dict(self.input),
             "outputs": {"signals": list(self.outputs)},
             "solver": dataclasses.asdict(self.solver),
+            **{k: copy.deepcopy(v) for k, v in self.sections.items()},
         }
 
     def replace(self, **sections: Mapping[str, Any] | Any) -> Scene:
@@ -121,9 +123,10 @@ class Scene:
         1e-4})`.
         Scalars (`name`, `description`) replace; mappings are merged key by key."""
         d = self.to_dict()
+        valid = [*TOP_KEYS[1:], *self.spec.sections]
         for key, val in sections.items():
-            if key not in TOP_KEYS or key == "model":
-                raise SceneError(f"cannot replace scene section {key!r}; valid sections: {list(TOP_KEYS[1:])}")
+            if key not in valid:
+                raise SceneError(f"cannot replace scene section {key!r}; valid sections: {valid}")
             if key == "outputs" and not isinstance(val, Mapping):
                 val = {"signals": list(val)}
             if isinstance(val, Mapping):
@@ -139,12 +142,13 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones."""
     where = f" in {source}" if source else ""
     data = copy.deepcopy(dict(data))
-    unknown = sorted(set(data) - set(TOP_KEYS))
-    if unknown:
-        raise SceneError(f"unknown scene key(s) {unknown}{where}; valid keys: {list(TOP_KEYS)}")
     if "model" not in data:
         raise SceneError(f"scene{where} does not name a model; valid models: {sorted(models())}")
     spec = get_model(data["model"])
+    unknown = sorted(set(data) - set(TOP_KEYS) - set(spec.sections))
+    if unknown:
+        raise SceneError(f"unknown scene key(s) {unknown}{where}; valid keys: {[*TOP_KEYS, *spec.sections]}")
+    extra = {k: spec.sections[k](data[k]) for k in spec.sections if k in data}
 
     effects_in = data.get("effects") or {}
     if not isinstance(effects_in, Mapping):
@@ -208,6 +212,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         outputs=signals,
         solver=solver,
         source=source,
+        sections=extra,
     )
     scene.build_params()  # parameter dataclasses validate themselves (negative mass etc.)
     return scene

@@ -8,7 +8,6 @@ input's fundamental (degrees, negative = lag).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,8 +28,6 @@ from .reference import PantographConfig, PantographODE, simulate
 UNITS = {
     "F1": "m", "F2": "m", "HD": "m", "y_d": "m", "y_w": "m", "theta1": "rad", "theta2": "rad", "thetah": "rad",
     "theta_e": "rad", "elbow_windup": "rad", "contact_force": "N", "cylinder_force": "N", "cylinder_state": "m or Pa",
-    # under a catenary (input type "catenary"): the FE model's signals
-    "position": "m", "head_height": "m", "wire_height": "m", "contact_force_filtered": "N",
 }
 FR_SIGNALS = ("F1", "F2", "HD", "y_d")
 THESIS_RESONANCES_SIM = (4.25, 8.75, 19.5)
@@ -130,45 +127,10 @@ def _contact_losses(t: np.ndarray, fc: np.ndarray) -> list[dict]:
     return ev
 
 
-def run_under_catenary(scene: Scene) -> SimResult:
-    """The same pantograph scene under the EN 50318 finite-element catenary instead of the ram (input type
-    "catenary"): effects, parameters and engine are the scene's; the catenary's contact spring replaces ks. The
-    reference path uses the smooth Coulomb law there (event-exact stick/slip needs an adaptive integrator, the coupled
-    scheme is fixed-step). Statistics (EN 50318 procedure) are in `stats`; contact losses in `events`."""
-    from ..catenary.analysis import simulate as catenary_simulate
-    from ..catenary.analysis import to_simresult
-    from ..catenary.eppinger import EppingerMujoco, EppingerReference
-    from ..catenary.params import CatenaryParams
-
-    inp = scene.input
-    dt = float(inp.get("timestep", 1e-4))
-    effects = dict(scene.effects)
-    contact = effects.pop("contact")
-    if scene.solver.engine == "reference":
-        if effects["coulomb"] is True:
-            effects["coulomb"] = "smooth"
-        panto = EppingerReference(dict(scene.params), effects)
-    else:
-        panto = EppingerMujoco(dict(scene.params), effects, timestep=dt)
-    cp = CatenaryParams(element_length=float(inp.get("element_length", 0.5)))
-    speed = float(inp.get("speed", 250.0))
-    stretch = speed / 3.6 * scene.solver.duration
-    if cp.x_start + stretch < cp.x_end:  # a shorter duration runs a shorter stretch of line (statistics over 20-90 %)
-        cp = dataclasses.replace(cp, x_end=cp.x_start + stretch, window_start=cp.x_start + 0.2 * stretch,
-                                 window_end=cp.x_start + 0.9 * stretch)
-    run_ = catenary_simulate(cp, speed, dt, dropper_law=str(inp.get("droppers", "slack")), pantograph=panto,
-                             contact=contact)
-    res = to_simresult(run_, None)
-    res.scene = scene.to_dict()
-    res.stats["static_contact_force"] = run_.static_force
-    return res
-
-
 def run(scene: Scene) -> SimResult:
-    """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference"), under the ram of the
-    thesis' lab (input sine/step/static) or under a finite-element catenary (input catenary)."""
-    if scene.input.get("type") == "catenary":
-        return run_under_catenary(scene)
+    """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference") under the ram of the
+    thesis' lab (input sine/step/static). Under a finite-element catenary the pantograph runs as a catenary scene
+    (`under_wire.py` implements the catenary's protocol)."""
     p = scene.build_params()
     cfg = config_of(scene)
     ode = PantographODE(p, cfg)

@@ -1,11 +1,11 @@
-"""The hard-case registry: situations that break naive multibody codes, each with the scene that provokes it and what
+"""The hard-case harness: situations that break naive multibody codes, each with the scene that provokes it and what
 must hold (no NaN/inf, bounded work in steps or RHS calls, bounded closure residual, bounded energy drift, correct
 detection and reporting).
 
-Every entry calls the models' own machinery (scenes through `mbsuite.run`, or the model modules' public functions);
-nothing here re-implements physics. `mbsuite hardcases` lists the registry; `mbsuite hardcases --run` runs it and
-prints what was measured against each bound; `tests/suite/test_hardcases.py` runs every entry (entries marked slow
-only under `pytest -m slow`). Bounds are stated with the numbers measured when they were set (README-style comments).
+Each model declares its own cases (`HARD_CASES` in the module named by its `ModelSpec.cases`); this module names no
+model: it holds the `HardCase`/`Checker` machinery, collects the registry from the models and runs cases.
+`mbsuite hardcases` lists the registry; `mbsuite hardcases --run` runs it and prints what was measured against each
+bound; `tests/suite/test_hardcases.py` runs every entry (entries marked slow only under `pytest -m slow`).
 """
 
 from __future__ import annotations
@@ -117,125 +117,39 @@ def run_case(case: HardCase) -> Outcome:
     return Outcome(case, ck.checks, ck.measured)
 
 
-# ================================================================================================ pantograph
-def _pantograph_stick_slip(ck: Checker) -> None:
-    from . import load_scene, run
-    from .analysis.harmonic import fundamental
+def registry() -> tuple[HardCase, ...]:
+    """Every model's hard cases (`HARD_CASES` of the module named by its `ModelSpec.cases`), in model order."""
+    from .registry import models
 
-    sc = load_scene("pantograph").replace(input={"frequency": 2.0}, solver={"duration": 4.0, "t_settle": 2.0})
-    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
-    mj = run(sc)
-    sticks = sum(1 for e in ref.events if e["kind"] == "stick")
-    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
-    ck.ge("stick events in 4 s (the head joint sticks twice per cycle)", sticks, 8)
-    ck.le("reference RHS calls (no stall at the sign change)", ref.stats["nfev"], 50_000)
-    ck.le("reference smooth segments", ref.stats["segments"], 500)
-    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
-    a, b = fundamental(mj.t, mj["F1"], 2.0, 2.0), fundamental(ref.t, ref["F1"], 2.0, 2.0)
-    ck.le("|F1| MuJoCo frictionloss vs event-exact reference, relative", abs(abs(a) / abs(b) - 1), 0.02)
-
-
-def _pantograph_orifice_dp0(ck: Checker) -> None:
-    from . import load_scene, run
-
-    sc = load_scene("pantograph/nonlinear_cylinder").replace(solver={"duration": 2.0, "t_settle": 1.0})
-    ref = run(sc.replace(solver={"engine": "reference"}))
-    mj = run(sc)
-    P = ref["cylinder_state"] if "cylinder_state" in ref.signals else None
-    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
-    ck.le("reference RHS calls starting at P = Ps (dp = 0)", ref.stats["nfev"], 50_000)
-    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
-    if P is not None:
-        ck.true("cylinder pressure stays positive", bool(np.min(P) > 0), float(np.min(P)))
+    out: list[HardCase] = []
+    for name, spec in sorted(models().items()):
+        suite = spec.suite()
+        for c in getattr(suite, "HARD_CASES", ()):
+            if c.model != name:
+                raise MbsuiteError(f"hard case {c.name!r} is declared by model {name!r} but names model {c.model!r}")
+            out.append(c)
+    names = [c.name for c in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise MbsuiteError(f"hard case names must be unique; repeated: {dup}")
+    return tuple(out)
 
 
-def _pantograph_orifice_choked(ck: Checker) -> None:
-    from .models.pantograph.reference import PantographODE
-
-    ode = PantographODE(cylinder="nonlinear")
-    p = ode.p
-    flows = np.array([ode.orifice_mass_flow(r * p.Ps) for r in np.linspace(0.05, 1.5, 2901)])
-    ck.finite("orifice flow over 0.05-1.5 Ps", flows)
-    ck.true("inflow below Ps, outflow above, zero at Ps",
-            ode.orifice_mass_flow(0.9 * p.Ps) > 0 > ode.orifice_mass_flow(1.1 * p.Ps)
-            and ode.orifice_mass_flow(p.Ps) == 0.0)
-    choked = [ode.orifice_mass_flow(r * p.Ps) for r in (0.1, 0.3, 0.5)]
-    ck.le("choked plateau: flow independent of Pd/Pu < 0.528 (relative spread)", np.ptp(choked) / choked[0], 1e-12)
-    r = 0.528
-    ck.le("continuity at the choke ratio 0.528 (relative jump)",
-          abs(ode.orifice_mass_flow(r * p.Ps * (1 - 1e-9)) / ode.orifice_mass_flow(r * p.Ps * (1 + 1e-9)) - 1),
-          1e-6)
-    edge = p.r_laminar * p.Ps
-    ck.le("continuity at the laminar band edge (relative jump)",
-          abs(ode.orifice_mass_flow(edge * (1 - 1e-12)) / ode.orifice_mass_flow(edge * (1 + 1e-12)) - 1), 1e-6)
-    slope = np.diff(flows) / np.diff(np.linspace(0.05, 1.5, 2901) * p.Ps)
-    ck.finite("finite slope d(mdot)/dP everywhere (Lipschitz RHS near dp = 0)", slope)
+def cases(model: str | None = None, include_slow: bool = True) -> list[HardCase]:
+    out = [c for c in registry() if (model is None or c.model == model) and (include_slow or not c.slow)]
+    if model is not None and not out:
+        raise MbsuiteError(f"no hard cases for model {model!r}; models: {sorted({c.model for c in registry()})}")
+    return out
 
 
-def _pantograph_unilateral(ck: Checker) -> None:
-    from . import load_scene, run
-
-    sc = load_scene("pantograph/unilateral").replace(solver={"duration": 4.0, "t_settle": 2.0})
-    mj = run(sc)
-    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
-    lm = [e for e in mj.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
-    lr = [e for e in ref.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
-    ck.finite("outputs", *mj.signals.values(), *ref.signals.values())
-    ck.ge("contact losses detected (reference, 2-4 s)", len(lr), 8)
-    ck.le("|losses MuJoCo - reference|", abs(len(lm) - len(lr)), 1)
-    ck.true("contact force never negative (push-only)", min(np.min(mj["contact_force"]),
-                                                            np.min(ref["contact_force"])) >= 0.0)
-    tot_m, tot_r = sum(e["duration"] for e in lm), sum(e["duration"] for e in lr)
-    ck.le("total loss time MuJoCo vs reference, relative", abs(tot_m / tot_r - 1) if tot_r else math.inf, 0.1)
+def get(name: str) -> HardCase:
+    for c in registry():
+        if c.name == name:
+            return c
+    raise MbsuiteError(f"unknown hard case {name!r}; valid: {[c.name for c in registry()]}")
 
 
-def _pantograph_big_step(ck: Checker) -> None:
-    from . import load_scene, run
-
-    sc = load_scene("pantograph").replace(solver={"timestep": 0.02, "duration": 2.0, "t_settle": 1.0})
-    for integ in ("euler", "implicitfast"):
-        ck.raises(f"{integ} at h = 0.02 s: SolverError telling to reduce the step",
-                  lambda i=integ: run(sc.replace(solver={"integrator": i})), SolverError, "reduce solver.timestep")
-    res = run(sc.replace(solver={"integrator": "rk4"}))
-    ck.finite("RK4 at h = 0.02 s", *res.signals.values())
-
-
-def _pantograph_energy_100s(ck: Checker) -> None:
-    import mujoco
-
-    from .engines.mujoco_engine import callbacks
-    from .models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
-    from .models.pantograph.mujoco import MujocoPantograph
-    from .models.pantograph.reference import PantographConfig, PantographODE
-
-    cfg = PantographConfig(cylinder="constant", viscous=False, coulomb=False)
-    ode = PantographODE(config=cfg)
-    x0 = ode.equilibrium()
-    x0[3:6] = [0.05, -0.03, 0.1]
-    y_w = 1.58
-    E0 = ode.energy(x0, y_w)
-    mp = MujocoPantograph(config=cfg, integrator="rk4", timestep=1e-3)
-    m, d = mp.model, mp.data
-    mujoco.mj_resetData(m, d)
-    d.qpos[:] = theta_to_q(x0[:3])
-    d.qvel[:] = np.linalg.solve(E_THETA_Q, x0[3:6])
-    d.ctrl[:] = y_w
-    drift = []
-    with callbacks(**mp.callback_set()):
-        mujoco.mj_forward(m, d)
-        for k in range(100_000):
-            mujoco.mj_step(m, d)
-            if k % 1000 == 999:
-                drift.append(ode.energy(np.r_[q_to_theta(d.qpos), E_THETA_Q @ d.qvel], y_w) - E0)
-    drift = np.abs(np.array(drift))
-    ck.finite("state after 100 s", d.qpos, d.qvel)
-    ck.le("energy drift over 100 s, MuJoCo RK4 1 ms, no damping (J)", drift.max(), 1e-3)
-    # RK4 is not symplectic: its energy error grows linearly (measured 1.6e-4 J at 100 s, ratio 9.4 = linear from 0);
-    # faster growth (quadratic: ratio ~100, exponential) would be an instability
-    ck.le("drift last 10 s / first 10 s (linear growth gives ~10; faster growth fails)",
-          drift[-10:].max() / (drift[:10].max() + 1e-9), 15.0)
-
-
+# ---- TRANSITIONAL: the coupler, drives and catenary cases below move to their models' cases modules ----
 # ================================================================================================ coupler
 def _coupler_ey_to_zero(ck: Checker) -> None:
     from .models.coupler import reference as ref
@@ -456,88 +370,6 @@ def _drives_energy_balance(ck: Checker) -> None:
                 res.stats["energy_balance"]["relative"]), 1e-4)
 
 
-# ================================================================================================ iftomm
-def _iftomm_fourbar(ck: Checker) -> None:
-    from scipy.integrate import solve_ivp
-
-    from . import load_scene, run
-
-    sc = load_scene("iftomm/fourbar")
-    mj = run(sc)
-    ref = run(sc.replace(solver={"engine": "reference", "rtol": 1e-10, "atol": 1e-12}))
-    # independent closed form on the parallelogram branch: M = (1/3 + 1/3 + 1) m L^2, V = 2 m g L sin(psi)
-    g = 9.81
-    an = solve_ivp(lambda t, x: [x[1], -1.2 * g * math.cos(x[0])], (0, ref.t[-1]), [math.pi / 2, 6.0],
-                   method="DOP853", rtol=1e-12, atol=1e-12, t_eval=ref.t)
-    ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
-    turns = (mj["input_angle"][-1] - mj["input_angle"][0]) / (2 * math.pi)
-    ck.ge("crank turns in 10 s (2 singular positions per turn)", turns, 10)
-    ck.le("Pinocchio (branch-reduced) vs closed form, crank angle (rad)",
-          np.max(np.abs(ref["input_angle"] + math.pi / 2 - an.y[0])), 1e-6)
-    ck.le("MuJoCo stays on the parallelogram branch: max |coupler angle| (rad)", mj.stats["branch_angle_max"], 0.01)
-    ck.le("MuJoCo closure residual (m)", mj.stats["closure_residual_max"], 2e-4)
-    # measured 0.36 J of 30 J kinetic energy: the soft closure (solref 4 ms, damping ratio 1) dissipates
-    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.5)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-6)
-    ck.le("MuJoCo vs Pinocchio crank angle over the first 2 s (rad)",
-          np.max(np.abs(mj["input_angle"] - ref["input_angle"])[mj.t <= 2.0]), 0.05)
-    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
-
-
-def _iftomm_bricard(ck: Checker) -> None:
-    from . import load_scene, run
-    from .models.iftomm.mechanisms import closure_jacobian_rank, mujoco_model
-
-    sc = load_scene("iftomm/bricard")
-    mj = run(sc)
-    ref = run(sc.replace(solver={"engine": "reference"}))
-    m = mujoco_model("bricard", 1e-3, "rk4", 0.004, 9.81)
-    rank0, s0 = closure_jacobian_rank(m, np.zeros(m.nq))
-    ck.true("closure Jacobian: 6 rows, rank 4 on 5 joints -> 1 DOF (Gruebler: 0), detected by SVD",
-            rank0 == 4 and m.nv - rank0 == 1, (rank0, np.round(s0, 6).tolist()))
-    ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
-    ck.ge("it moves: range of joint 1 (rad)", np.ptp(ref["input_angle"]), 0.5)
-    ck.le("Pinocchio closure residual (m)", ref.stats["closure_residual_max"], 1e-6)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-3)
-    ck.le("MuJoCo closure residual with redundant rows (m)", mj.stats["closure_residual_max"], 5e-4)
-    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.1)
-    ck.le("MuJoCo vs Pinocchio joint 1 over 10 s (rad)", np.max(np.abs(mj["input_angle"] - ref["input_angle"])), 0.15)
-    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.stats["branch_angle_max"], 1e-5)
-    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
-
-
-def _iftomm_drift_100s(ck: Checker) -> None:
-    import mujoco
-
-    from .analysis.sweep import get_state, rollout_sweep
-    from .models.iftomm.mechanisms import initial_velocity, mujoco_model
-
-    for mech, rate in (("fourbar", 6.0), ("bricard", 0.0)):
-        m = mujoco_model(mech, 1e-3, "rk4", 0.004, 9.81)
-        d = mujoco.MjData(m)
-        d.qvel[:] = initial_velocity(m, rate)
-        mujoco.mj_forward(m, d)
-        E0 = float(d.energy.sum())
-        state, _ = rollout_sweep(m, get_state(m, d)[None, :], np.zeros((1, 100_000, m.nu)), workers=1)
-        qs = state[0, ::100, 1:1 + m.nq]
-        res, en = [], []
-        for x in state[0, ::100]:
-            mujoco.mj_setState(m, d, x, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-            mujoco.mj_forward(m, d)
-            rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-            res.append(float(np.max(np.abs(d.efc_pos[rows]))))
-            en.append(float(d.energy.sum()) - E0)
-        res, en = np.array(res), np.array(en)
-        ck.finite(f"{mech}: 100 s state", state[0, -1])
-        ck.le(f"{mech}: closure residual over 100 s (m)", res.max(), 5e-4)
-        ck.le(f"{mech}: closure residual last 10 s / first 10 s (no drift)", res[-100:].max() / res[:100].max(), 2.0)
-        ck.true(f"{mech}: energy only dissipated (soft closure damping), never gained beyond 1e-6 J",
-                bool(en.max() <= 1e-6), float(en.max()))
-        if mech == "fourbar":
-            ck.le("fourbar: branch kept for 100 s, max |coupler angle| (rad)", float(np.max(np.abs(
-                qs[:, 0] + qs[:, 1]))), 0.02)
-
-
 # ================================================================================================ catenary
 def _catenary_critical_speed(ck: Checker) -> None:
     from .models.catenary.analysis import CriticalSpeedWarning, speed_regime
@@ -557,35 +389,8 @@ def _catenary_critical_speed(ck: Checker) -> None:
     ck.true("50 % of c: no warning, subcritical", not w and info["regime"] == "subcritical")
 
 
-REGISTRY: tuple[HardCase, ...] = (
-    HardCase("pantograph_stick_slip_2hz", "pantograph",
-             "Coulomb stick/slip every half cycle: sign() chatter stalls adaptive solvers",
-             "pantograph/lab at 2 Hz, 4 s, both engines",
-             "no NaN; >= 8 stick events; reference RHS calls <= 5e4, segments <= 500; no MuJoCo warning; "
-             "|F1| MuJoCo vs exact within 2 %", _pantograph_stick_slip),
-    HardCase("pantograph_orifice_dp0", "pantograph",
-             "orifice law at dp -> 0: unbounded slope of the turbulent law at P = Ps",
-             "pantograph/nonlinear_cylinder from P = Ps, 2 s, both engines",
-             "no NaN; reference RHS calls <= 5e4; pressure > 0; no MuJoCo warning", _pantograph_orifice_dp0),
-    HardCase("pantograph_orifice_choked", "pantograph",
-             "choked flow below Pd/Pu = 0.528 and the laminar band: branch switches of the orifice law",
-             "PantographODE(cylinder='nonlinear').orifice_mass_flow over 0.05-1.5 Ps",
-             "finite flow and slope; flow sign; choked plateau flat to 1e-12; continuous at 0.528 and the band edge",
-             _pantograph_orifice_choked),
-    HardCase("pantograph_unilateral_contact", "pantograph",
-             "push-only contact: non-smooth force, repeated contact loss and impact",
-             "pantograph/unilateral (2.5 mm at 4.25 Hz), 4 s, both engines",
-             "losses detected (>= 8), counts agree within 1, total loss time within 10 %, force >= 0",
-             _pantograph_unilateral),
-    HardCase("pantograph_over_large_timestep", "pantograph",
-             "explicit/semi-implicit integration far above the stable step",
-             "pantograph/lab at h = 0.02 s with euler, implicitfast, rk4",
-             "euler/implicitfast: SolverError 'reduce solver.timestep' (not garbage); rk4 finite",
-             _pantograph_big_step),
-    HardCase("pantograph_energy_drift_100s", "pantograph",
-             "long-time energy drift of a conservative 3-DOF system with callbacks",
-             "pantograph, constant cylinder, no damping/friction, RK4 1 ms, 100 s",
-             "energy drift <= 1e-3 J; growth no faster than linear", _pantograph_energy_100s),
+
+_TRANSITIONAL_ENTRIES = (
     HardCase("coupler_ey_to_zero", "coupler",
              "coplanar platforms e_y -> 0: the mechanism Jacobian loses rank (cond ~ 1/e_y)",
              "single coupler Jacobian at e_y = 1e-1 ... 1e-8 and 0",
@@ -644,38 +449,9 @@ REGISTRY: tuple[HardCase, ...] = (
              "energy bookkeeping through locks, slips and controller switching",
              "drives/step_up_pwm and drives/susd_500w_open, 0.5 s, both paths",
              "|input - output - losses - stored| <= 1e-4 of the input; no NaN", _drives_energy_balance),
-    HardCase("iftomm_fourbar_singular", "iftomm",
-             "A02: all bars collinear twice per turn; the closure Jacobian loses rank and the parallelogram may "
-             "switch to the anti-parallelogram branch",
-             "iftomm/fourbar, 10 s, MuJoCo and Pinocchio",
-             ">= 10 turns; stays on branch (|coupler angle| <= 0.01 rad); closure <= 2e-4 m; energy drift <= 0.5 J "
-             "(MuJoCo) / 1e-6 J (Pinocchio); Pinocchio = closed form to 1e-6 rad", _iftomm_fourbar),
-    HardCase("iftomm_bricard_overconstrained", "iftomm",
-             "A04: over-constrained loop (Gruebler 0 DOF, real 1 DOF): redundant closure rows",
-             "iftomm/bricard, 10 s, MuJoCo and Pinocchio",
-             "rank 4 of 6 rows detected; closure <= 5e-4 m (MuJoCo) / 1e-6 m (Pinocchio); energy drift <= 0.1 / "
-             "1e-3 J; paths agree within 0.15 rad", _iftomm_bricard),
-    HardCase("iftomm_drift_100s", "iftomm",
-             "100 s of soft closures through singular positions and redundant rows",
-             "iftomm fourbar and bricard, MuJoCo RK4 1 ms via mujoco.rollout, 100 s",
-             "closure <= 5e-4 m without growth; energy never gained; four-bar stays on its branch",
-             _iftomm_drift_100s),
     HardCase("catenary_critical_speed", "catenary",
              "train speed approaching the contact wire's wave speed: no steady solution",
              "catenary speed regime at 50 %, 95 %, 100 % of sqrt(T/rho)",
              "ParameterError at c; CriticalSpeedWarning near c; nothing at 50 %", _catenary_critical_speed),
+
 )
-
-
-def cases(model: str | None = None, include_slow: bool = True) -> list[HardCase]:
-    out = [c for c in REGISTRY if (model is None or c.model == model) and (include_slow or not c.slow)]
-    if model is not None and not out:
-        raise MbsuiteError(f"no hard cases for model {model!r}; models: {sorted({c.model for c in REGISTRY})}")
-    return out
-
-
-def get(name: str) -> HardCase:
-    for c in REGISTRY:
-        if c.name == name:
-            return c
-    raise MbsuiteError(f"unknown hard case {name!r}; valid: {[c.name for c in REGISTRY]}")

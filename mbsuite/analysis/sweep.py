@@ -1,19 +1,22 @@
 """One sweep API for every analysis: evaluate `fn(point)` over points, in parallel on all local cores by default.
 
     run_sweep(fn, points, workers=0, progress=None, desc="sweep")            # local processes (all cores)
+    run_sweep(fn, points, executor="threads")                                # C threads of the native core
     run_sweep(fn, points, executor="dask", scheduler="tcp://host:8786")     # a Dask distributed cluster
     run_sweep(fn, points, store="out/sweep.jsonl")                           # stream to disk; resume after a crash
 
 Executors
 - `local` (default): a process pool (fork) with `workers` processes (0 = all cores available to this process);
-  `workers=1` runs serially in this process. Processes, not threads: MuJoCo's Python callbacks are process-global and
-  hold the GIL.
-- `dask`: `distributed.Client(scheduler)` (an address, or a `Client`/`LocalCluster` object). Each call of `fn` holds a
-  per-process lock, so a worker started with several threads still runs one simulation at a time (callbacks are
-  process-global); start workers with `--nthreads 1` and one worker per core. `fn` and the points travel by cloudpickle,
-  results come back pickled: bit-identical to the local executor.
-- `rollout_sweep` (below) is the third way for scenes that install no Python callback: `mujoco.rollout` steps a batch of
-  open-loop trajectories in C threads (no GIL, no process start-up).
+  `workers=1` runs serially in this process. For work that is Python: the hand-derived paths.
+- `threads`: a thread pool in this process. For MuJoCo work: the native core (`mbsuite.engines.core`) releases the
+  GIL while it steps and keeps no global state, so each thread steps its own MjData in C, with no process start-up
+  and nothing pickled (the pantograph's frequency sweep runs its MuJoCo points this way).
+- `dask`: `distributed.Client(scheduler)` (an address, or a `Client`/`LocalCluster` object). `fn` and the points
+  travel by cloudpickle, results come back pickled: bit-identical to the local executor.
+- `rollout_sweep` (below): `mujoco.rollout` steps a batch of open-loop trajectories in C threads; mbsuite's engine
+  plugins run under it (a test holds it bitwise equal to the native core).
+MuJoCo's Python callbacks (`mujoco.set_mjcb_*`) are process-global: work that installs one (mbsuite's shipped scenes
+never do) must not share a process between threads.
 
 Results always come back in the order of `points`, whatever the executor and completion order.
 
@@ -38,30 +41,19 @@ import json
 import multiprocessing as mp
 import os
 import pickle
-import threading
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..engines.core import n_workers
 from ..errors import MbsuiteError, SceneError
 from ..results import Progress, to_jsonable
 
-EXECUTORS = ("local", "dask")
+EXECUTORS = ("local", "threads", "dask")
 _defaults: dict[str, Any] = {"executor": "local", "scheduler": None, "store": None}
-_call_lock = threading.Lock()
-
-
-def n_workers(workers: int = 0) -> int:
-    """0 = all cores available to this process."""
-    if workers and workers > 0:
-        return workers
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - non-Linux
-        return os.cpu_count() or 1
 
 
 @contextlib.contextmanager
@@ -81,6 +73,11 @@ def sweep_options(executor: str | None = None, scheduler: Any = None,
     finally:
         _defaults.clear()
         _defaults.update(saved)
+
+
+def current_executor() -> str:
+    """The executor a `run_sweep` call without its own `executor` would use (set by `sweep_options`)."""
+    return _defaults["executor"]
 
 
 def _check_executor(executor: str, scheduler: Any) -> None:
@@ -144,12 +141,6 @@ def _json_view(result: Any) -> Any:
 
 
 # ------------------------------------------------------------------------------------------------------ executors
-def _locked_call(fn: Callable[[Any], Any], point: Any) -> Any:
-    """Run fn(point) holding this process's lock (MuJoCo callbacks are process-global: one simulation at a time)."""
-    with _call_lock:
-        return fn(point)
-
-
 def _dask_client(scheduler: Any):
     try:
         from distributed import Client
@@ -171,6 +162,8 @@ def run_sweep(fn: Callable[[Any], Any], points: Sequence[Any], *, workers: int =
     `workers`: local processes (0 = all cores; 1 = serial in this process). `executor`: "local" or "dask" (then
     `scheduler` = address or Client). `store`: JSON-lines file to stream results to and resume from."""
     executor = executor or _defaults["executor"]
+    if executor == "threads" and _defaults["executor"] == "dask":
+        executor = "dask"  # a cluster was asked for: it wins over a caller's local preference
     scheduler = scheduler if scheduler is not None else _defaults["scheduler"]
     store = store if store is not None else _defaults["store"]
     _check_executor(executor, scheduler)
@@ -201,8 +194,7 @@ def run_sweep(fn: Callable[[Any], Any], points: Sequence[Any], *, workers: int =
             try:
                 from distributed import as_completed as dask_completed
 
-                futs = {client.submit(_locked_call, fn, points[i], key=f"{desc}-{keys[i]}", pure=False): i
-                        for i in todo}
+                futs = {client.submit(fn, points[i], key=f"{desc}-{keys[i]}", pure=False): i for i in todo}
                 for fut in dask_completed(list(futs)):
                     finish(futs[fut], fut.result())
             finally:
@@ -214,7 +206,9 @@ def run_sweep(fn: Callable[[Any], Any], points: Sequence[Any], *, workers: int =
             for i in todo:
                 finish(i, fn(points[i]))
             return results
-        with ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("fork")) as ex:
+        pool = (ThreadPoolExecutor(max_workers=nw) if executor == "threads"
+                else ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("fork")))
+        with pool as ex:
             futs = {ex.submit(fn, points[i]): i for i in todo}
             try:
                 for fut in as_completed(futs):

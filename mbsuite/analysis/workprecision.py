@@ -1,6 +1,8 @@
 """Work-precision studies: what accuracy costs in wall time, for every engine and method of a scene.
 
-`workprecision(scene)` (CLI: `mbsuite workprecision SCENE [--out DIR] [--json]`) runs the scene's study:
+`workprecision(scene)` (CLI: `mbsuite workprecision SCENE [--out DIR] [--json]`) runs the study the scene's model
+declares (`workprecision_study(scene, quick)` in the module named by its `ModelSpec.cases`); this module names no model.
+The studies:
 
 - pantograph scenes: MuJoCo timestep x integrator (euler, implicitfast, implicit, rk4, discrete) and the hand-derived
   path with scipy methods x rtol. Reference: Radau at rtol 1e-12 (its own accuracy is measured against DOP853 at
@@ -45,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import MbsuiteError, SceneError
+from ..errors import MbsuiteError
 from ..results import Report, format_table, write_csv
 from ..scenes import Scene
 
@@ -113,81 +115,6 @@ class Study:
 
     def physics_error(self, res: Any, ref: Any) -> tuple[float, dict]:
         raise NotImplementedError
-
-
-# ================================================================================================ pantograph
-class PantographStudy(Study):
-    SIGNALS = ("F1", "F2", "HD", "y_d")
-    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4", "discrete")
-    MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5)
-    SCIPY = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "RK45": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8, 1e-10),
-             "LSODA": (1e-4, 1e-6, 1e-8, 1e-10), "BDF": (1e-4, 1e-6, 1e-8)}
-    state_doc = "max_t |F1, F2, HD, y_d - ref| / A (A = input amplitude), t >= t_settle, 1 ms grid"
-    physics_doc = ("max(rel. amplitude error F1, HD; phase error F1, HD in rad at the forcing frequency; rel. error of "
-                   "contact-force mean and std)")
-
-    def __init__(self, scene: Scene, quick: bool = False, frequency: float | None = None, duration: float = 3.0):
-        super().__init__(scene, quick)
-        inp = dict(scene.input)
-        if inp.get("type", "sine") != "sine":
-            raise SceneError("the pantograph work-precision study needs a sine input")
-        self.f = float(frequency or inp.get("frequency", 4.25))
-        T = 1.0 if quick else duration
-        self.ts = T / 2
-        self.base = scene.replace(effects={"coulomb": False}, input={"frequency": self.f},
-                                  outputs=[*self.SIGNALS, "y_w", "contact_force"],
-                                  solver={"duration": T, "t_settle": self.ts, "sample_dt": 1e-3,
-                                          "max_step": 1.0 / (16 * self.f)})
-        self.A = float(self.base.input.get("amplitude", 1.85e-3))
-
-    def _run(self, **solver):
-        from .. import run
-
-        sc = self.base.replace(solver=solver)
-        return lambda: run(sc)
-
-    def settings(self) -> list[Setting]:
-        out = []
-        integ = ("implicitfast", "rk4") if self.quick else self.MJ_INTEGRATORS
-        steps = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
-        for i in integ:
-            for h in steps:
-                out.append(Setting("mujoco", i, h, self._run(engine="mujoco", integrator=i, timestep=h)))
-        meth = {"DOP853": (1e-4, 1e-6)} if self.quick else self.SCIPY
-        for mth, rtols in meth.items():
-            for r in rtols:
-                out.append(Setting("reference", mth, r, self._run(engine="reference", method=mth, rtol=r,
-                                                                   atol=r * 1e-2)))
-        return out
-
-    def reference(self):
-        from .. import run
-
-        ref = run(self.base.replace(solver={"engine": "reference", "method": "Radau", "rtol": 1e-12, "atol": 1e-14}))
-        chk = run(self.base.replace(solver={"engine": "reference", "method": "DOP853", "rtol": 1e-12, "atol": 1e-14}))
-        err, det = self.physics_error(chk, ref)
-        return ref, {"reference": "scipy Radau rtol 1e-12, atol 1e-14",
-                     "check": "scipy DOP853 rtol 1e-12", "check_state_error": self.state_error(chk, ref),
-                     "check_physics_error": err}
-
-    def state_error(self, res, ref) -> float:
-        m = ref.t >= self.ts
-        grid = ref.t[m]
-        return max(float(np.max(np.abs(np.interp(grid, res.t, res[s]) - ref[s][m]))) / self.A for s in self.SIGNALS)
-
-    def physics_error(self, res, ref):
-        from .harmonic import fundamental
-
-        det = {}
-        for s in ("F1", "HD"):
-            a, b = fundamental(res.t, res[s], self.f, self.ts), fundamental(ref.t, ref[s], self.f, self.ts)
-            det[f"{s}_amp_rel"] = abs(abs(a) / abs(b) - 1.0)
-            det[f"{s}_phase_rad"] = abs(float(np.angle(a / b)))
-        fr, fc = ref["contact_force"][ref.t >= self.ts], res["contact_force"][res.t >= self.ts]
-        sd = float(np.std(fr)) or 1.0
-        det["Fc_mean_rel"] = abs(float(np.mean(fc)) - float(np.mean(fr))) / abs(float(np.mean(fr)))
-        det["Fc_std_rel"] = abs(float(np.std(fc)) - sd) / sd
-        return max(det.values()), det
 
 
 # ================================================================================================ coupler
@@ -394,70 +321,25 @@ class DrivesStudy(Study):
         return (max(vals) if vals else math.nan), det
 
 
-# ================================================================================================ iftomm
-class FourbarStudy(Study):
-    MJ_INTEGRATORS = ("euler", "implicitfast", "rk4")
-    MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4)
-    PIN = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "LSODA": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8)}
-    state_doc = "max_t |crank angle - ref| / 1 rad, 10 s through 24 singular positions"
-    physics_doc = ("max(rel. error of the crank's turns in 10 s, max closure residual / L, |energy drift| / E_kin(0), "
-                   "max |coupler angle| (branch))")
-
-    def __init__(self, scene: Scene, quick: bool = False):
-        super().__init__(scene, quick)
-        if scene.effects["mechanism"] != "fourbar":
-            raise MbsuiteError("the IFToMM work-precision study covers the four-bar (closed-form reference); the "
-                               "Bricard has none (its hard case compares MuJoCo with Pinocchio)")
-        T = 2.0 if quick else 10.0
-        self.base = scene.replace(solver={"duration": T, "sample_dt": 1e-2})
-        self.rate = float(scene.input.get("rate", 6.0))
-        self.g = float(scene.build_params().gravity)
-
-    def settings(self) -> list[Setting]:
-        from .. import run
-
-        out = []
-        for i in (("rk4",) if self.quick else self.MJ_INTEGRATORS):
-            for h in ((1e-3,) if self.quick else self.MJ_STEPS):
-                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
-                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
-        for mth, rtols in ({"DOP853": (1e-6,)} if self.quick else self.PIN).items():
-            for r in rtols:
-                sc = self.base.replace(solver={"engine": "reference", "method": mth, "rtol": r, "atol": r * 1e-2})
-                out.append(Setting("pinocchio", mth, r, lambda sc=sc: run(sc)))
-        return out
-
-    def reference(self):
-        from scipy.integrate import solve_ivp
-
-        t = np.arange(0.0, self.base.solver.duration + 5e-3, 1e-2)
-        g = self.g
-        sol = solve_ivp(lambda _, x: [x[1], -1.2 * g * math.cos(x[0])], (0.0, t[-1]), [math.pi / 2, self.rate],
-                        method="DOP853", rtol=1e-13, atol=1e-13, t_eval=t)
-        self.e_kin0 = 0.5 * (5.0 / 3.0) * self.rate**2
-        return {"t": sol.t, "angle": sol.y[0] - math.pi / 2}, {
-            "reference": "closed form on the parallelogram branch, psi'' = -(6/5) g cos(psi), DOP853 rtol 1e-13"}
-
-    def state_error(self, res, ref) -> float:
-        return float(np.max(np.abs(np.interp(ref["t"], res.t, res["input_angle"]) - ref["angle"])))
-
-    def physics_error(self, res, ref):
-        turns = (res["input_angle"][-1] - res["input_angle"][0]) / (2 * math.pi)
-        turns_ref = (ref["angle"][-1] - ref["angle"][0]) / (2 * math.pi)
-        det = {"turns_rel": _rel(turns, turns_ref), "closure_residual": res.stats["closure_residual_max"],
-               "energy_drift_rel": res.stats["energy_drift_max"] / self.e_kin0,
-               "branch_rad": res.stats["branch_angle_max"]}
-        return max(det.values()), det
+_TRANSITIONAL: dict[str, type[Study]] = {"coupler": CouplerStudy, "drives": DrivesStudy}
 
 
-STUDIES: dict[str, type[Study]] = {"pantograph": PantographStudy, "coupler": CouplerStudy, "drives": DrivesStudy,
-                                   "iftomm": FourbarStudy}
+def available() -> list[str]:
+    """Models that declare a work-precision study (`workprecision_study` in their `ModelSpec.cases` module)."""
+    from ..registry import models
+
+    return sorted(n for n, s in models().items()
+                  if hasattr(s.suite(), "workprecision_study") or n in _TRANSITIONAL)
 
 
 def study_for(scene: Scene, quick: bool = False) -> Study:
-    if scene.model not in STUDIES:
-        raise MbsuiteError(f"no work-precision study for model '{scene.model}'; available: {sorted(STUDIES)}")
-    return STUDIES[scene.model](scene, quick=quick)
+    """The study the scene's model declares (its `ModelSpec.cases` module's `workprecision_study`)."""
+    make = getattr(scene.spec.suite(), "workprecision_study", None)
+    if make is None and scene.model in _TRANSITIONAL:
+        return _TRANSITIONAL[scene.model](scene, quick=quick)
+    if make is None:
+        raise MbsuiteError(f"no work-precision study for model '{scene.model}'; available: {available()}")
+    return make(scene, quick=quick)
 
 
 def cheapest(rows: list[Row], tols=TOLS) -> list[dict]:

@@ -6,7 +6,9 @@ optional native stepper (a model's compiled state machine) acts on the forward, 
 every `every` steps into one preallocated array, the state is integrated with the model's own integrator, and the
 run is checked: MuJoCo's bad-acceleration warning and the faults of mbsuite's plugins every step, finite
 qpos/qvel/act every `check_every` steps and at every recorded row, and every recorded value against the plausibility
-bounds its channel declares. The trajectory is bitwise that of `mj_step` (the core calls what `mj_step` calls).
+bounds its channel declares. MuJoCo's own warnings of a broken state (bad qpos, qvel, qacc or ctrl, full arrays) are
+failures too: MuJoCo would reset or zero the offending values and go on. The trajectory is bitwise that of `mj_step`
+(the core calls what `mj_step` calls).
 
 Inputs:
 - an array: `ctrl` of shape (nstep, len(ctrl_idx)), row k written into `d.ctrl[ctrl_idx]` before step k;
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import os
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -37,7 +40,7 @@ from . import native
 FIELDS = ("time", "qpos", "qvel", "act", "ctrl", "actuator_force", "actuator_length", "actuator_velocity",
           "sensordata", "qfrc_passive", "qfrc_actuator", "energy", "eq_pos", "eq_force", "hook", "site_xpos")
 _FIELD_ID = {f: i for i, f in enumerate(FIELDS)}
-_STATUS = {0: "ok", 1: "non-finite state", 2: "bad acceleration", 3: "plugin fault", 4: "implausible value",
+_STATUS = {0: "ok", 1: "non-finite state", 2: "MuJoCo warning", 3: "plugin fault", 4: "implausible value",
            5: "native stepper error", 6: "invalid arguments"}
 DEFAULT_HINT = "reduce solver.timestep or use an implicit integrator"
 
@@ -243,6 +246,8 @@ class Stepper:
         setting = (f"integrator {mujoco.mjtIntegrator(m.opt.integrator).name[6:].lower()}, timestep "
                    f"{m.opt.timestep:g} s")
         at = f"at t = {job.fail_time:.6g} s"
+        if job.status == 3 and job.fail_time < 0:
+            at = "in the model's configuration (found at load)"
         if job.status == 3:
             inst = job.fail_plugin
             name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PLUGIN, inst) or f"instance {inst}"
@@ -257,6 +262,10 @@ class Stepper:
             return SolverError(f"{self.what}: {self.hook.describe(job.fail_code)} {at} ({setting})")
         if job.status == 6:
             return SolverError(f"{self.what}: invalid arguments to the native core")
+        if job.status == 2:
+            warning = mujoco.mjtWarning(job.fail_code).name[7:].lower()
+            return SolverError(f"{self.what}: MuJoCo diverged (warning {warning}: a non-finite or huge value) {at} "
+                               f"({setting}); {self.hint}")
         return SolverError(f"{self.what}: MuJoCo diverged ({_STATUS.get(job.status, job.status)}) {at} ({setting}); "
                            f"{self.hint}")
 
@@ -264,12 +273,20 @@ class Stepper:
         return float(self._lo[col]), float(self._hi[col])
 
 
+def n_workers(workers: int = 0) -> int:
+    """`workers` if positive, else all cores available to this process."""
+    if workers and workers > 0:
+        return int(workers)
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - non-Linux
+        return os.cpu_count() or 1
+
+
 def map_threads(fn: Callable[[Any], Any], items: Iterable[Any], workers: int = 0) -> list[Any]:
     """`[fn(x) for x in items]` on `workers` threads (0 = all cores). For functions whose work is native-core runs
     (the GIL is released while the core steps), this is a parallel sweep in C threads; results keep the order of
     `items` and are identical to a serial run."""
-    from ..analysis.sweep import n_workers
-
     items = list(items)
     nw = min(n_workers(workers), len(items)) or 1
     if nw <= 1:

@@ -11,8 +11,8 @@ from mbsuite.cli import main
 def test_hardcases_listing_json(capsys):
     assert main(["hardcases", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["counts"]["total"] == len(hardcases.REGISTRY) == len(data["cases"])
-    assert sum(data["counts"]["by_model"].values()) == len(hardcases.REGISTRY)
+    assert data["counts"]["total"] == len(hardcases.registry()) == len(data["cases"])
+    assert sum(data["counts"]["by_model"].values()) == len(hardcases.registry())
     assert {"name", "hard", "scene", "asserts"} <= set(data["cases"][0])
 
 

@@ -8,7 +8,7 @@ from mbsuite import hardcases
 
 CASES = [pytest.param(c, id=c.name, marks=([pytest.mark.slow] if c.slow else [])
                       + ([pytest.mark.xfail(strict=True, reason=c.expected_failure)] if c.expected_failure else []))
-         for c in hardcases.REGISTRY]
+         for c in hardcases.registry()]
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -18,9 +18,9 @@ def test_hard_case(case):
 
 
 def test_registry_is_complete_and_described():
-    names = [c.name for c in hardcases.REGISTRY]
+    names = [c.name for c in hardcases.registry()]
     assert len(names) == len(set(names))
-    for c in hardcases.REGISTRY:
+    for c in hardcases.registry():
         assert c.hard and c.scene and c.asserts, c.name
     # the list: stick-slip (3 kinds), orifice dp -> 0 and choked, coupler e_y -> 0 and e_y < R alpha,
     # phi_bc = pi/2, both clutches locked, mismatch engagement, over-large timesteps, 100 s drift, two IFToMM gates

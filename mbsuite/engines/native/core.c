@@ -5,7 +5,8 @@
  * multiple of `every` (every recorded quantity is then consistent with the state at t_k);  integrate with the
  * model's integrator (mj_Euler / mj_RungeKutta / mj_implicit: what mj_step calls, so the trajectory is bitwise the
  * one of mj_step; the `discrete` integrator, which MuJoCo does not export, goes through mj_step after the
- * forward);  native stepper (POST_STEP);  checks: MuJoCo's bad-acceleration warning and mbsuite plugin faults
+ * forward);  native stepper (POST_STEP);  checks: MuJoCo's warnings of a broken state (bad qpos, qvel, qacc or
+ * ctrl; full constraint arrays) and mbsuite plugin faults
  * every step, finite qpos/qvel/act every `check_every` steps and at every recorded row, plausibility bounds on
  * every recorded value. The first failure stops the run and is reported in the job. */
 #include <math.h>
@@ -210,6 +211,19 @@ static int record(const mjModel* m, const mjData* d, mbs_job* J, long k) {
   return MBS_OK;
 }
 
+/* MuJoCo's warnings that mean the state is garbage: bad qpos/qvel/qacc/ctrl, full constraint or contact arrays */
+static const int bad_warnings[] = {mjWARN_BADQPOS, mjWARN_BADQVEL, mjWARN_BADQACC, mjWARN_BADCTRL, mjWARN_CNSTRFULL,
+                                   mjWARN_CONTACTFULL};
+#define N_BAD_WARNINGS ((int)(sizeof(bad_warnings) / sizeof(bad_warnings[0])))
+
+/* index of the first bad warning whose counter grew since `base`, or -1 */
+static int new_bad_warning(const mjData* d, const int* base) {
+  for (int i = 0; i < N_BAD_WARNINGS; i++) {
+    if (d->warning[bad_warnings[i]].number > base[i]) return bad_warnings[i];
+  }
+  return -1;
+}
+
 static int plugin_faults(const mjModel* m, const mjData* d, mbs_job* J, long k) {
   for (int i = 0; i < m->nplugin; i++) {
     if (!mbs_is_own_instance(m, i)) continue;
@@ -238,7 +252,8 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
   const int integrator = m->opt.integrator;
   const int split = integrator == mjINT_EULER || integrator == mjINT_RK4 || integrator == mjINT_IMPLICIT ||
                     integrator == mjINT_IMPLICITFAST;
-  const int warn0 = d->warning[mjWARN_BADQACC].number;
+  int warn0[N_BAD_WARNINGS];
+  for (int i = 0; i < N_BAD_WARNINGS; i++) warn0[i] = d->warning[bad_warnings[i]].number;
   const long n = J->nstep + (J->final ? 1 : 0);
   for (long i = 0; i < n; i++) {
     const long k = J->k0 + i;
@@ -253,8 +268,10 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
       mj_checkVel(m, d);
       mj_forward(m, d);
       mj_checkAcc(m, d);
-      if (d->warning[mjWARN_BADQACC].number > warn0) {
+      int w = new_bad_warning(d, warn0);
+      if (w >= 0) {
         fail(J, MBS_FAIL_BADQACC, k, d->time);
+        J->fail_code = w;
         return J->status;
       }
       if (J->hook) {
@@ -288,8 +305,10 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
         return J->status;
       }
     }
-    if (d->warning[mjWARN_BADQACC].number > warn0) {
+    int w = new_bad_warning(d, warn0);
+    if (w >= 0) {
       fail(J, MBS_FAIL_BADQACC, k, d->time);
+      J->fail_code = w;
       return J->status;
     }
     if (m->nplugin && plugin_faults(m, d, J, k)) return J->status;

@@ -16,7 +16,7 @@
  * and the time. A plugin cannot raise: this is its only way out. */
 typedef struct {
   int fault;          /* 0 = none; else a model-specific code, described by mbs_fault_text */
-  double fault_time;  /* d->time of the first fault */
+  double fault_time;  /* d->time of the first fault; < 0: found when the model was loaded (a configuration fault) */
   double fault_value; /* the offending value */
 } mbs_plugin_header;
 
@@ -73,7 +73,7 @@ typedef int (*mbs_hook_fn)(const mjModel* m, mjData* d, void* ud, long k, int st
 
 /* Status of mbs_run. */
 enum {
-  MBS_OK = 0, MBS_FAIL_NONFINITE = 1, MBS_FAIL_BADQACC = 2, MBS_FAIL_PLUGIN = 3, MBS_FAIL_BOUNDS = 4,
+  MBS_OK = 0, MBS_FAIL_NONFINITE = 1, MBS_FAIL_BADQACC = 2 /* any MuJoCo warning of a broken state; fail_code */, MBS_FAIL_PLUGIN = 3, MBS_FAIL_BOUNDS = 4,
   MBS_FAIL_HOOK = 5, MBS_FAIL_ARGS = 6
 };
 

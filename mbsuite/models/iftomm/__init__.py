@@ -20,6 +20,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="fourbar",
     run=run,
+    cases="mbsuite.models.iftomm.cases",
     extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3, "method": "DOP853",
                                "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "sample_dt": 1e-2}},
 )

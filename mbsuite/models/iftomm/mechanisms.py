@@ -8,8 +8,9 @@
   distance of the two `connect`s that make the sixth hinge).
 
 Engines:
-- `mujoco`: the MJCF as shipped (soft `connect` equalities, solref timeconst from the parameters), stepped in Python
-  with divergence checks; energy from MuJoCo's own `mj_energyPos/Vel`.
+- `mujoco`: the MJCF as shipped (soft `connect` equalities, solref timeconst from the parameters), stepped by the
+  native core (`mbsuite.engines.core`); energy from MuJoCo's own `mj_energyPos/Vel`, closure error from the
+  `connect` constraint rows.
 - `reference`: the same file read by Pinocchio (`buildModelFromMJCF`); the closures are taken from MuJoCo's compiled
   `connect` anchors (body -> Pinocchio joint of the same name), and the constrained dynamics are the index-1 DAE
   replaced by the penalty formulation `(M + p J^T J) a = -h - p J^T (Jdot v + 2 w J v + w^2 r)` (p = 1e7, w = 10/s:
@@ -30,6 +31,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
+from ...engines import core
 from ...engines import mujoco_engine as mje
 from ...engines import pinocchio_engine as pe
 from ...errors import SceneError, SolverError
@@ -95,29 +97,34 @@ def initial_velocity(m: mujoco.MjModel, rate: float) -> np.ndarray:
     return rate * n / n[0]
 
 
+def channels(m: mujoco.MjModel) -> list[core.Channel]:
+    """What a MuJoCo run of a gate records: joint positions and rates, MuJoCo's potential and kinetic energy, and the
+    three constraint rows of every `connect` (its closure error)."""
+    out = [core.Channel("q", "qpos", 0, m.nq), core.Channel("v", "qvel", 0, m.nv),
+           core.Channel("energy", "energy", 0, 2)]
+    out += [core.Channel(f"closure_{e}", "eq_pos", e, 3) for e in range(m.neq)]
+    return out
+
+
+def closure_of(tr: core.Trajectory, m: mujoco.MjModel) -> np.ndarray:
+    """Max |closure error| (m) over every connect's rows, per recorded sample."""
+    if not m.neq:
+        return np.zeros(tr.t.size)
+    return np.max(np.abs(np.hstack([tr[f"closure_{e}"] for e in range(m.neq)])), axis=1)
+
+
 def simulate_mujoco(m: mujoco.MjModel, v0: np.ndarray, duration: float, sample_dt: float) -> Trajectory:
+    """MuJoCo from q = 0 (the assembled pose of the files) with joint rates v0, on the native core."""
     d = mujoco.MjData(m)
     d.qvel[:] = v0
-    mujoco.mj_forward(m, d)
     n = int(round(duration / m.opt.timestep))
     every = max(1, int(round(sample_dt / m.opt.timestep))) if sample_dt > 0 else 1
-    rec_t, rec_q, rec_v, rec_e, rec_r = [], [], [], [], []
-    what = f"IFToMM {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, 1)}"
-    for i in range(n + 1):
-        if i % every == 0 or i == n:
-            mujoco.mj_forward(m, d)
-            eq_rows = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-            rec_t.append(d.time)
-            rec_q.append(d.qpos.copy())
-            rec_v.append(d.qvel.copy())
-            rec_e.append(float(d.energy[0] + d.energy[1]))
-            rec_r.append(float(np.max(np.abs(d.efc_pos[eq_rows]))) if np.any(eq_rows) else 0.0)
-        if i == n:
-            break
-        mujoco.mj_step(m, d)
-        mje.check_finite(m, d, what)
-    return Trajectory(np.array(rec_t), np.array(rec_q), np.array(rec_v), np.array(rec_e), np.array(rec_r),
-                      {"steps": n, "warnings": mje.warnings_raised(d)})
+    what = f"IFToMM {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, 1)} (MuJoCo)"
+    tr = core.Stepper(m, d, channels(m), every=every, what=what).run(n)
+    q = tr["q"].reshape(tr.t.size, m.nq)
+    v = tr["v"].reshape(tr.t.size, m.nv)
+    return Trajectory(tr.t, q, v, tr["energy"].sum(axis=1), closure_of(tr, m),
+                      {"steps": tr.steps, "warnings": tr.warnings})
 
 
 class PinocchioMechanism:

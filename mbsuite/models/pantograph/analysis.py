@@ -229,11 +229,24 @@ def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------------------ frequency response
+def _harmonics(t: np.ndarray, sig: dict[str, np.ndarray], f: float, ts: float, method: str) -> dict:
+    """Amplitude ratio and phase (deg) of each frequency-response signal relative to the input's fundamental, and
+    the contact-force range after t_settle."""
+    cin = fundamental(t, sig["y_w"], f, ts)
+    out = {"f": f, "method": method}
+    for s in FR_SIGNALS:
+        H = fundamental(t, sig[s], f, ts) / cin
+        out[s] = (abs(H), math.degrees(math.atan2(H.imag, H.real)))
+    fc = sig["contact_force"][t >= ts]
+    out["contact_force_min"] = float(np.min(fc))
+    out["contact_force_max"] = float(np.max(fc))
+    return out
+
+
 def _point(job: tuple[dict, float, str]) -> dict:
-    """One frequency with one method (module-level so that it can run in a worker process)."""
+    """One frequency with one method, through `run` (module-level so that it can run in a worker process)."""
     scene_d, f, method = job
-    scene = scene_from_dict(scene_d)
-    scene = scene.replace(input={"type": "sine", "frequency": f})
+    scene = scene_from_dict(scene_d).replace(input={"type": "sine", "frequency": f})
     if method == "reference":
         scene = scene.replace(solver={"engine": "reference", "sample_dt": 1.0 / (64.0 * f)})
     elif method == "mujoco_no_coulomb":  # the same sweep without Coulomb friction, to show its effect on the peaks
@@ -241,17 +254,48 @@ def _point(job: tuple[dict, float, str]) -> dict:
     else:
         scene = scene.replace(solver={"engine": "mujoco"})
     res = run(scene.replace(outputs=[*FR_SIGNALS, "y_w", "contact_force"]))
-    ts = scene.solver.t_settle or 0.5 * scene.solver.duration
-    cin = fundamental(res.t, res["y_w"], f, ts)
-    out = {"f": f, "method": method}
-    for s in FR_SIGNALS:
-        H = fundamental(res.t, res[s], f, ts) / cin
-        out[s] = (abs(H), math.degrees(math.atan2(H.imag, H.real)))
-    fc = res["contact_force"]
-    out["contact_force_min"] = float(np.min(fc[res.t >= ts]))
-    out["contact_force_max"] = float(np.max(fc[res.t >= ts]))
+    out = _harmonics(res.t, res.signals, f, scene.solver.t_settle or 0.5 * scene.solver.duration, method)
     out["cost"] = res.stats
     return out
+
+
+def mujoco_sweep(scene: Scene, freqs: np.ndarray, *, method: str = "mujoco", workers: int = 0,
+                 progress: bool | None = None) -> list[dict]:
+    """The MuJoCo path at every frequency of `freqs` (`method` "mujoco", or "mujoco_no_coulomb" for the same sweep
+    without Coulomb friction): one compiled model and one equilibrium, one native-core run per frequency, the runs
+    spread over `workers` C threads (0 = all cores; the results do not depend on it). Under the Dask executor every
+    point runs through `run` on the cluster instead."""
+    import mujoco
+
+    from ...analysis.sweep import current_executor
+
+    jobs = [(scene.to_dict(), float(f), method) for f in freqs]
+    if current_executor() == "dask":
+        return run_sweep(_point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}")
+    if method == "mujoco_no_coulomb":
+        scene = scene.replace(effects={"coulomb": False})
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    s = scene.solver
+    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
+    base = input_of(scene.replace(input={"type": "sine"}), p)
+    x0 = initial_theta(scene, ode, base)
+    q0 = mp.equilibrium(base(0.0)) if scene.input.get("initial", "equilibrium") == "equilibrium" else \
+        theta_to_q(x0[:3])
+    ts = s.t_settle or 0.5 * s.duration
+
+    def point(job: tuple[dict, float, str]) -> dict:
+        f = job[1]
+        u = InputSignal("sine", p.y_op, base.amplitude, f)
+        tr = mp.simulate(u, s.duration, q0, data=mujoco.MjData(mp.model),
+                         what=f"pantograph frequency sweep at {f:g} Hz (MuJoCo)")
+        P = tr["act"].reshape(tr.t.size, -1)[:, 0] if mp.model.na else None
+        out = _harmonics(tr.t, signals(ode, thetas(tr["qpos"]), u(tr.t), P), f, ts, method)
+        out["cost"] = {"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep, "warnings": tr.warnings}
+        return out
+
+    return run_sweep(point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}", executor="threads")
 
 
 def peaks(freqs: np.ndarray, amp: np.ndarray) -> list[float]:
@@ -290,8 +334,13 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
     sim_methods = [m for m in methods if m != "linear"]
     if "mujoco" in sim_methods and cfg.coulomb:
         sim_methods.append("mujoco_no_coulomb")
-    jobs = [(scene.to_dict(), float(f), m) for m in sim_methods for f in freqs]
-    results = run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp")
+    results = []
+    if "reference" in sim_methods:
+        jobs = [(scene.to_dict(), float(f), "reference") for f in freqs]
+        results += run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp reference")
+    for m in ("mujoco", "mujoco_no_coulomb"):
+        if m in sim_methods:
+            results += mujoco_sweep(scene, freqs, method=m, workers=workers, progress=progress)
     for m in sim_methods:
         rows = [r for r in results if r["method"] == m]
         curves[m] = {s: np.array([r[s][0] * np.exp(1j * math.radians(r[s][1])) for r in rows]) for s in FR_SIGNALS}

@@ -105,9 +105,10 @@ class MujocoPantograph:
             return self.p.Ps
         return None
 
-    def set_static(self, q: np.ndarray, y_w: float) -> None:
-        """Put the data at rest at joint positions q, ram height y_w, cylinder at rest; then mj_forward."""
-        d, m = self.data, self.model
+    def set_static(self, q: np.ndarray, y_w: float, data: mujoco.MjData | None = None) -> None:
+        """Put the data (default: this object's) at rest at joint positions q, ram height y_w, cylinder at rest;
+        then mj_forward."""
+        d, m = (self.data if data is None else data), self.model
         mujoco.mj_resetData(m, d)
         d.qpos[:] = q
         d.ctrl[self.i_cat] = y_w
@@ -162,15 +163,19 @@ class MujocoPantograph:
         h = self.model.opt.timestep
         return np.asarray(y_w((np.arange(nstep) + self.hold_offset) * h), dtype=float).reshape(nstep, 1)
 
-    def stepper(self, every: int = 1, what: str = "pantograph (MuJoCo)") -> core.Stepper:
-        return core.Stepper(self.model, self.data, self.channels(), every=every, what=what)
+    def stepper(self, every: int = 1, what: str = "pantograph (MuJoCo)",
+                data: mujoco.MjData | None = None) -> core.Stepper:
+        return core.Stepper(self.model, self.data if data is None else data, self.channels(), every=every, what=what)
 
     def simulate(self, y_w: Callable[[np.ndarray], np.ndarray], t_end: float, q0: np.ndarray | None = None, *,
-                 every: int = 1, what: str = "pantograph (MuJoCo)") -> core.Trajectory:
+                 every: int = 1, what: str = "pantograph (MuJoCo)",
+                 data: mujoco.MjData | None = None) -> core.Trajectory:
         """Step from the static equilibrium (or q0) at rest for t_end seconds under the ram y_w (vectorised callable
-        of time), recording every `every` steps. Failures raise SolverError."""
+        of time), recording every `every` steps. Failures raise SolverError. With `data` (and q0) given, nothing of
+        this object is touched: runs in several threads share the model."""
         nstep = int(round(t_end / self.model.opt.timestep))
-        y0 = float(np.asarray(y_w(np.zeros(1)))[0])
-        self.set_static(self.equilibrium(y0) if q0 is None else q0, y0)
-        self.data.time = 0.0
-        return self.stepper(every, what).run(nstep, ctrl=self.ram_input(y_w, nstep), ctrl_idx=[self.i_cat])
+        y0 = float(np.asarray(y_w(np.zeros(1))).ravel()[0])
+        self.set_static(self.equilibrium(y0) if q0 is None else q0, y0, data)
+        d = self.data if data is None else data
+        d.time = 0.0
+        return self.stepper(every, what, d).run(nstep, ctrl=self.ram_input(y_w, nstep), ctrl_idx=[self.i_cat])

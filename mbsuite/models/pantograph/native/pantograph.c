@@ -75,7 +75,7 @@ static int cyl_init(const mjModel* m, mjData* d, int instance) {
   if (bad) {
     /* reported by the core as a configuration fault at the first step (a plugin cannot raise) */
     c->h.fault = MBS_FAULT_CONFIG;
-    c->h.fault_time = 0.0;
+    c->h.fault_time = -1.0; /* at load: survives mj_resetData */
     c->h.fault_value = NAN;
   }
   return 0;
@@ -94,7 +94,7 @@ static void cyl_copy(mjData* dst, const mjModel* m, const mjData* src, int insta
 
 static void plugin_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
   mbs_plugin_header* h = (mbs_plugin_header*)plugin_data;
-  if (h && h->fault != MBS_FAULT_CONFIG) {
+  if (h && h->fault_time >= 0.0) { /* a fault found at load (fault_time < 0) stays */
     h->fault = 0;
     h->fault_time = 0.0;
     h->fault_value = 0.0;
@@ -211,11 +211,12 @@ static int elbow_init(const mjModel* m, mjData* d, int instance) {
   if (!joint_address(m, mj_getPluginConfig(m, instance, "joint1"), &e->q1, &e->v1)) bad = 1;
   if (!joint_address(m, mj_getPluginConfig(m, instance, "joint2"), &e->q2, &e->v2)) bad = 1;
   double dphi, dl;
-  if (!bad && !chain(e, 0.0, &e->phi1_0, &dphi, &e->lfb0, &dl)) bad = 1;
+  int geometry = !bad && !chain(e, 0.0, &e->phi1_0, &dphi, &e->lfb0, &dl);
   d->plugin_data[instance] = (uintptr_t)e;
-  if (bad) {
-    e->h.fault = MBS_FAULT_CONFIG;
-    e->h.fault_value = NAN;
+  if (bad || geometry) {
+    e->h.fault = bad ? MBS_FAULT_CONFIG : MBS_FAULT_GEOMETRY;
+    e->h.fault_time = -1.0; /* at load: survives mj_resetData */
+    e->h.fault_value = bad ? NAN : 0.0;
   }
   return 0;
 }
@@ -228,7 +229,7 @@ static void elbow_copy(mjData* dst, const mjModel* m, const mjData* src, int ins
 
 static void elbow_compute(const mjModel* m, mjData* d, int instance, int capability_bit) {
   Elbow* e = (Elbow*)d->plugin_data[instance];
-  if (e->h.fault == MBS_FAULT_CONFIG) return;
+  if (e->h.fault) return;
   double q1 = d->qpos[e->q1], q2 = d->qpos[e->q2];
   if (!isfinite(q1) || !isfinite(q2)) {
     mbs_fault(d, instance, MBS_FAULT_NONFINITE, q1);

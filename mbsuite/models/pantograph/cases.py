@@ -1,0 +1,229 @@
+"""The pantograph's suite declarations: its hard cases, its work-precision study and the random admissible inputs of
+the random-input test (collected by `mbsuite.hardcases`, `mbsuite.analysis.workprecision` and the suite's tests
+through `SPEC.cases`). Bounds are stated with the numbers measured when they were set."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ... import load_scene, run
+from ...analysis.harmonic import fundamental
+from ...analysis.workprecision import Setting, Study
+from ...errors import SceneError, SolverError
+from ...hardcases import Checker, HardCase
+from ...scenes import Scene
+
+
+def _pantograph_stick_slip(ck: Checker) -> None:
+    sc = load_scene("pantograph").replace(input={"frequency": 2.0}, solver={"duration": 4.0, "t_settle": 2.0})
+    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
+    mj = run(sc)
+    sticks = sum(1 for e in ref.events if e["kind"] == "stick")
+    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
+    ck.ge("stick events in 4 s (the head joint sticks twice per cycle)", sticks, 8)
+    ck.le("reference RHS calls (no stall at the sign change)", ref.stats["nfev"], 50_000)
+    ck.le("reference smooth segments", ref.stats["segments"], 500)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+    a, b = fundamental(mj.t, mj["F1"], 2.0, 2.0), fundamental(ref.t, ref["F1"], 2.0, 2.0)
+    ck.le("|F1| MuJoCo frictionloss vs event-exact reference, relative", abs(abs(a) / abs(b) - 1), 0.02)
+
+
+def _pantograph_orifice_dp0(ck: Checker) -> None:
+    sc = load_scene("pantograph/nonlinear_cylinder").replace(solver={"duration": 2.0, "t_settle": 1.0})
+    ref = run(sc.replace(solver={"engine": "reference"}))
+    mj = run(sc)
+    P = ref["cylinder_state"] if "cylinder_state" in ref.signals else None
+    ck.finite("reference and MuJoCo outputs", *ref.signals.values(), *mj.signals.values())
+    ck.le("reference RHS calls starting at P = Ps (dp = 0)", ref.stats["nfev"], 50_000)
+    ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
+    if P is not None:
+        ck.true("cylinder pressure stays positive", bool(np.min(P) > 0), float(np.min(P)))
+
+
+def _pantograph_orifice_choked(ck: Checker) -> None:
+    from .reference import PantographODE
+
+    ode = PantographODE(cylinder="nonlinear")
+    p = ode.p
+    flows = np.array([ode.orifice_mass_flow(r * p.Ps) for r in np.linspace(0.05, 1.5, 2901)])
+    ck.finite("orifice flow over 0.05-1.5 Ps", flows)
+    ck.true("inflow below Ps, outflow above, zero at Ps",
+            ode.orifice_mass_flow(0.9 * p.Ps) > 0 > ode.orifice_mass_flow(1.1 * p.Ps)
+            and ode.orifice_mass_flow(p.Ps) == 0.0)
+    choked = [ode.orifice_mass_flow(r * p.Ps) for r in (0.1, 0.3, 0.5)]
+    ck.le("choked plateau: flow independent of Pd/Pu < 0.528 (relative spread)", np.ptp(choked) / choked[0], 1e-12)
+    r = 0.528
+    ck.le("continuity at the choke ratio 0.528 (relative jump)",
+          abs(ode.orifice_mass_flow(r * p.Ps * (1 - 1e-9)) / ode.orifice_mass_flow(r * p.Ps * (1 + 1e-9)) - 1),
+          1e-6)
+    edge = p.r_laminar * p.Ps
+    ck.le("continuity at the laminar band edge (relative jump)",
+          abs(ode.orifice_mass_flow(edge * (1 - 1e-12)) / ode.orifice_mass_flow(edge * (1 + 1e-12)) - 1), 1e-6)
+    slope = np.diff(flows) / np.diff(np.linspace(0.05, 1.5, 2901) * p.Ps)
+    ck.finite("finite slope d(mdot)/dP everywhere (Lipschitz RHS near dp = 0)", slope)
+
+
+def _pantograph_unilateral(ck: Checker) -> None:
+    sc = load_scene("pantograph/unilateral").replace(solver={"duration": 4.0, "t_settle": 2.0})
+    mj = run(sc)
+    ref = run(sc.replace(solver={"engine": "reference", "sample_dt": 1e-3}))
+    lm = [e for e in mj.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
+    lr = [e for e in ref.events if e["kind"] == "contact_loss" and e["t_start"] >= 2.0 and e["duration"]]
+    ck.finite("outputs", *mj.signals.values(), *ref.signals.values())
+    ck.ge("contact losses detected (reference, 2-4 s)", len(lr), 8)
+    ck.le("|losses MuJoCo - reference|", abs(len(lm) - len(lr)), 1)
+    ck.true("contact force never negative (push-only)", min(np.min(mj["contact_force"]),
+                                                            np.min(ref["contact_force"])) >= 0.0)
+    tot_m, tot_r = sum(e["duration"] for e in lm), sum(e["duration"] for e in lr)
+    ck.le("total loss time MuJoCo vs reference, relative", abs(tot_m / tot_r - 1) if tot_r else math.inf, 0.1)
+
+
+def _pantograph_big_step(ck: Checker) -> None:
+    sc = load_scene("pantograph").replace(solver={"timestep": 0.02, "duration": 2.0, "t_settle": 1.0})
+    for integ in ("euler", "implicitfast"):
+        ck.raises(f"{integ} at h = 0.02 s: SolverError telling to reduce the step",
+                  lambda i=integ: run(sc.replace(solver={"integrator": i})), SolverError, "reduce solver.timestep")
+    res = run(sc.replace(solver={"integrator": "rk4"}))
+    ck.finite("RK4 at h = 0.02 s", *res.signals.values())
+
+
+def _pantograph_energy_100s(ck: Checker) -> None:
+    from .modelfiles import E_THETA_Q, q_to_theta, theta_to_q
+    from .mujoco import MujocoPantograph
+    from .reference import PantographConfig, PantographODE
+
+    cfg = PantographConfig(cylinder="constant", viscous=False, coulomb=False)
+    ode = PantographODE(config=cfg)
+    x0 = ode.equilibrium()
+    x0[3:6] = [0.05, -0.03, 0.1]
+    y_w = 1.58
+    E0 = ode.energy(x0, y_w)
+    mp = MujocoPantograph(config=cfg, integrator="rk4", timestep=1e-3)
+    mp.set_static(theta_to_q(x0[:3]), y_w)
+    mp.data.qvel[:] = np.linalg.solve(E_THETA_Q, x0[3:6])
+    tr = mp.stepper(every=1000).run(100_000)
+    d = mp.data
+    drift = [ode.energy(np.r_[q_to_theta(q), E_THETA_Q @ v], y_w) - E0
+             for q, v in zip(tr["qpos"][1:], tr["qvel"][1:], strict=True)]
+    drift = np.abs(np.array(drift))
+    ck.finite("state after 100 s", d.qpos, d.qvel)
+    ck.le("energy drift over 100 s, MuJoCo RK4 1 ms, no damping (J)", drift.max(), 1e-3)
+    # RK4 is not symplectic: its energy error grows linearly (measured 1.6e-4 J at 100 s, ratio 9.4 = linear from 0);
+    # faster growth (quadratic: ratio ~100, exponential) would be an instability
+    ck.le("drift last 10 s / first 10 s (linear growth gives ~10; faster growth fails)",
+          drift[-10:].max() / (drift[:10].max() + 1e-9), 15.0)
+
+
+class PantographStudy(Study):
+    SIGNALS = ("F1", "F2", "HD", "y_d")
+    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4", "discrete")
+    MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5)
+    SCIPY = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "RK45": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8, 1e-10),
+             "LSODA": (1e-4, 1e-6, 1e-8, 1e-10), "BDF": (1e-4, 1e-6, 1e-8)}
+    state_doc = "max_t |F1, F2, HD, y_d - ref| / A (A = input amplitude), t >= t_settle, 1 ms grid"
+    physics_doc = ("max(rel. amplitude error F1, HD; phase error F1, HD in rad at the forcing frequency; rel. error of "
+                   "contact-force mean and std)")
+
+    def __init__(self, scene: Scene, quick: bool = False, frequency: float | None = None, duration: float = 3.0):
+        super().__init__(scene, quick)
+        inp = dict(scene.input)
+        if inp.get("type", "sine") != "sine":
+            raise SceneError("the pantograph work-precision study needs a sine input")
+        self.f = float(frequency or inp.get("frequency", 4.25))
+        T = 1.0 if quick else duration
+        self.ts = T / 2
+        self.base = scene.replace(effects={"coulomb": False}, input={"frequency": self.f},
+                                  outputs=[*self.SIGNALS, "y_w", "contact_force"],
+                                  solver={"duration": T, "t_settle": self.ts, "sample_dt": 1e-3,
+                                          "max_step": 1.0 / (16 * self.f)})
+        self.A = float(self.base.input.get("amplitude", 1.85e-3))
+
+    def _run(self, **solver):
+        sc = self.base.replace(solver=solver)
+        return lambda: run(sc)
+
+    def settings(self) -> list[Setting]:
+        out = []
+        integ = ("implicitfast", "rk4") if self.quick else self.MJ_INTEGRATORS
+        steps = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
+        for i in integ:
+            for h in steps:
+                out.append(Setting("mujoco", i, h, self._run(engine="mujoco", integrator=i, timestep=h)))
+        meth = {"DOP853": (1e-4, 1e-6)} if self.quick else self.SCIPY
+        for mth, rtols in meth.items():
+            for r in rtols:
+                out.append(Setting("reference", mth, r, self._run(engine="reference", method=mth, rtol=r,
+                                                                   atol=r * 1e-2)))
+        return out
+
+    def reference(self):
+        ref = run(self.base.replace(solver={"engine": "reference", "method": "Radau", "rtol": 1e-12, "atol": 1e-14}))
+        chk = run(self.base.replace(solver={"engine": "reference", "method": "DOP853", "rtol": 1e-12, "atol": 1e-14}))
+        err, det = self.physics_error(chk, ref)
+        return ref, {"reference": "scipy Radau rtol 1e-12, atol 1e-14",
+                     "check": "scipy DOP853 rtol 1e-12", "check_state_error": self.state_error(chk, ref),
+                     "check_physics_error": err}
+
+    def state_error(self, res, ref) -> float:
+        m = ref.t >= self.ts
+        grid = ref.t[m]
+        return max(float(np.max(np.abs(np.interp(grid, res.t, res[s]) - ref[s][m]))) / self.A for s in self.SIGNALS)
+
+    def physics_error(self, res, ref):
+        det = {}
+        for s in ("F1", "HD"):
+            a, b = fundamental(res.t, res[s], self.f, self.ts), fundamental(ref.t, ref[s], self.f, self.ts)
+            det[f"{s}_amp_rel"] = abs(abs(a) / abs(b) - 1.0)
+            det[f"{s}_phase_rad"] = abs(float(np.angle(a / b)))
+        fr, fc = ref["contact_force"][ref.t >= self.ts], res["contact_force"][res.t >= self.ts]
+        sd = float(np.std(fr)) or 1.0
+        det["Fc_mean_rel"] = abs(float(np.mean(fc)) - float(np.mean(fr))) / abs(float(np.mean(fr)))
+        det["Fc_std_rel"] = abs(float(np.std(fc)) - sd) / sd
+        return max(det.values()), det
+
+HARD_CASES: tuple[HardCase, ...] = (
+    HardCase("pantograph_stick_slip_2hz", "pantograph",
+             "Coulomb stick/slip every half cycle: sign() chatter stalls adaptive solvers",
+             "pantograph/lab at 2 Hz, 4 s, both engines",
+             "no NaN; >= 8 stick events; reference RHS calls <= 5e4, segments <= 500; no MuJoCo warning; "
+             "|F1| MuJoCo vs exact within 2 %", _pantograph_stick_slip),
+    HardCase("pantograph_orifice_dp0", "pantograph",
+             "orifice law at dp -> 0: unbounded slope of the turbulent law at P = Ps",
+             "pantograph/nonlinear_cylinder from P = Ps, 2 s, both engines",
+             "no NaN; reference RHS calls <= 5e4; pressure > 0; no MuJoCo warning", _pantograph_orifice_dp0),
+    HardCase("pantograph_orifice_choked", "pantograph",
+             "choked flow below Pd/Pu = 0.528 and the laminar band: branch switches of the orifice law",
+             "PantographODE(cylinder='nonlinear').orifice_mass_flow over 0.05-1.5 Ps",
+             "finite flow and slope; flow sign; choked plateau flat to 1e-12; continuous at 0.528 and the band edge",
+             _pantograph_orifice_choked),
+    HardCase("pantograph_unilateral_contact", "pantograph",
+             "push-only contact: non-smooth force, repeated contact loss and impact",
+             "pantograph/unilateral (2.5 mm at 4.25 Hz), 4 s, both engines",
+             "losses detected (>= 8), counts agree within 1, total loss time within 10 %, force >= 0",
+             _pantograph_unilateral),
+    HardCase("pantograph_over_large_timestep", "pantograph",
+             "explicit/semi-implicit integration far above the stable step",
+             "pantograph/lab at h = 0.02 s with euler, implicitfast, rk4",
+             "euler/implicitfast: SolverError 'reduce solver.timestep' (not garbage); rk4 finite",
+             _pantograph_big_step),
+    HardCase("pantograph_energy_drift_100s", "pantograph",
+             "long-time energy drift of a conservative 3-DOF system with engine plugins",
+             "pantograph, constant cylinder, no damping/friction, RK4 1 ms, 100 s",
+             "energy drift <= 1e-3 J; growth no faster than linear", _pantograph_energy_100s),
+)
+
+
+def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    return PantographStudy(scene, quick=quick)
+
+
+def random_input(scene: Scene, rng: np.random.Generator) -> dict:
+    """Admissible random changes of a pantograph scene's input: a sine ram of 0.5-1 x the scene's amplitude at 1-12
+    Hz."""
+    inp = dict(scene.input)
+    if inp.get("type") == "sine":
+        inp.update(amplitude=float(inp.get("amplitude", 1.85e-3)) * rng.uniform(0.5, 1.0),
+                   frequency=rng.uniform(1.0, 12.0))
+    return {"input": inp}

@@ -1,0 +1,189 @@
+"""The native step-and-record core: bitwise MuJoCo's own stepping, recording semantics, one error path for every
+failure, no mixing between models in concurrent threads, and `mujoco.rollout` over mbsuite's plugin models."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import mujoco
+import numpy as np
+import pytest
+from mujoco import rollout
+
+import mbsuite
+from mbsuite import SolverError
+from mbsuite.engines import native
+from mbsuite.engines.core import Channel, Stepper, map_threads, rows_for
+from mbsuite.models.pantograph.modelfiles import mjcf_text
+from mbsuite.models.pantograph.mujoco import compiled_model
+from mbsuite.models.pantograph.params import PantographParams
+from mbsuite.models.pantograph.reference import PantographConfig
+
+PENDULUM = """<mujoco><option timestep="0.002"/><worldbody><body><joint name="j" type="hinge" axis="0 1 0"/>
+<geom type="capsule" fromto="0 0 0 0 0 -1" size="0.05" mass="1"/></body></worldbody>
+<actuator><motor joint="j"/></actuator></mujoco>"""
+
+
+def _lab(integrator="rk4"):
+    return compiled_model(PantographParams(), PantographConfig(), integrator, 1e-3)
+
+
+def _start(m):
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    return d
+
+
+def _ram(n, h, f=4.25):
+    return 1.58 + 1.85e-3 * (1 - np.cos(2 * np.pi * f * (np.arange(n) + 0.5) * h))
+
+
+@pytest.mark.parametrize("integrator", ["euler", "rk4", "implicit", "implicitfast", "discrete"])
+def test_bitwise_equal_to_mj_step_and_rollout(integrator):
+    """The core calls what mj_step calls: the trajectory of the lab pantograph (engine plugins, friction
+    constraints) is bitwise that of a Python mj_step loop and of mujoco.rollout, for every integrator."""
+    m = _lab(integrator)
+    n = 600
+    u = _ram(n, m.opt.timestep)
+    d = _start(m)
+    tr = Stepper(m, d, [Channel("q", "qpos", 0, 3), Channel("v", "qvel", 0, 3), Channel("P", "act", 0, 1)]).run(
+        n, ctrl=u, ctrl_idx=[0])
+    d2 = _start(m)
+    ref = [np.r_[d2.qpos, d2.qvel, d2.act]]
+    for k in range(n):
+        d2.ctrl[0] = u[k]
+        mujoco.mj_step(m, d2)
+        ref.append(np.r_[d2.qpos, d2.qvel, d2.act])
+    ref = np.array(ref)
+    assert np.array_equal(np.hstack([tr["q"], tr["v"], tr["P"][:, None]]), ref)
+    d3 = _start(m)
+    x0 = np.zeros(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+    mujoco.mj_getState(m, d3, x0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    ctrl = np.tile(d3.ctrl, (1, n, 1))
+    ctrl[0, :, 0] = u
+    state, _ = rollout.rollout(m, [mujoco.MjData(m) for _ in range(2)], x0[None], ctrl)
+    assert np.array_equal(state[0, :, 1:1 + 7], ref[1:])  # rollout: time, qpos, qvel, act
+
+
+def test_recording_rows_and_times():
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    d = mujoco.MjData(m)
+    d.qpos[0] = 0.3
+    for n, every in ((10, 1), (10, 3), (9, 3), (0, 5)):
+        mujoco.mj_resetData(m, d)
+        tr = Stepper(m, d, [Channel("q", "qpos")], every=every).run(n)
+        expect = sorted(set(range(0, n + 1, every)) | {n})
+        assert tr.t.size == rows_for(n, every) == len(expect)
+        assert np.allclose(tr.t, np.array(expect) * m.opt.timestep, rtol=0, atol=1e-15)
+        assert tr.steps == n
+
+
+def test_python_input_between_steps_is_the_same_as_an_array():
+    """A Python callable at a sample period (a discrete controller) gives the trajectory of the equivalent array."""
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    n, period = 500, 7
+    u = np.repeat(np.sin(np.arange(n // period + 1)), period)[:n]
+    d1 = mujoco.MjData(m)
+    a = Stepper(m, d1, [Channel("q", "qpos")]).run(n, ctrl=u, ctrl_idx=[0])
+    d2 = mujoco.MjData(m)
+
+    def controller(k, data):
+        data.ctrl[0] = u[k]
+
+    b = Stepper(m, d2, [Channel("q", "qpos")]).run(n, between=controller, period=period)
+    assert np.array_equal(a["q"], b["q"])
+
+
+def test_non_finite_input_is_an_error_naming_the_time():
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    u = np.zeros(100)
+    u[40] = np.nan
+    with pytest.raises(SolverError, match=r"pendulum run: MuJoCo diverged \(warning badctrl.*at t = 0\.08"):
+        Stepper(m, mujoco.MjData(m), [Channel("q", "qpos")], what="pendulum run", check_every=1).run(
+            100, ctrl=u, ctrl_idx=[0])
+
+
+def test_implausible_value_names_the_channel_and_bound():
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    d = mujoco.MjData(m)
+    d.qpos[0] = 1.0
+    with pytest.raises(SolverError, match=r"swing = -0\.\d+ is outside its plausible range \[-0\.5, 2\]"):
+        Stepper(m, d, [Channel("swing", "qpos", 0, 1, lo=-0.5, hi=2.0)]).run(2000)
+
+
+def test_plugin_fault_names_the_effect_and_time():
+    """A native effect meeting a non-physical state stops the run with the effect's name, the fault and the time."""
+    m = compiled_model(PantographParams(), PantographConfig(cylinder="nonlinear"), "rk4", 1e-3)
+    d = _start(m)
+    d.act[0] = -5.0  # a negative absolute pressure
+    with pytest.raises(SolverError, match=r"effect 'cylinder': absolute cylinder pressure became <= 0 .*value -5"):
+        Stepper(m, d, [Channel("q", "qpos", 0, 3)]).run(10, ctrl=np.full(10, 1.58), ctrl_idx=[0])
+
+
+def test_plugin_configuration_fault_is_reported_at_the_first_step():
+    native.load()
+    text = mjcf_text(PantographParams()).replace('key="le" value="0.082"', 'key="le" value="3.0"')
+    m = mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(SolverError, match=r"effect 'elbow': elbow chain has no tangent line.*found at load"):
+        Stepper(m, _start(m)).run(1)
+    text = mjcf_text(PantographParams()).replace('key="ke" value="44640.0"', 'key="ke" value="stiff"')
+    m = mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(SolverError, match=r"effect 'elbow': a configuration attribute"):
+        Stepper(m, _start(m)).run(1)
+
+
+def test_bad_arguments_are_value_errors():
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    with pytest.raises(ValueError, match="unknown channel field"):
+        Channel("x", "qacc_warmstart")
+    with pytest.raises(ValueError, match="out of range"):
+        Stepper(m, None, [Channel("q", "qpos", 0, 2)])
+    with pytest.raises(ValueError, match="ctrl must have shape"):
+        Stepper(m).run(10, ctrl=np.zeros(5), ctrl_idx=[0])
+
+
+def _scene_run(ref: str, duration: float) -> dict:
+    sc = mbsuite.load_scene(ref).replace(solver={"duration": duration, "t_settle": 0.0})
+    res = mbsuite.run(sc)
+    return {k: v.copy() for k, v in res.signals.items()}
+
+
+def test_two_models_in_two_threads_do_not_mix():
+    """Different scenes in two Python threads at the same time give results identical to each run alone (with
+    process-global Python callbacks the effects of one model acted on the other's steps)."""
+    jobs = [("pantograph/lab", 3.0), ("iftomm/fourbar", 3.0), ("pantograph/nonlinear_cylinder", 2.0)]
+    alone = [_scene_run(*j) for j in jobs]
+    together: list[dict | None] = [None] * len(jobs)
+    errors = []
+
+    def work(i):
+        try:
+            together[i] = _scene_run(*jobs[i])
+        except Exception as exc:  # noqa: BLE001 - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(jobs))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    for a, b in zip(alone, together, strict=True):
+        assert a.keys() == b.keys()
+        assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
+def test_map_threads_keeps_order_and_equals_serial():
+    m = compiled_model(PantographParams(), PantographConfig(), "rk4", 1e-3)
+    freqs = [2.0, 4.25, 8.5, 12.0]
+
+    def point(f):
+        d = _start(m)
+        return Stepper(m, d, [Channel("q", "qpos", 0, 3)]).run(500, ctrl=_ram(500, 1e-3, f), ctrl_idx=[0])["q"]
+
+    serial = [point(f) for f in freqs]
+    threaded = map_threads(point, freqs, workers=2)
+    assert all(np.array_equal(a, b) for a, b in zip(serial, threaded, strict=True))
+    assert not all(np.array_equal(serial[0], s) for s in serial[1:])  # the inputs really differ
+    assert math.isfinite(float(np.sum(threaded[-1])))

@@ -28,9 +28,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check mbsuite tests scripts
 
 bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tests)
-	$(BIN)/python scripts/bench_callbacks.py
-	$(BIN)/python scripts/bench_step_cost.py
-	$(BIN)/python scripts/bench_effects_off.py
+	$(BIN)/python scripts/bench_core.py
 	$(BIN)/python scripts/bench_paths.py
 	$(BIN)/python scripts/bench_sweep.py
 

@@ -2,7 +2,7 @@
 
 For each scene the work-precision study (mbsuite.analysis.workprecision) is run once; for each relative physics-metric
 tolerance the cheapest MuJoCo setting and the cheapest hand-derived setting reaching it are put side by side:
-ratio = hand time / MuJoCo time (> 1: MuJoCo faster; the issue's target is >= 10).
+ratio = hand time / MuJoCo time (> 1: MuJoCo faster).
 
     python scripts/bench_paths.py [--repeats 5] [--quick] [scene ...]     (default: pantograph/lab drives/step_up_pwm)
 """

@@ -1,6 +1,9 @@
 """MuJoCo double-coupler study: every shipped scene against the kinematics, the closure residual vs solref time
 constant (residual ~ tau^2), convergence of the massless-link limit, and time-series plots of the default scene.
 
+Every MuJoCo run is one call of mbsuite's native core (the step loop in C, the GIL released), so the runs of each table
+go through `engines.core.map_threads` and use all cores; the results are those of a serial loop.
+
     .venv/bin/python scripts/coupler_dynamics_study.py [OUT_DIR]      (default out/coupler_dynamics)
 """
 
@@ -16,6 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import mbsuite  # noqa: E402
+from mbsuite.engines.core import map_threads  # noqa: E402
 from mbsuite.models.coupler import SPEC  # noqa: E402
 from mbsuite.results import format_table  # noqa: E402
 from mbsuite.scenes import load_scene  # noqa: E402
@@ -27,28 +31,27 @@ KEYS = ("phi_c_err_max", "phi_c_kin_fluctuation_pp", "closure_residual_max", "to
 def main() -> None:
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/coupler_dynamics")
     out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for name in sorted(SPEC.scene_files()):
-        sc = load_scene(f"coupler/{name}")
-        r = mbsuite.run(sc)
-        rr = mbsuite.run(sc, engine="reference")
-        rows.append([name, *(r.stats[k] for k in KEYS), rr.stats["torque_in_ripple_pp"], len(r.stats["warnings"])])
+    names = sorted(SPEC.scene_files())
+    runs = map_threads(lambda name: (mbsuite.run(load_scene(f"coupler/{name}")),
+                                     mbsuite.run(load_scene(f"coupler/{name}"), engine="reference")), names)
+    rows = [[name, *(r.stats[k] for k in KEYS), rr.stats["torque_in_ripple_pp"], len(r.stats["warnings"])]
+            for name, (r, rr) in zip(names, runs, strict=True)]
     print("shipped scenes (window after t_settle; reference = rigid shafts, massless links, no gravity/friction)")
     print(format_table(["scene", *KEYS, "ripple_ref", "warnings"], rows, ".4g"))
 
     base = load_scene("coupler/double_lateral").replace(effects={"gravity": False})
-    rows = []
-    for tau in (1e-3, 2e-3, 4e-3, 8e-3):
-        r = mbsuite.run(base.replace(params={"solref_timeconst": tau}))
-        rows.append([tau, r.stats["closure_residual_max"], r.stats["phi_c_err_max"], r.stats["torque_in_ripple_pp"]])
+    taus = (1e-3, 2e-3, 4e-3, 8e-3)
+    runs = map_threads(lambda tau: mbsuite.run(base.replace(params={"solref_timeconst": tau})), taus)
+    rows = [[tau, r.stats["closure_residual_max"], r.stats["phi_c_err_max"], r.stats["torque_in_ripple_pp"]]
+            for tau, r in zip(taus, runs, strict=True)]
     print("\nsolref time constant (timestep 5e-4 s, dampratio 1): residual scales ~ tau^2")
     print(format_table(["timeconst", "closure_res_max", "phi_c_err_max", "ripple_pp"], rows, ".4g"))
 
+    facs = (1.0, 0.3, 0.1, 0.05)
+    runs = map_threads(lambda fac: mbsuite.run(base.replace(effects={"link_inertia": "massless"}, params={
+        "massless_factor": fac, "solref_timeconst": 1e-3})), facs)
     rows = []
-    for fac in (1.0, 0.3, 0.1, 0.05):
-        sc = base.replace(effects={"link_inertia": "massless"}, params={"massless_factor": fac,
-                                                                         "solref_timeconst": 1e-3})
-        r = mbsuite.run(sc)
+    for fac, r in zip(facs, runs, strict=True):
         f = np.array(r.stats["link_force_mean"])
         rows.append([fac, r.stats["torque_in_ripple_pp"], float(np.mean(np.abs(f))), float(np.ptp(np.abs(f))),
                      r.stats["closure_residual_max"]])

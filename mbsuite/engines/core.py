@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import SolverError
 from . import native
+from .mujoco_engine import warnings_raised
 
 #: recordable MjData quantities (order mirrors the MBS_F_* enum of native/mbsuite.h)
 FIELDS = ("time", "qpos", "qvel", "act", "ctrl", "actuator_force", "actuator_length", "actuator_velocity",
@@ -114,11 +115,6 @@ def _ptr(a: np.ndarray | None) -> int | None:
 def rows_for(nstep: int, every: int) -> int:
     """Recorded rows of a run of `nstep` steps sampled every `every` steps (the final state always included)."""
     return nstep // every + 1 + (1 if nstep % every else 0)
-
-
-def warnings_raised(data: mujoco.MjData) -> dict[str, int]:
-    """Non-zero MuJoCo warning counters by name."""
-    return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(data.warning) if w.number > 0}
 
 
 class Stepper:

@@ -1,8 +1,10 @@
-"""MuJoCo plumbing shared by all models: loading with clear errors, scoped callbacks, stepping with divergence checks.
+"""MuJoCo plumbing shared by all models: loading with clear errors (mbsuite's engine plugins registered first),
+integrators, warning counters, the joint-space inertia, and scoped Python callbacks.
 
-MuJoCo's Python callbacks (`mujoco.set_mjcb_*`) are process-global and hold the GIL. `callbacks(...)` installs only the
-callbacks a scene needs for the duration of a `with` block and always removes them, so a scene without them runs at the
-bare engine's cost and `mujoco.rollout` can use its C threads.
+mbsuite's shipped scenes install no Python callback: their effects are engine plugins (`native/`). `callbacks(...)`
+remains for the Python twins of those plugins (the readable reference the tests compare against) and for users'
+own experiments: MuJoCo's Python callbacks (`mujoco.set_mjcb_*`) are process-global and hold the GIL, so they are
+installed only for the duration of a `with` block and always removed.
 """
 
 from __future__ import annotations
@@ -106,7 +108,8 @@ def check_finite(model: mujoco.MjModel, data: mujoco.MjData, what: str) -> None:
 
 def warnings_raised(data: mujoco.MjData) -> dict[str, int]:
     """Non-zero MuJoCo warning counters by name."""
-    return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(data.warning) if w.number > 0}
+    counts = data.warning.number  # one array: iterating the struct list costs ~100 us
+    return {mujoco.mjtWarning(int(i)).name: int(counts[i]) for i in np.flatnonzero(counts)}
 
 
 def full_inertia(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -114,28 +117,3 @@ def full_inertia(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     M = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, M)
     return M
-
-
-def step_cost(model: mujoco.MjModel, cbs: dict[str, Callable | None], q0: np.ndarray | None, steps: int,
-              repeats: int, ctrl: float | np.ndarray | None = None) -> float:
-    """Seconds per `mj_step` in a Python loop (best of `repeats`), with the given callbacks installed.
-
-    `ctrl`: None, a constant for ctrl[0], or one value per step for ctrl[0] (written before every step, so that the
-    loop overhead is the same for the variants a benchmark compares)."""
-    import time
-
-    d = mujoco.MjData(model)
-    seq = None if ctrl is None else np.broadcast_to(np.asarray(ctrl, dtype=float), (steps,))
-    best = np.inf
-    with callbacks(**cbs):
-        for _ in range(repeats):
-            mujoco.mj_resetData(model, d)
-            if q0 is not None:
-                d.qpos[:] = q0
-            t0 = time.perf_counter()
-            for k in range(steps):
-                if seq is not None:
-                    d.ctrl[0] = seq[k]
-                mujoco.mj_step(model, d)
-            best = min(best, time.perf_counter() - t0)
-    return best / steps

@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _jobs(n: int = 4) -> list:
-    """Short pantograph runs at different frequencies (MuJoCo path, callbacks installed in each process)."""
+    """Short pantograph runs at different frequencies (MuJoCo path with its engine plugins)."""
     sc = load_scene("pantograph").replace(solver={"duration": 0.3, "t_settle": 0.0})
     return [(sc.to_dict(), {"input": {"frequency": 2.0 + 1.5 * i}}) for i in range(n)]
 
@@ -42,6 +42,33 @@ def test_local_pool_equals_serial_and_keeps_order():
     assert pooled == serial  # bit-identical, in the order of the points
     f1max = [r["signals"]["F1"]["max"] for r in serial]
     assert len(set(f1max)) == len(f1max)  # the points really differ (no accidental caching)
+
+
+def test_threads_equal_serial_and_keep_order():
+    """The thread executor (native-core runs release the GIL): bit-identical to one worker, in order."""
+    jobs = _jobs()
+    assert run_sweep(scene_point, jobs, workers=2, executor="threads") == run_sweep(scene_point, jobs, workers=1)
+
+
+def test_pantograph_frequency_sweep_threads_and_rollout_identical_to_one_thread():
+    """The MuJoCo frequency sweep in C threads equals one thread; mujoco.rollout runs the same plugin model with 1 or 2
+    threads to identical states."""
+    from mbsuite.models.pantograph.analysis import mujoco_sweep
+    from mbsuite.models.pantograph.mujoco import MujocoPantograph
+
+    sc = load_scene("pantograph").replace(solver={"duration": 0.6, "t_settle": 0.1})
+    freqs = np.array([2.0, 5.0, 9.0, 14.0])
+    one, two = mujoco_sweep(sc, freqs, workers=1), mujoco_sweep(sc, freqs, workers=2)
+    assert [r["F1"] for r in one] == [r["F1"] for r in two] and len({r["F1"] for r in one}) == 4
+    mp = MujocoPantograph(sc.build_params(), None, "rk4", 1e-3)
+    mp.set_static(mp.equilibrium(), mp.p.y_op)
+    x0 = np.tile(get_state(mp.model, mp.data), (4, 1))
+    t = (np.arange(600) + 0.5) * 1e-3
+    ctrl = np.zeros((4, 600, mp.model.nu))
+    ctrl[:, :, 0] = 1.58 + 1.85e-3 * (1 - np.cos(2 * np.pi * freqs[:, None] * t[None, :]))
+    s1, _ = rollout_sweep(mp.model, x0, ctrl, workers=1)
+    s2, _ = rollout_sweep(mp.model, x0, ctrl, workers=2)
+    assert np.array_equal(s1, s2) and np.all(np.isfinite(s1))
 
 
 def test_dask_localcluster_identical_to_local(tmp_path):

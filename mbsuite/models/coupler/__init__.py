@@ -39,6 +39,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).resolve().parent / "scenes",
     default_scene="double_lateral",
     run=run,
+    cases="mbsuite.models.coupler.cases",
     extra={"solver_defaults": {"integrator": "implicitfast", "timestep": 5e-4, "duration": 2.0, "t_settle": 0.5,
                                "sample_dt": 2e-3}},
 )

@@ -13,6 +13,8 @@ Conventions (reference B1, README):
   row k = [l_k^T, ((b_k - o^b) x l_k)^T] with l_k the unit link vector. The paper's printed Eq (15) is the transposed
   matrix with the moment rows negated ((o - b) x l, Eq 13) and the rows ordered (x, z, -y | m_x, m_z, -m_y):
   see `paper_eq15_layout`.
+- batched double-coupler FPP (`solve_double_batch`, `solve_double_wrapped_batch`): the same equations and tolerance for
+  N poses at once (numpy, batched 8 x 8 solves), for the samples of a run; `solve_double` stays the readable reference.
 """
 
 from __future__ import annotations
@@ -535,6 +537,180 @@ def double_revolution(p: CouplerParams, alpha_cx: float = 0.0, alpha_cz: float =
     except SolverError as exc:
         _no_physical(p, _double_tilt(p, np.r_[0.0, rest]), exc)
     return DoubleRevolution(phis, u, rest)
+
+
+# ---------------------------------------------------------------------------------------- double coupler, batched
+# The same equations for N poses at once (numpy, no Python loop over samples): used where the FPP is solved for every
+# recorded sample of a run. `double_residual` / `double_residual_jac` / `solve_double` above stay the readable
+# reference; a test holds the batched functions equal to them.
+def _rx(x, y, z, c, s):
+    return x, c * y - s * z, s * y + c * z
+
+
+def _ry(x, y, z, c, s):
+    return c * x + s * z, y, -s * x + c * z
+
+
+def _rz(x, y, z, c, s):
+    return c * x - s * y, s * x + c * y, z
+
+
+def _trig(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return np.cos(a)[:, None], np.sin(a)[:, None]
+
+
+def _link_points_b(p: CouplerParams) -> np.ndarray:
+    """Local points (8, 3) on shaft b where links 1..8 end: BA_{k+1} for coupler 1, BC_{k+1} for coupler 2."""
+    return np.vstack([platform_points(p.gamma, p.R)[NEXT], bc_points(p)[NEXT]])
+
+
+def _double_links_n(p: CouplerParams, inp: np.ndarray, u: np.ndarray, jac: bool):
+    """For N poses (inp (N, 5), u (N, 8)): the link vectors L = (driven point - driving point) as components
+    (Lx, Ly, Lz), each (N, 8) (links 1-4: ba_{k+1} - a_k; links 5-8: bc_{k+1} - c_k), shaft b's and c's axes
+    R_b e_y, R_c e_y (N, 3), and, if `jac`, d(|L|^2 / 2)/du (N, 8, 8). Rotations are applied to point components one
+    factor at a time (R = R_z R_x R_y), so everything is elementwise on (N, 8) arrays."""
+    n = inp.shape[0]
+    loc = platform_points(p.gamma, p.R)
+    qb = _link_points_b(p)
+    ca, sa = _trig(inp[:, 0])
+    ccx, scx = _trig(inp[:, 1])
+    ccz, scz = _trig(inp[:, 2])
+    cpc, spc = _trig(u[:, 0])
+    cpb, spb = _trig(u[:, 5])
+    cbx, sbx = _trig(u[:, 6])
+    cbz, sbz = _trig(u[:, 7])
+    zero = np.zeros((n, 1))
+    # shaft b: P = R_b q (q the 8 link points), W = R_x R_y q (for d/dalpha_bx)
+    v = _ry(qb[:, 0], qb[:, 1] + zero, qb[:, 2], cpb, spb)
+    w = _rx(*v, cbx, sbx)
+    P = _rz(*w, cbz, sbz)
+    ob = (u[:, 2:3], p.e_y + u[:, 3:4], u[:, 4:5])
+    # driving points: a_k on shaft a (links 1-4), c_k on shaft c (links 5-8)
+    a = _ry(loc[:, 0], loc[:, 1] + zero, loc[:, 2], ca, sa)
+    vc = _ry(loc[:, 0], loc[:, 1] + zero, loc[:, 2], cpc, spc)
+    C = _rz(*_rx(*vc, ccx, scx), ccz, scz)
+    oc = (inp[:, 3:4], 2 * p.e_y + p.l_b + u[:, 1:2], inp[:, 4:5])
+    L = tuple(np.hstack([P[i][:, :4] + ob[i] - a[i], P[i][:, 4:] + ob[i] - C[i] - oc[i]]) for i in range(3))
+    yb = np.column_stack([-sbz * cbx, cbz * cbx, sbx])  # R_b e_y
+    yc = np.column_stack([-scz * ccx, ccz * ccx, scx])  # R_c e_y
+    if not jac:
+        return L, yb, yc, None
+    J = np.zeros((n, 8, 8))
+    J[:, :, 2], J[:, :, 3], J[:, :, 4] = L
+
+    def dot(D) -> np.ndarray:
+        return L[0] * D[0] + L[1] * D[1] + L[2] * D[2]
+
+    # d/dphi_b: R_b (e_y x q);  d/dalpha_bx: R_z (e_x x W);  d/dalpha_bz: e_z x P
+    sy = (qb[:, 2], qb[:, 1] * 0.0, -qb[:, 0])
+    J[:, :, 5] = dot(_rz(*_rx(*_ry(*sy, cpb, spb), cbx, sbx), cbz, sbz))
+    J[:, :, 6] = dot(_rz(zero, -w[2], w[1], cbz, sbz))
+    J[:, :, 7] = dot((-P[1], P[0], zero))
+    # coupler 2 also depends on shaft c: d/dphi_c of c_k is R_c (e_y x p_k); d/dy_c of c_k is e_y
+    syc = (loc[:, 2], loc[:, 1] * 0.0, -loc[:, 0])
+    dC = _rz(*_rx(*_ry(*syc, cpc, spc), ccx, scx), ccz, scz)
+    J[:, 4:, 0] = -(L[0][:, 4:] * dC[0] + L[1][:, 4:] * dC[1] + L[2][:, 4:] * dC[2])
+    J[:, 4:, 1] = -L[1][:, 4:]
+    return L, yb, yc, J
+
+
+def double_residual_batch(p: CouplerParams, inp: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """`double_residual` for N poses: inp (N, 5), u (N, 8) -> (N, 8)."""
+    L, *_ = _double_links_n(p, np.atleast_2d(inp), np.atleast_2d(u), False)
+    return L[0] ** 2 + L[1] ** 2 + L[2] ** 2 - p.link_length**2
+
+
+def double_residual_jac_batch(p: CouplerParams, inp: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """`double_residual_jac` for N poses: (N, 8, 8)."""
+    return 2.0 * _double_links_n(p, np.atleast_2d(inp), np.atleast_2d(u), True)[3]
+
+
+def _sample(i: int, inp: np.ndarray, times: np.ndarray | None) -> str:
+    where = f"t = {times[i]:.6g} s" if times is not None else f"sample {i}"
+    return f"{where} (phi_a = {inp[i, 0]:.6g} rad)"
+
+
+def _check_physical_batch(p: CouplerParams, links: np.ndarray, axes: list[np.ndarray], what: str,
+                          inp: np.ndarray, times: np.ndarray | None) -> None:
+    """`check_physical` for N poses: links (3 components, each (N, 4)), axes [(N, 3)]; GeometryError naming the first
+    bad sample."""
+    for s in axes:
+        worst = np.min(links[0] * s[:, :1] + links[1] * s[:, 1:2] + links[2] * s[:, 2:], axis=1) / p.link_length
+        bad = np.flatnonzero(~(worst > 0.0))
+        if bad.size:
+            i = int(bad[0])
+            raise GeometryError(
+                f"{what} at {_sample(i, inp, times)}: no physical pose - platform B would cross platform A (a link's "
+                f"axial component {worst[i]:+.3g} l <= 0; {bad.size} of {worst.size} samples); e_y = {p.e_y:g} is too "
+                "small for this misalignment (need e_y > ~R*alpha)")
+
+
+def solve_double_batch(p: CouplerParams, inp: np.ndarray, guess: np.ndarray, *, tol: float = 1e-13,
+                       max_iter: int = 50, times: np.ndarray | None = None) -> np.ndarray:
+    """`solve_double` for N poses at once: Gauss-Newton on Eq (4) for every sample (batched 8 x 8 solves), each sample
+    iterated until |r|_inf <= tol R^2 (the tolerance of `solve_double`), then the same physical-pose check. inp (N, 5)
+    as DOUBLE_INPUTS, guess (N, 8) as DOUBLE_UNKNOWNS, one guess per sample (it must be near the wanted branch: a
+    continuation's predictor, or the state of a simulation of the mechanism). A sample that does not converge is a
+    SolverError naming it (its time if `times` is given), never a silent number."""
+    inp = np.atleast_2d(np.asarray(inp, float))
+    u = np.array(np.atleast_2d(guess), dtype=float)
+    if inp.ndim != 2 or inp.shape[1] != 5 or u.shape != (inp.shape[0], 8):
+        raise ValueError(f"inp must be (N, 5) and guess (N, 8); got {inp.shape} and {u.shape}")
+    if p.e_y == 0.0 and np.any(inp[:, 1:] != 0.0):
+        raise GeometryError("double coupler FPP: e_y = 0 (coplanar platforms) admits no misaligned physical pose")
+    tol_abs = tol * p.R**2
+    l2 = p.link_length**2
+    rmax = np.full(inp.shape[0], np.inf)
+    active = np.ones(inp.shape[0], bool)
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging sample is reported below, by name
+        for it in range(max_iter + 1):
+            idx = np.flatnonzero(active)
+            if not idx.size:
+                break
+            L, _, _, J = _double_links_n(p, inp[idx], u[idx], True)
+            r = L[0] ** 2 + L[1] ** 2 + L[2] ** 2 - l2
+            rmax[idx] = np.max(np.abs(r), axis=1)  # NaN for a non-finite residual
+            go = ~(rmax[idx] <= tol_abs) & np.isfinite(rmax[idx])  # converged or non-finite: stop iterating it
+            active[idx] = go
+            if it == max_iter or not go.any():
+                break
+            idx, J, r = idx[go], 2.0 * J[go], r[go]
+            try:
+                du = np.linalg.solve(J, r[:, :, None])[..., 0]
+            except np.linalg.LinAlgError:  # an exactly singular J somewhere: least squares for these samples
+                du = (np.linalg.pinv(J) @ r[:, :, None])[..., 0]
+            u[idx] -= du
+    bad = np.flatnonzero(~(rmax <= tol_abs))
+    if bad.size:
+        i = int(bad[0])
+        fin = bool(np.isfinite(rmax[i]))
+        why = f"did not converge in {max_iter} iterations" if fin else "met a non-finite residual"
+        res = f"residual |r|_inf = {rmax[i]:.3e}, " if fin else ""
+        exc = SolverError(f"double coupler FPP: Gauss-Newton {why} at {_sample(i, inp, times)} ({res}tolerance "
+                          f"{tol_abs:.1e}; {bad.size} of {rmax.size} samples)")
+        _no_physical(p, _double_tilt(p, inp[i]), exc)
+    if p.e_y > 0.0:
+        L, yb, yc, _ = _double_links_n(p, inp, u, False)
+        ey = np.broadcast_to(EY, yb.shape)
+        _check_physical_batch(p, [x[:, :4] for x in L], [ey, yb], "double coupler FPP (coupler A-BA)", inp, times)
+        _check_physical_batch(p, [-x[:, 4:] for x in L], [yb, yc], "double coupler FPP (coupler BC-C)", inp, times)
+    return u
+
+
+#: the unknowns that turn with phi_a (phi_c and phi_b): the pose is 2 pi-periodic in phi_a with these advanced by 2 pi
+DOUBLE_TURN = np.array([2 * math.pi, 0.0, 0.0, 0.0, 0.0, 2 * math.pi, 0.0, 0.0])
+
+
+def solve_double_wrapped_batch(p: CouplerParams, phi_a: np.ndarray, rest: np.ndarray, guess: np.ndarray, *,
+                               tol: float = 1e-13, times: np.ndarray | None = None) -> np.ndarray:
+    """FPP poses (N, 8) at input angles phi_a (N,) and fixed misalignment rest = (alpha_cx, alpha_cz, x_c, z_c), solved
+    at phi_a wrapped to within pi of 0 and turned back: the absolute tolerance cannot be met by sin/cos of an angle of
+    1000 rad (long runs), and the pose is 2 pi-periodic in phi_a (phi_b, phi_c advanced by 2 pi, `DOUBLE_TURN`)."""
+    phi_a = np.asarray(phi_a, float)
+    k = np.round(phi_a / (2 * math.pi))
+    inp = np.column_stack([phi_a - 2 * math.pi * k, np.broadcast_to(np.asarray(rest, float), (phi_a.size, 4))])
+    turn = k[:, None] * DOUBLE_TURN
+    return solve_double_batch(p, inp, np.asarray(guess, float) - turn, tol=tol, times=times) + turn
 
 
 def double_output_angle(p: CouplerParams, inp: np.ndarray, guess: np.ndarray | None = None) -> float:

@@ -151,7 +151,8 @@ def run(scene: Scene) -> SimResult:
         mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
         q0 = None if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
         every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
-        tr = mp.simulate(u, s.duration, q0, every=every, what=f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)")
+        tr = mp.simulate(u, s.duration, q0, every=every, what=f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)",
+                         guess=theta_to_q(ode.theta(x0[:ode.nq])))
         P = tr["act"].reshape(tr.t.size, -1)[:, 0] if mp.model.na else None
         sig = signals(ode, thetas(tr["qpos"]), u(tr.t), P)
         ev = _contact_losses(tr.t, sig["contact_force"]) if cfg.contact == "unilateral" else []
@@ -281,8 +282,8 @@ def mujoco_sweep(scene: Scene, freqs: np.ndarray, *, method: str = "mujoco", wor
     mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
     base = input_of(scene.replace(input={"type": "sine"}), p)
     x0 = initial_theta(scene, ode, base)
-    q0 = mp.equilibrium(base(0.0)) if scene.input.get("initial", "equilibrium") == "equilibrium" else \
-        theta_to_q(x0[:3])
+    q0 = mp.equilibrium(base(0.0), theta_to_q(ode.theta(x0[:ode.nq]))) \
+        if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
     ts = s.t_settle or 0.5 * s.duration
 
     def point(job: tuple[dict, float, str]) -> dict:

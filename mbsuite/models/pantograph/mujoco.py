@@ -128,24 +128,28 @@ class MujocoPantograph:
             return np.array([r[0] + dq2 * r[1], c, r[2]])
         return r.copy()
 
-    def equilibrium(self, y_w: float | None = None) -> np.ndarray:
-        """Joint positions of the static equilibrium at ram height y_w (default y_op) on MuJoCo's own residual,
-        started from the hand-derived equilibrium."""
-        y_w = self.p.y_op if y_w is None else y_w
-        ode = self._ode
-        x = ode.equilibrium(y_w)
-        guess = theta_to_q(ode.theta(x[:ode.nq]))
-        q, _, ier, msg = fsolve(lambda q: self.static_residual(q, y_w), guess, xtol=1e-14, full_output=True)
-        for _ in range(3):  # Newton polish on MuJoCo's residual
+    def equilibrium(self, y_w: float | None = None, guess: np.ndarray | None = None) -> np.ndarray:
+        """Joint positions of the static equilibrium at ram height y_w (default y_op): Newton's method on MuJoCo's own
+        residual (central-difference Jacobian), started from `guess` or the hand-derived equilibrium (fsolve if Newton
+        does not converge from there)."""
+        y_w = self.p.y_op if y_w is None else float(y_w)
+        if guess is None:
+            ode = self._ode
+            guess = theta_to_q(ode.theta(ode.equilibrium(y_w)[:ode.nq]))
+        q = np.asarray(guess, dtype=float).copy()
+        for _ in range(8):
             r = self.static_residual(q, y_w)
-            if np.max(np.abs(r)) < 1e-11:
-                break
             h = 1e-7
             Jr = np.column_stack([(self.static_residual(q + h * e, y_w) - self.static_residual(q - h * e, y_w))
                                   / (2 * h) for e in np.eye(3)])
-            q = q - np.linalg.solve(Jr, r)
+            dq = np.linalg.solve(Jr, -r)
+            q = q + dq
+            if np.max(np.abs(dq)) < 1e-15:
+                break
+        if not np.max(np.abs(self.static_residual(q, y_w))) < 1e-8:
+            q, *_ = fsolve(lambda x: self.static_residual(x, y_w), guess, xtol=1e-14, full_output=True)
         res = np.max(np.abs(self.static_residual(q, y_w)))
-        if res > 1e-6:
+        if not res <= 1e-6:
             raise GeometryError(f"MuJoCo: no static equilibrium at y_w = {y_w} m (residual {res:.3g} N m)")
         return q
 
@@ -168,14 +172,15 @@ class MujocoPantograph:
         return core.Stepper(self.model, self.data if data is None else data, self.channels(), every=every, what=what)
 
     def simulate(self, y_w: Callable[[np.ndarray], np.ndarray], t_end: float, q0: np.ndarray | None = None, *,
-                 every: int = 1, what: str = "pantograph (MuJoCo)",
-                 data: mujoco.MjData | None = None) -> core.Trajectory:
+                 every: int = 1, what: str = "pantograph (MuJoCo)", data: mujoco.MjData | None = None,
+                 guess: np.ndarray | None = None) -> core.Trajectory:
         """Step from the static equilibrium (or q0) at rest for t_end seconds under the ram y_w (vectorised callable
-        of time), recording every `every` steps. Failures raise SolverError. With `data` (and q0) given, nothing of
-        this object is touched: runs in several threads share the model."""
+        of time), recording every `every` steps; `guess` starts the equilibrium's Newton iteration. Failures raise
+        SolverError. With `data` (and q0) given, nothing of this object is touched: runs in several threads share
+        the model."""
         nstep = int(round(t_end / self.model.opt.timestep))
         y0 = float(np.asarray(y_w(np.zeros(1))).ravel()[0])
-        self.set_static(self.equilibrium(y0) if q0 is None else q0, y0, data)
+        self.set_static(self.equilibrium(y0, guess) if q0 is None else q0, y0, data)
         d = self.data if data is None else data
         d.time = 0.0
         return self.stepper(every, what, d).run(nstep, ctrl=self.ram_input(y_w, nstep), ctrl_idx=[self.i_cat])

@@ -1,0 +1,318 @@
+"""The coupler's suite declarations (`SPEC.cases`): its hard cases, its work-precision study and its random input.
+
+- `HARD_CASES`: situations that break naive codes, each with the scene that provokes it and what must hold
+  (`mbsuite.hardcases.HardCase`; bounds are stated with the numbers measured when they were set);
+- `workprecision_study(scene, quick)`: the FPP (Gauss-Newton tolerance x continuation steps) and the MuJoCo dynamics
+  (integrator x timestep) against their references (`CouplerStudy`);
+- `random_input(scene, rng)`: admissible random changes of a scene's input (speed, load, misalignment).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ...analysis.workprecision import Setting, Study, _rel
+from ...errors import GeometryError, SceneError, SolverError
+from ...hardcases import Checker, HardCase
+from ...scenes import Scene
+
+
+def _error_of(fn: Callable[[], Any]) -> BaseException | None:
+    """The exception `fn` raises (None if it returns)."""
+    try:
+        fn()
+    except Exception as e:  # noqa: BLE001 - the caller checks the type and the message
+        return e
+    return None
+
+
+def _raises_exactly(ck: Checker, what: str, fn: Callable[[], Any], exc: type[BaseException],
+                    phrases: tuple[str, ...]) -> None:
+    """A check that `fn` raises `exc` whose message contains every one of `phrases` (case-insensitive)."""
+    e = _error_of(fn)
+    text = "no error raised" if e is None else f"{type(e).__name__}: {e}"
+    missing = [] if e is None else [ph for ph in phrases if ph.lower() not in str(e).lower()]
+    ck.true(what, isinstance(e, exc) and not missing, text[:160] + (f" (missing {missing})" if missing else ""))
+
+
+# ================================================================================================ hard cases
+def _coupler_ey_to_zero(ck: Checker) -> None:
+    from . import reference as ref
+    from .params import CouplerParams
+
+    conds = {}
+    for ey in (1e-1, 1e-2, 1e-4, 1e-6, 1e-8):
+        p = CouplerParams(e_y=ey)
+        an = ref.analyse_jacobian(ref.single_jacobian(p, ref.solve_single(p, 0.0)), np.zeros(3))
+        conds[ey] = an.cond
+        ck.le(f"cond(J) at e_y = {ey:g} vs R cos(2 gamma)/e_y, relative", abs(an.cond / (math.cos(2 * p.gamma) / ey)
+                                                                            - 1), 1e-3)
+        ck.true(f"rank 4 at e_y = {ey:g}", an.rank == 4, an.rank)
+    p0 = CouplerParams(e_y=0.0)
+    an0 = ref.analyse_jacobian(ref.single_jacobian(p0), np.zeros(3))
+    ck.true("e_y = 0: rank 3 detected, cond = inf", an0.rank == 3 and math.isinf(an0.cond), (an0.rank, an0.cond))
+    ck.true("e_y = 0: a free translation along the shaft is reported",
+            any(not math.isfinite(s.pitch) and abs(abs(s.axis[1]) - 1) < 1e-9 for s in an0.principal_screws))
+    ck.measured["cond"] = conds
+
+
+def _coupler_ey_below_alpha(ck: Checker) -> None:
+    from . import reference as ref
+    from .params import CouplerParams
+
+    p = CouplerParams(e_y=0.02)
+    ck.raises("single FPP with e_y = 0.02 < R alpha = 0.07", lambda: ref._ramp_single(p, 0.0, 0.07, 0.0),
+              GeometryError, "no physical pose")
+    ck.raises("single revolution with e_y = 0.02, alpha = 0.07", lambda: ref.single_revolution(p, 0.07, n=37),
+              GeometryError, "e_y")
+    ck.raises("e_y = 0 with any inclination", lambda: ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01),
+              GeometryError, "coplanar")
+    ok = ref.single_revolution(CouplerParams(e_y=0.1), 0.07, n=73)
+    ck.le("e_y = 0.1 > R alpha: closes after a turn |phi_b(2 pi) - phi_b(0) - 2 pi|",
+          abs(ok.u[-1, 0] - ok.u[0, 0] - 2 * math.pi), 1e-9)
+
+
+def _coupler_phibc90(ck: Checker) -> None:
+    from mbsuite import load_scene, run
+
+    from . import reference as ref
+    from .params import CouplerParams
+
+    rev = ref.double_revolution(CouplerParams(phi_bc=math.pi / 2), z_c=0.08, n=73)
+    ck.le("FPP revolution closes: |phi_c(2 pi) - phi_c(0) - 2 pi|", abs(rev.u[-1, 0] - rev.u[0, 0] - 2 * math.pi),
+          1e-9)
+    res = run(load_scene("coupler/double_phibc90").replace(solver={"duration": 1.0}))
+    ck.finite("MuJoCo outputs", *res.signals.values())
+    ck.true("MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
+    # README: settled residual 2.77e-5 m (2 s); the start-up ramp peak is excluded by t_settle
+    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-4)
+    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-3)
+
+
+def _coupler_big_step(ck: Checker) -> None:
+    from mbsuite import load_scene, run
+
+    sc = load_scene("coupler/double_lateral").replace(solver={"duration": 0.5, "t_settle": 0.3, "sample_dt": 0.0})
+    # above solref_timeconst / 2 MuJoCo would silently stiffen the closures (solref raised to 2 h): refused up front
+    for h in (5e-3, 2e-2):
+        _raises_exactly(ck, f"h = {h:g} s: SceneError before any step, naming solref_timeconst and the admissible "
+                            "timestep", lambda h=h: run(sc.replace(solver={"timestep": h})), SceneError,
+                        (f"solver.timestep = {h:g} s is too large for the soft link closures", "solref_timeconst",
+                         "use timestep <= 0.001 s"))
+    # at the limit h = solref_timeconst / 2 the closures keep their time constant (measured 0.5 s: residual 3.86e-5 m
+    # after the ramp vs 3.75e-5 m at 0.5 ms; phi_c error 3.53e-5 rad)
+    res = run(sc.replace(solver={"timestep": 1e-3}))
+    ck.finite("h = 1 ms (= solref_timeconst / 2) outputs", *res.signals.values())
+    ck.true("h = 1 ms: no MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
+    ck.le("h = 1 ms: closure residual after the ramp (m)", res.stats["closure_residual_max"], 5e-5)
+    ck.le("h = 1 ms: phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 5e-5)
+
+
+def _coupler_rk4_limit(ck: Checker) -> None:
+    from mbsuite import load_scene, run
+
+    sc = load_scene("coupler/double_lateral").replace(solver={"integrator": "rk4", "timestep": 1e-3, "duration": 1.0})
+    # RK4 cannot hold the stiff servo at 1 ms: the drive torque leaves its bound kv x 1 rad/s (measured t = 0.018 s)
+    _raises_exactly(ck, "RK4 at h = 1 ms: SolverError on the servo bound, with the integrator, the timestep and the "
+                        "advice", lambda: run(sc), SolverError,
+                    ("torque_in", "plausible range", "integrator rk4, timestep 0.001 s", "input velocity servo",
+                     "reduce solver.timestep or use implicitfast/implicit"))
+    # closures at exactly 2 timesteps with a step RK4 holds the servo at: h = 0.5 ms, solref_timeconst = 1 ms
+    # (measured 1 s: residual 9.25e-6 m, phi_c error 8.85e-6 rad, mean input torque 1000.0014 N m, ripple 7.05 N m;
+    # implicitfast at the same settings: 9.68e-6 m, 8.85e-6 rad, 1000.0006 N m, 6.96 N m)
+    res = run(sc.replace(solver={"timestep": 5e-4}, params={"solref_timeconst": 1e-3}))
+    ck.finite("RK4 at h = 0.5 ms = solref_timeconst / 2: outputs", *res.signals.values())
+    ck.true("RK4 at h = 0.5 ms: no MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
+    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1.5e-5)
+    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1.5e-5)
+    # power balance: the mean input torque equals the 1 kN m load
+    ck.le("|mean input torque / load - 1|", abs(res.stats["torque_in_mean"] / 1000.0 - 1), 1e-4)
+    ck.le("input-torque ripple p-p (N m)", res.stats["torque_in_ripple_pp"], 8.0)
+
+
+def _coupler_drift_100s(ck: Checker) -> None:
+    from mbsuite import load_scene, run
+
+    res = run(load_scene("coupler/double_lateral").replace(solver={"duration": 100.0, "sample_dt": 0.01}))
+    r, t = res["closure_residual"], res.t
+    ck.finite("100 s outputs", *res.signals.values())
+    ck.le("closure residual over 100 s after the ramp (m)", np.max(r[t >= 0.5]), 1e-4)
+    ck.le("residual last 10 s / residual 0.5-10.5 s (no drift)",
+          np.max(r[t >= 90]) / np.max(r[(t >= 0.5) & (t < 10.5)]), 1.5)
+    ck.le("phi_c - phi_c,kin over 100 s (rad)", np.max(np.abs(res["phi_c_err"][t >= 0.5])), 1e-3)
+
+
+HARD_CASES: tuple[HardCase, ...] = (
+    HardCase("coupler_ey_to_zero", "coupler",
+             "coplanar platforms e_y -> 0: the mechanism Jacobian loses rank (cond ~ 1/e_y)",
+             "single coupler Jacobian at e_y = 1e-1 ... 1e-8 and 0",
+             "cond = R cos(2 gamma)/e_y within 1e-3; rank 4 down to 1e-8; rank 3 and cond = inf at 0; free axial "
+             "translation reported", _coupler_ey_to_zero),
+    HardCase("coupler_ey_below_R_alpha", "coupler",
+             "e_y < R alpha: no physical pose (platform B would cross A); Gauss-Newton may converge to garbage",
+             "single coupler FPP, e_y = 0.02, alpha_bx = 0.07 (and e_y = 0)",
+             "GeometryError naming the cause; the physical case e_y = 0.1 closes after a turn to 1e-9",
+             _coupler_ey_below_alpha),
+    HardCase("coupler_double_phibc90", "coupler",
+             "double coupler with phi_bc = pi/2: fluctuations add, continuation through large swings",
+             "coupler/double_phibc90 (MuJoCo 1 s) and its FPP revolution",
+             "FPP closes to 1e-9; no NaN, no MuJoCo warning; closure residual <= 1e-4 m; phi_c error <= 1e-3 rad",
+             _coupler_phibc90),
+    HardCase("coupler_over_large_timestep", "coupler",
+             "soft closures at a timestep far above solref/2",
+             "coupler/double_lateral at h = 5 ms and 20 ms, and at the limit h = solref_timeconst / 2 = 1 ms",
+             "5 ms and 20 ms: SceneError before any step naming solref_timeconst and 'use timestep <= 0.001 s'; "
+             "1 ms: no NaN, no warning, closure residual <= 5e-5 m, phi_c error <= 5e-5 rad",
+             _coupler_big_step),
+    HardCase("coupler_rk4_at_solref_limit", "coupler",
+             "explicit RK4 at h = 1 ms: stiff input servo (kv/J = 2e4 /s) and closures at exactly 2 timesteps",
+             "coupler/double_lateral with integrator rk4: h = 1 ms; h = 0.5 ms with solref_timeconst = 1 ms, 1 s",
+             "1 ms: SolverError on the drive-torque bound naming rk4, the timestep and the advice 'reduce "
+             "solver.timestep or use implicitfast/implicit'; 0.5 ms (closures at 2 timesteps): no NaN, no warning, "
+             "closure <= 1.5e-5 m, phi_c error <= 1.5e-5 rad, mean input torque = load within 1e-4, ripple <= 8 N m",
+             _coupler_rk4_limit),
+    HardCase("coupler_closure_drift_100s", "coupler",
+             "long-time drift of 8 soft closures", "coupler/double_lateral, 100 s",
+             "residual <= 1e-4 m, last 10 s <= 1.5x the first 10 s; phi_c error <= 1e-3 rad",
+             _coupler_drift_100s, slow=True),
+)
+
+
+# ================================================================================================ work-precision
+class CouplerStudy(Study):
+    FPP_TOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-13)
+    FPP_STEPS = (19, 37, 73, 181)
+    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
+    MJ_STEPS = (1e-3, 5e-4, 2.5e-4)
+    state_doc = ("FPP: max |u - u_ref| over the 8 unknowns (rad, R); MuJoCo: max(|phi_c - ref| / 1 rad, |omega_c - "
+                 "ref| / omega, |torque_in - ref| / T_load)")
+    physics_doc = ("FPP: max(|phi_c - ref| rad, |c5 - c5_ref| rad, max closure residual / R^2); MuJoCo: max rel. error "
+                   "of settled (phi_c - phi_c,kin) max, closure residual max, input-torque ripple")
+
+    def __init__(self, scene: Scene, quick: bool = False):
+        super().__init__(scene, quick)
+        from .mujoco import _inputs
+
+        self.p = scene.build_params()
+        self.inp = _inputs(scene)
+        T = 0.5 if quick else 1.0
+        self.base = scene.replace(solver={"duration": T, "t_settle": 0.3 if quick else 0.5, "sample_dt": 2e-3},
+                                  outputs=["phi_a", "phi_c", "phi_c_kin", "phi_c_err", "omega_c", "torque_in",
+                                           "closure_residual"])
+        self.rest = np.array([self.inp["alpha_cx"], self.inp["alpha_cz"], self.inp["x_c"], self.inp["z_c"]])
+
+    # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
+    def fpp(self, tol: float, n: int) -> np.ndarray:
+        from . import reference as ref
+
+        phis = np.linspace(0.0, 2 * math.pi, n)
+        u = ref._ramp_double(self.p, np.r_[0.0, self.rest])
+        out = [u]
+        du = np.zeros_like(u)
+        for ph in phis[1:]:
+            g = u + du
+            u_new = ref.solve_double(self.p, np.r_[ph, self.rest], g, tol=tol)
+            du = u_new - u
+            u = u_new
+            out.append(u)
+        return np.array(out)
+
+    def fpp_reference(self, n: int) -> np.ndarray:
+        from scipy.optimize import least_squares
+
+        from . import reference as ref
+
+        u = self.fpp(1e-13, n)
+        out = []
+        for ph, g in zip(np.linspace(0.0, 2 * math.pi, n), u, strict=True):
+            x = np.r_[ph, self.rest]
+            sol = least_squares(lambda v, x=x: ref.double_residual(self.p, x, v), g,
+                                jac=lambda v, x=x: ref.double_residual_jac(self.p, x, v), method="trf",
+                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            out.append(sol.x)
+        return np.array(out)
+
+    def settings(self) -> list[Setting]:
+        from mbsuite import run
+
+        out = []
+        tols = (1e-4, 1e-8) if self.quick else self.FPP_TOLS
+        steps = (19, 37) if self.quick else self.FPP_STEPS
+        for tol in tols:
+            for n in steps:
+                out.append(Setting("fpp", "gauss-newton", f"tol {tol:g}, {n} steps",
+                                   lambda tol=tol, n=n: ("fpp", n, self.fpp(tol, n))))
+        integ = ("implicitfast",) if self.quick else self.MJ_INTEGRATORS
+        hs = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
+        for i in integ:
+            for h in hs:
+                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
+                out.append(Setting("mujoco", i, h, lambda sc=sc: ("mujoco", 0, run(sc))))
+        return out
+
+    def reference(self):
+        from mbsuite import run
+
+        self._fpp_ref = {n: self.fpp_reference(n) for n in ((19, 37) if self.quick else self.FPP_STEPS)}
+        mj_ref = run(self.base.replace(solver={"engine": "mujoco", "integrator": "rk4", "timestep": 1e-4}))
+        return {"mujoco": mj_ref}, {"reference": "FPP: scipy least_squares (trf) xtol=ftol=gtol=1e-15; "
+                                                 "MuJoCo: rk4 at 1e-4 s (same soft-closure model)"}
+
+    def _c5(self, u: np.ndarray, n: int) -> float:
+        phis = np.linspace(0.0, 2 * math.pi, n)
+        d = phis - u[:, 0]
+        return float(np.max(np.abs(d - d.mean())))
+
+    def state_error(self, res, ref) -> float:
+        kind, n, r = res
+        if kind == "fpp":
+            return float(np.max(np.abs(r - self._fpp_ref[n])))
+        rr = ref["mujoco"]
+        om, tl = self.inp["omega"], self.inp["load_torque"]
+        m = rr.t >= self.base.solver.t_settle  # the start-up ramp of the stiff servo is not compared
+
+        def err(sig: str) -> float:
+            return float(np.max(np.abs(np.interp(rr.t[m], r.t, r[sig]) - rr[sig][m])))
+
+        return max(err("phi_c"), err("omega_c") / om, err("torque_in") / tl)
+
+    def physics_error(self, res, ref):
+        from . import reference as cref
+
+        kind, n, r = res
+        if kind == "fpp":
+            uref = self._fpp_ref[n]
+            phis = np.linspace(0.0, 2 * math.pi, n)
+            resid = max(float(np.max(np.abs(cref.double_residual(self.p, np.r_[ph, self.rest], u))))
+                        for ph, u in zip(phis, r, strict=True)) / self.p.R**2
+            det = {"phi_c_err_rad": float(np.max(np.abs(r[:, 0] - uref[:, 0]))),
+                   "c5_err_rad": abs(self._c5(r, n) - self._c5(uref, n)), "closure_residual": resid}
+            return max(det.values()), det
+        sr, sf = r.stats, ref["mujoco"].stats
+        det = {"phi_c_err_rel": _rel(sr["phi_c_err_max"], sf["phi_c_err_max"]),
+               "closure_rel": _rel(sr["closure_residual_max"], sf["closure_residual_max"]),
+               "ripple_rel": _rel(sr["torque_in_ripple_pp"], sf["torque_in_ripple_pp"])}
+        return max(det.values()), det
+
+
+def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    """The coupler's work-precision study of a scene (see `mbsuite.analysis.workprecision` for the report)."""
+    return CouplerStudy(scene, quick)
+
+
+# ================================================================================================ random input
+def random_input(scene: Scene, rng: np.random.Generator) -> dict:
+    """Admissible random changes of a coupler scene's input: speed and load x U(0.5, 1.5), the misalignments it sets
+    x U(0.8, 1.2) (kept well inside the physical range of e_y)."""
+    inp = dict(scene.input)
+    for k in ("omega", "load_torque"):
+        if k in inp:
+            inp[k] = float(inp[k]) * rng.uniform(0.5, 1.5)
+    for k in ("z_c", "x_c", "alpha_cx", "alpha_cz"):
+        if k in inp:
+            inp[k] = float(inp[k]) * rng.uniform(0.8, 1.2)
+    return {"input": inp}

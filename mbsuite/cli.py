@@ -55,8 +55,9 @@ def _cmd_list(args: argparse.Namespace) -> None:
 
 def _sweep_args(p: argparse.ArgumentParser) -> None:
     """Where the command's sweep runs (the one sweep API, mbsuite.analysis.sweep)."""
-    p.add_argument("--executor", choices=EXECUTORS, default="local",
-                   help="local: processes on all cores (default); dask: a Dask distributed cluster")
+    p.add_argument("--executor", choices=EXECUTORS, default=None,
+                   help="local: processes on all cores; threads: C threads of the native core (MuJoCo work); dask: a "
+                        "Dask distributed cluster (default: threads for MuJoCo points, processes for the rest)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="Dask scheduler address (tcp://HOST:PORT) for --executor dask")
     p.add_argument("--store", metavar="FILE", help="stream finished points to FILE (JSON lines) and resume from it")
@@ -162,15 +163,18 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
     if not axes:
         raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")
     combos = list(itertools.product(*[a[2] for a in axes]))
-    points = []
+    points, engines = [], set()
     for combo in combos:
         sections: dict = {}
         for (section, name, _), v in zip(axes, combo, strict=True):
             sections.setdefault(section, {})[name] = v
-        scene.replace(**sections)  # validate every point before anything runs
+        engines.add(scene.replace(**sections).solver.engine)  # validate every point before anything runs
         points.append((scene.to_dict(), sections))
+    # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
+    auto = "threads" if engines == {"mujoco"} else "local"
     with _sweeping(args):
-        results = run_sweep(scene_point, points, workers=args.workers, desc="sweep")
+        results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
+                            executor=None if args.executor else auto)
     signals = [x for x in (args.signals.split(",") if args.signals else []) if x] or \
         sorted(results[0]["signals"]) if results else []
     head = [f"{s}.{n}" for s, n, _ in axes]

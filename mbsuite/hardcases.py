@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import GeometryError, MbsuiteError, ParameterError, SceneError, SolverError
+from .errors import MbsuiteError, ParameterError, SceneError
 
 
 @dataclass
@@ -150,106 +150,6 @@ def get(name: str) -> HardCase:
 
 
 # ---- TRANSITIONAL: the coupler, drives and catenary cases below move to their models' cases modules ----
-# ================================================================================================ coupler
-def _coupler_ey_to_zero(ck: Checker) -> None:
-    from .models.coupler import reference as ref
-    from .models.coupler.params import CouplerParams
-
-    conds = {}
-    for ey in (1e-1, 1e-2, 1e-4, 1e-6, 1e-8):
-        p = CouplerParams(e_y=ey)
-        an = ref.analyse_jacobian(ref.single_jacobian(p, ref.solve_single(p, 0.0)), np.zeros(3))
-        conds[ey] = an.cond
-        ck.le(f"cond(J) at e_y = {ey:g} vs R cos(2 gamma)/e_y, relative", abs(an.cond / (math.cos(2 * p.gamma) / ey)
-                                                                            - 1), 1e-3)
-        ck.true(f"rank 4 at e_y = {ey:g}", an.rank == 4, an.rank)
-    p0 = CouplerParams(e_y=0.0)
-    an0 = ref.analyse_jacobian(ref.single_jacobian(p0), np.zeros(3))
-    ck.true("e_y = 0: rank 3 detected, cond = inf", an0.rank == 3 and math.isinf(an0.cond), (an0.rank, an0.cond))
-    ck.true("e_y = 0: a free translation along the shaft is reported",
-            any(not math.isfinite(s.pitch) and abs(abs(s.axis[1]) - 1) < 1e-9 for s in an0.principal_screws))
-    ck.measured["cond"] = conds
-
-
-def _coupler_ey_below_alpha(ck: Checker) -> None:
-    from .models.coupler import reference as ref
-    from .models.coupler.params import CouplerParams
-
-    p = CouplerParams(e_y=0.02)
-    ck.raises("single FPP with e_y = 0.02 < R alpha = 0.07", lambda: ref._ramp_single(p, 0.0, 0.07, 0.0),
-              GeometryError, "no physical pose")
-    ck.raises("single revolution with e_y = 0.02, alpha = 0.07", lambda: ref.single_revolution(p, 0.07, n=37),
-              GeometryError, "e_y")
-    ck.raises("e_y = 0 with any inclination", lambda: ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01),
-              GeometryError, "coplanar")
-    ok = ref.single_revolution(CouplerParams(e_y=0.1), 0.07, n=73)
-    ck.le("e_y = 0.1 > R alpha: closes after a turn |phi_b(2 pi) - phi_b(0) - 2 pi|",
-          abs(ok.u[-1, 0] - ok.u[0, 0] - 2 * math.pi), 1e-9)
-
-
-def _coupler_phibc90(ck: Checker) -> None:
-    from . import load_scene, run
-    from .models.coupler import reference as ref
-    from .models.coupler.params import CouplerParams
-
-    rev = ref.double_revolution(CouplerParams(phi_bc=math.pi / 2), z_c=0.08, n=73)
-    ck.le("FPP revolution closes: |phi_c(2 pi) - phi_c(0) - 2 pi|", abs(rev.u[-1, 0] - rev.u[0, 0] - 2 * math.pi),
-          1e-9)
-    res = run(load_scene("coupler/double_phibc90").replace(solver={"duration": 1.0}))
-    ck.finite("MuJoCo outputs", *res.signals.values())
-    ck.true("MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
-    # README: settled residual 2.77e-5 m (2 s); the start-up ramp peak is excluded by t_settle
-    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-4)
-    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-3)
-
-
-def _coupler_big_step(ck: Checker) -> None:
-    from . import load_scene, run
-
-    sc = load_scene("coupler/double_lateral").replace(solver={"duration": 0.5, "t_settle": 0.3, "sample_dt": 0.0})
-    for h in (5e-3, 2e-2):
-        try:
-            res = run(sc.replace(solver={"timestep": h}))
-        except (SceneError, SolverError) as e:
-            ck.true(f"h = {h:g} s: a clear error naming the timestep", "timestep" in str(e), str(e)[:80])
-            continue
-        # not an error: the result is finite and its degraded closure is reported in the stats (measured 1.3e-2 m at
-        # 5 ms vs 3.8e-5 m at the default 0.5 ms: MuJoCo silently stiffens solref to 2 h; see `known`)
-        ck.finite(f"h = {h:g} s outputs", *res.signals.values())
-        ck.true(f"h = {h:g} s: closure residual reported in the stats", "closure_residual_max" in res.stats,
-                res.stats.get("closure_residual_max"))
-        ck.le(f"h = {h:g} s: closure residual (m) bounded", res.stats["closure_residual_max"], 0.05)
-
-
-def _coupler_rk4_limit(ck: Checker) -> None:
-    from . import load_scene, run
-
-    sc = load_scene("coupler/double_lateral").replace(solver={"integrator": "rk4", "timestep": 1e-3, "duration": 1.0})
-    try:
-        res = run(sc)
-    except SolverError as e:
-        ck.true("RK4 at h = solref/2: a clear SolverError", "timestep" in str(e), str(e)[:80])
-        return
-    ck.finite("outputs", *res.signals.values())
-    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-3)
-    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-2)
-    # power balance: the mean input torque equals the 1 kN m load (README: 1000.01 N m), ripple ~7 N m p-p
-    ck.le("|mean input torque / load - 1|", abs(res.stats["torque_in_mean"] / 1000.0 - 1), 0.01)
-    ck.le("input-torque ripple p-p (N m)", res.stats["torque_in_ripple_pp"], 100.0)
-
-
-def _coupler_drift_100s(ck: Checker) -> None:
-    from . import load_scene, run
-
-    res = run(load_scene("coupler/double_lateral").replace(solver={"duration": 100.0, "sample_dt": 0.01}))
-    r, t = res["closure_residual"], res.t
-    ck.finite("100 s outputs", *res.signals.values())
-    ck.le("closure residual over 100 s after the ramp (m)", np.max(r[t >= 0.5]), 1e-4)
-    ck.le("residual last 10 s / residual 0.5-10.5 s (no drift)",
-          np.max(r[t >= 90]) / np.max(r[(t >= 0.5) & (t < 10.5)]), 1.5)
-    ck.le("phi_c - phi_c,kin over 100 s (rad)", np.max(np.abs(res["phi_c_err"][t >= 0.5])), 1e-3)
-
-
 # ================================================================================================ drives
 def _drives_coupled_clutches(ck: Checker) -> None:
     from .models.drives import coupled_clutches as cc
@@ -391,36 +291,6 @@ def _catenary_critical_speed(ck: Checker) -> None:
 
 
 _TRANSITIONAL_ENTRIES = (
-    HardCase("coupler_ey_to_zero", "coupler",
-             "coplanar platforms e_y -> 0: the mechanism Jacobian loses rank (cond ~ 1/e_y)",
-             "single coupler Jacobian at e_y = 1e-1 ... 1e-8 and 0",
-             "cond = R cos(2 gamma)/e_y within 1e-3; rank 4 down to 1e-8; rank 3 and cond = inf at 0; free axial "
-             "translation reported", _coupler_ey_to_zero),
-    HardCase("coupler_ey_below_R_alpha", "coupler",
-             "e_y < R alpha: no physical pose (platform B would cross A); Gauss-Newton may converge to garbage",
-             "single coupler FPP, e_y = 0.02, alpha_bx = 0.07 (and e_y = 0)",
-             "GeometryError naming the cause; the physical case e_y = 0.1 closes after a turn to 1e-9",
-             _coupler_ey_below_alpha),
-    HardCase("coupler_double_phibc90", "coupler",
-             "double coupler with phi_bc = pi/2: fluctuations add, continuation through large swings",
-             "coupler/double_phibc90 (MuJoCo 1 s) and its FPP revolution",
-             "FPP closes to 1e-9; no NaN, no MuJoCo warning; closure residual <= 1e-4 m; phi_c error <= 1e-3 rad",
-             _coupler_phibc90),
-    HardCase("coupler_over_large_timestep", "coupler",
-             "soft closures at a timestep far above solref/2",
-             "coupler/double_lateral at h = 5 ms and 20 ms",
-             "either a clear SolverError, or finite results whose closure residual is reported (<= 5 cm)",
-             _coupler_big_step),
-    HardCase("coupler_rk4_at_solref_limit", "coupler",
-             "explicit RK4 at h = 1 ms: stiff input servo (kv/J = 2e4 /s) and closures at exactly 2 timesteps",
-             "coupler/double_lateral with integrator rk4, h = 1 ms, 1 s",
-             "a clear SolverError, or finite results with closure <= 1 mm, phi_c error <= 0.01 rad, mean input "
-             "torque = load within 1 %, ripple <= 100 N m",
-             _coupler_rk4_limit),
-    HardCase("coupler_closure_drift_100s", "coupler",
-             "long-time drift of 8 soft closures", "coupler/double_lateral, 100 s",
-             "residual <= 1e-4 m, last 10 s <= 1.5x the first 10 s; phi_c error <= 1e-3 rad",
-             _coupler_drift_100s, slow=True),
     HardCase("drives_clutch_lock_unlock", "drives",
              "clutch stick/slip with nested mode changes (Modelica CoupledClutches)",
              "drives/coupled_clutches machinery, both paths vs the Dymola result",

@@ -117,123 +117,6 @@ class Study:
         raise NotImplementedError
 
 
-# ================================================================================================ coupler
-class CouplerStudy(Study):
-    FPP_TOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-13)
-    FPP_STEPS = (19, 37, 73, 181)
-    MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
-    MJ_STEPS = (1e-3, 5e-4, 2.5e-4)
-    state_doc = ("FPP: max |u - u_ref| over the 8 unknowns (rad, R); MuJoCo: max(|phi_c - ref| / 1 rad, |omega_c - "
-                 "ref| / omega, |torque_in - ref| / T_load)")
-    physics_doc = ("FPP: max(|phi_c - ref| rad, |c5 - c5_ref| rad, max closure residual / R^2); MuJoCo: max rel. error "
-                   "of settled (phi_c - phi_c,kin) max, closure residual max, input-torque ripple")
-
-    def __init__(self, scene: Scene, quick: bool = False):
-        super().__init__(scene, quick)
-        from ..models.coupler.mujoco import _inputs
-
-        self.p = scene.build_params()
-        self.inp = _inputs(scene)
-        T = 0.5 if quick else 1.0
-        self.base = scene.replace(solver={"duration": T, "t_settle": 0.3 if quick else 0.5, "sample_dt": 2e-3},
-                                  outputs=["phi_a", "phi_c", "phi_c_kin", "phi_c_err", "omega_c", "torque_in",
-                                           "closure_residual"])
-        self.rest = np.array([self.inp["alpha_cx"], self.inp["alpha_cz"], self.inp["x_c"], self.inp["z_c"]])
-
-    # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
-    def fpp(self, tol: float, n: int) -> np.ndarray:
-        from ..models.coupler import reference as ref
-
-        phis = np.linspace(0.0, 2 * math.pi, n)
-        u = ref._ramp_double(self.p, np.r_[0.0, self.rest])
-        out = [u]
-        du = np.zeros_like(u)
-        for ph in phis[1:]:
-            g = u + du
-            u_new = ref.solve_double(self.p, np.r_[ph, self.rest], g, tol=tol)
-            du = u_new - u
-            u = u_new
-            out.append(u)
-        return np.array(out)
-
-    def fpp_reference(self, n: int) -> np.ndarray:
-        from scipy.optimize import least_squares
-
-        from ..models.coupler import reference as ref
-
-        u = self.fpp(1e-13, n)
-        out = []
-        for ph, g in zip(np.linspace(0.0, 2 * math.pi, n), u, strict=True):
-            x = np.r_[ph, self.rest]
-            sol = least_squares(lambda v, x=x: ref.double_residual(self.p, x, v), g,
-                                jac=lambda v, x=x: ref.double_residual_jac(self.p, x, v), method="trf",
-                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
-            out.append(sol.x)
-        return np.array(out)
-
-    def settings(self) -> list[Setting]:
-        from .. import run
-
-        out = []
-        tols = (1e-4, 1e-8) if self.quick else self.FPP_TOLS
-        steps = (19, 37) if self.quick else self.FPP_STEPS
-        for tol in tols:
-            for n in steps:
-                out.append(Setting("fpp", "gauss-newton", f"tol {tol:g}, {n} steps",
-                                   lambda tol=tol, n=n: ("fpp", n, self.fpp(tol, n))))
-        integ = ("implicitfast",) if self.quick else self.MJ_INTEGRATORS
-        hs = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
-        for i in integ:
-            for h in hs:
-                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
-                out.append(Setting("mujoco", i, h, lambda sc=sc: ("mujoco", 0, run(sc))))
-        return out
-
-    def reference(self):
-        from .. import run
-
-        self._fpp_ref = {n: self.fpp_reference(n) for n in ((19, 37) if self.quick else self.FPP_STEPS)}
-        mj_ref = run(self.base.replace(solver={"engine": "mujoco", "integrator": "rk4", "timestep": 1e-4}))
-        return {"mujoco": mj_ref}, {"reference": "FPP: scipy least_squares (trf) xtol=ftol=gtol=1e-15; "
-                                                 "MuJoCo: rk4 at 1e-4 s (same soft-closure model)"}
-
-    def _c5(self, u: np.ndarray, n: int) -> float:
-        phis = np.linspace(0.0, 2 * math.pi, n)
-        d = phis - u[:, 0]
-        return float(np.max(np.abs(d - d.mean())))
-
-    def state_error(self, res, ref) -> float:
-        kind, n, r = res
-        if kind == "fpp":
-            return float(np.max(np.abs(r - self._fpp_ref[n])))
-        rr = ref["mujoco"]
-        om, tl = self.inp["omega"], self.inp["load_torque"]
-        m = rr.t >= self.base.solver.t_settle  # the start-up ramp of the stiff servo is not compared
-
-        def err(sig: str) -> float:
-            return float(np.max(np.abs(np.interp(rr.t[m], r.t, r[sig]) - rr[sig][m])))
-
-        return max(err("phi_c"), err("omega_c") / om, err("torque_in") / tl)
-
-    def physics_error(self, res, ref):
-        from ..models.coupler import reference as cref
-
-        kind, n, r = res
-        if kind == "fpp":
-            uref = self._fpp_ref[n]
-            phis = np.linspace(0.0, 2 * math.pi, n)
-            resid = max(float(np.max(np.abs(cref.double_residual(self.p, np.r_[ph, self.rest], u))))
-                        for ph, u in zip(phis, r, strict=True)) / self.p.R**2
-            det = {"phi_c_err_rad": float(np.max(np.abs(r[:, 0] - uref[:, 0]))),
-                   "c5_err_rad": abs(self._c5(r, n) - self._c5(uref, n)), "closure_residual": resid}
-            return max(det.values()), det
-        sr, sf = r.stats, ref["mujoco"].stats
-        det = {"phi_c_err_rel": _rel(sr["phi_c_err_max"], sf["phi_c_err_max"]),
-               "closure_rel": _rel(sr["closure_residual_max"], sf["closure_residual_max"]),
-               "ripple_rel": _rel(sr["torque_in_ripple_pp"], sf["torque_in_ripple_pp"])}
-        return max(det.values()), det
-
-
 # ================================================================================================ drives
 class DrivesStudy(Study):
     HAND_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
@@ -321,7 +204,7 @@ class DrivesStudy(Study):
         return (max(vals) if vals else math.nan), det
 
 
-_TRANSITIONAL: dict[str, type[Study]] = {"coupler": CouplerStudy, "drives": DrivesStudy}
+_TRANSITIONAL: dict[str, type[Study]] = {"drives": DrivesStudy}
 
 
 def available() -> list[str]:

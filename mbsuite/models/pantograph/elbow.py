@@ -80,31 +80,6 @@ class Elbow:
             dth = dlfb / self.p.le - 1.0
         return ElbowState(th, dth, phi1, lfb)
 
-    def fast(self, theta1: float) -> tuple[float, float]:
-        """(theta_e, d theta_e/d theta_1): the same formulas as `__call__`, inlined for the per-step MuJoCo callback."""
-        p = self.p
-        c1, s1 = math.cos(theta1), math.sin(theta1)
-        l1, le = p.l1, p.le
-        X = l1 * c1 - p.xf
-        Y = l1 * s1 + p.yf
-        A = X * X - le * le
-        B = -2.0 * X * Y
-        disc = B * B - 4.0 * A * (Y * Y - le * le)
-        if disc <= 0.0 or A == 0.0:
-            return self(theta1).theta_e, float("nan")  # raises GeometryError with the full message
-        t = (-B - math.sqrt(disc)) / (2.0 * A)
-        phi1 = math.atan2(-B - math.sqrt(disc), 2.0 * A)
-        dX, dY = -l1 * s1, l1 * c1
-        dt = -(2 * X * dX * t * t - 2.0 * (dX * Y + X * dY) * t + 2 * Y * dY) / (2.0 * A * t + B)
-        dphi1 = dt / (1.0 + t * t)
-        sp, cp = math.sin(phi1), math.cos(phi1)
-        gx, gy = X + le * sp, Y - le * cp
-        lfb = math.sqrt(gx * gx + gy * gy)
-        dlfb = (gx * (dX + le * cp * dphi1) + gy * (dY + le * sp * dphi1)) / lfb
-        if self.exact:
-            return p.theta_e0 + (lfb - self.lfb0) / le - (phi1 - self.phi1_0), dlfb / le - dphi1
-        return p.theta_e0 + (lfb - self.lfb0) / le - theta1, dlfb / le - 1.0
-
     def second_derivative(self, theta1: float, h: float = 1e-5) -> float:
         """d^2 theta_e / d theta_1^2 by a central difference of the analytic first derivative (error O(h^2) ~ 1e-10)."""
         return (self(theta1 + h).dtheta_e - self(theta1 - h).dtheta_e) / (2.0 * h)

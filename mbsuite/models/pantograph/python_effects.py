@@ -35,7 +35,8 @@ class PythonEffects:
     def elbow_passive(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """Eq 3.13 mapped to the joints: Q = E^T (-Te dte/dt1, Te, 0), theta_2 = pi - q1 - q2."""
         qpos = d.qpos.tolist()
-        te, dte = self.elbow.fast(qpos[0])
+        e = self.elbow(qpos[0])
+        te, dte = e.theta_e, e.dtheta_e
         Te = self.p.ke * (te - math.pi + qpos[0] + qpos[1])
         if self.p.be:
             qvel = d.qvel.tolist()

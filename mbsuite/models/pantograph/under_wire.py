@@ -1,0 +1,266 @@
+"""This pantograph under a catenary: two adapters that implement the catenary's pantograph protocol, one per engine
+path, made by `make(params, effects, engine, timestep)` (the model's `ModelSpec.under_wire`).
+
+The protocol (defined by the catenary, met here by structure only; this module imports no catenary code). The
+catenary advances its wire with the trapezoidal rule, so over one step of length dt the contact force f (>= 0 pushes
+the head down and the wire up) varies linearly from f0 to f1:
+- `static(y_wire, k_wire) -> f`: static equilibrium pressing on a wire at height y_wire (m, from the undisturbed
+  contact wire level) through a spring k_wire (N/m); returns the static contact force (N);
+- `trial(t, dt, f0, f1) -> y`: contact-point height (m, same datum) at t + dt under that force history, state
+  unchanged; `commit()` accepts the last trial;
+- `head() -> y`, `signals() -> {name: value}`; `affine = False` (the catenary couples by a secant iteration on f1);
+  `engine` names the path; `engine_warnings()` (MuJoCo path) the MuJoCo warnings raised.
+
+Heights: the contact-point height y_d is measured from the base pivot; the undisturbed wire is at the operating height
+y_op, so the catenary sees y_d - y_op. The static uplift is not a parameter: it follows from the supply pressure Pg (the
+cylinder's static force Pg Ap through the linkage); `static_force` / `pressure_for_static_force` relate the two.
+
+Effects are this model's (`SPEC.effects`, defaults for the ones not given). Under the wire the head-wire contact is the
+catenary's penalty spring and its own `contact` law (unilateral or bilateral); the pantograph's ram spring ks and its
+`contact` effect play no part (both adapters use the spring as a pure force input).
+
+- `EppingerReference` ("reference"): the hand-derived ODE `PantographODE.rhs_with_force`, advanced over each catenary
+  step by classical RK4 with the force varying linearly f0 -> f1 (the catenary's force history). Coulomb friction uses
+  the model's smooth law c tanh(w / omega_s) (`coulomb = true` is read as "smooth"): the event-exact stick/slip of the
+  reference path locates each stick/slip event with an adaptive integrator, which a fixed-step coupled scheme whose
+  step is set by the catenary cannot do (an event inside a step would be missed or would need the whole wire rolled
+  back); the smooth law is the model's own regularisation and RK4 at the catenary's dt resolves its time scale.
+- `EppingerMujoco` ("mujoco"): the MuJoCo model of exactly these effects (`MujocoPantograph`: the cylinder and the
+  elbow spring are engine plugins, nothing in Python), its `catenary` actuator turned into a pure force input (gain 1,
+  bias 0, unlimited). A trial restores the committed state (`mj_setState`), writes the step's mean contact force
+  (f0 + f1)/2 into the actuator's ctrl and advances one step of length dt through mbsuite's native core
+  (`core.Stepper.run(1)`, with every check of the core at that step: MuJoCo's warnings of a broken state, plugin
+  faults, finite state); the committed state is saved with `mj_getState` (the integration state: time, qpos, qvel,
+  act, ctrl, warm start).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from ...engines import core
+from ...engines.mujoco_engine import warnings_raised
+from ...errors import ParameterError, SceneError, SolverError
+from .modelfiles import q_to_theta
+from .mujoco import MujocoPantograph
+from .params import PantographParams
+from .reference import PantographConfig, PantographODE
+
+ENGINES = ("reference", "mujoco")
+
+
+def config(effects: dict[str, Any] | None, engine: str) -> PantographConfig:
+    """The pantograph's effects under the wire for an engine path (module docstring): the model's defaults for the
+    effects not given, the ram contact bilateral (the catenary owns the contact law), Coulomb friction as the path can
+    integrate it at a fixed step (reference: smooth law; MuJoCo: frictionloss)."""
+    eff = {**dataclasses.asdict(PantographConfig()), **(effects or {})}
+    eff["contact"] = "bilateral"
+    if engine == "reference" and eff["coulomb"] is True:
+        eff["coulomb"] = "smooth"
+    elif engine == "mujoco" and eff["coulomb"] == "smooth":
+        eff["coulomb"] = True  # MuJoCo's frictionloss is its own regularised Coulomb law
+    return PantographConfig(**eff)
+
+
+def _no_free_equilibrium(k_wire: float, params: PantographParams) -> None:
+    if k_wire <= 0.0:
+        raise ParameterError(
+            f"the Eppinger pantograph does not press on the wire at supply pressure Pg = {params.Pg:g} Pa (its static "
+            "contact force is <= 0 with these parameters) and has no equilibrium off the wire: raise Pg "
+            "(see pressure_for_static_force)")
+
+
+class EppingerReference:
+    """Eppinger pantograph under the wire, hand-derived ODE path (module docstring)."""
+
+    affine = False
+    engine = "reference"
+
+    def __init__(self, params: dict[str, Any] | None = None, effects: dict[str, Any] | None = None,
+                 name: str = "eppinger"):
+        self.name = name
+        self.params = PantographParams(**(params or {}))
+        self.cfg = config(effects, "reference")
+        self.ode = PantographODE(self.params, self.cfg)
+        self.y_op = self.params.y_op
+        self.x = np.zeros(self.ode.n)
+        self._pending = None
+
+    def static(self, y_wire: float, k_wire: float) -> float:
+        _no_free_equilibrium(k_wire, self.params)
+        ode = PantographODE(dataclasses.replace(self.params, ks=float(k_wire)), self.cfg)
+        y_w = self.y_op + y_wire
+        self.x = ode.equilibrium(y_w)
+        return float(k_wire * (ode.contact_height(self.x) - y_w))
+
+    def _rk4(self, t: float, dt: float, f0: float, f1: float) -> np.ndarray:
+        rhs = self.ode.rhs_with_force
+        x = self.x
+        fm = 0.5 * (f0 + f1)
+        k1 = rhs(t, x, -f0)
+        k2 = rhs(t + dt / 2, x + dt / 2 * k1, -fm)
+        k3 = rhs(t + dt / 2, x + dt / 2 * k2, -fm)
+        k4 = rhs(t + dt, x + dt * k3, -f1)
+        return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        xn = self._rk4(t, dt, f0, f1)
+        self._pending = xn
+        return self.ode.contact_height(xn) - self.y_op
+
+    def commit(self) -> None:
+        self.x = self._pending
+
+    def head(self) -> float:
+        return self.ode.contact_height(self.x) - self.y_op
+
+    def signals(self) -> dict[str, float]:
+        t = self.ode.theta(self.x[: self.ode.nq])
+        return {"head_displacement": self.head(), "theta_1": float(t[0]), "theta_2": float(t[1]),
+                "theta_h": float(t[2])}
+
+
+class EppingerMujoco:
+    """Eppinger pantograph under the wire, MuJoCo path (module docstring). `timestep` must be the catenary's."""
+
+    affine = False
+    engine = "mujoco"
+
+    def __init__(self, params: dict[str, Any] | None = None, effects: dict[str, Any] | None = None,
+                 timestep: float = 1e-4, integrator: str = "implicitfast", name: str = "eppinger"):
+        self.name = name
+        self.params = PantographParams(**(params or {}))
+        self.cfg = config(effects, "mujoco")
+        self.sim = MujocoPantograph(self.params, self.cfg, integrator=integrator, timestep=timestep)
+        m, d = self.m, self.d = self.sim.model, self.sim.data
+        self.y_op = self.params.y_op
+        self.timestep = float(m.opt.timestep)
+        i = self.i_cat = self.sim.i_cat
+        # the shipped ram spring, restored by every static() (which rescales it) before the force input replaces it
+        self._spring = (m.actuator_gainprm[i].copy(), m.actuator_biasprm[i].copy(), int(m.actuator_forcelimited[i]),
+                        int(m.actuator_ctrllimited[i]))
+        self.site_c = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "contact_point")
+        self.site_o = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "origin")
+        # one step per call, every check of the core at that step (check_every=1)
+        self.stepper = core.Stepper(m, d, (), check_every=1, what="Eppinger pantograph under the catenary (MuJoCo)",
+                                    hint="reduce solver.timestep")
+        self._spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        n = mujoco.mj_stateSize(m, self._spec)
+        self._state = np.empty(n)
+        self._pending = np.empty(n)
+        self._holds = None  # which state the data holds with its kinematics: "committed", "trial" or None
+
+    def _height(self) -> float:
+        mujoco.mj_kinematics(self.m, self.d)
+        xpos = self.d.site_xpos
+        return float(xpos[self.site_c, 2] - xpos[self.site_o, 2]) - self.y_op
+
+    def _as_force_input(self) -> None:
+        m, i = self.m, self.i_cat
+        m.actuator_gainprm[i, :] = 0.0
+        m.actuator_gainprm[i, 0] = 1.0
+        m.actuator_biasprm[i, :] = 0.0
+        m.actuator_forcelimited[i] = 0
+        m.actuator_ctrllimited[i] = 0
+
+    def static(self, y_wire: float, k_wire: float) -> float:
+        _no_free_equilibrium(k_wire, self.params)
+        m, d, i = self.m, self.d, self.i_cat
+        gain, bias, flim, clim = self._spring
+        m.actuator_gainprm[i], m.actuator_biasprm[i] = gain, bias
+        m.actuator_forcelimited[i], m.actuator_ctrllimited[i] = flim, clim
+        # static equilibrium on the ram spring rescaled to the stiffness k_wire, at the wire height
+        scale = k_wire / float(self.params.ks)
+        m.actuator_gainprm[i, 0] *= scale
+        m.actuator_biasprm[i, 1] *= scale
+        y_w = self.y_op + y_wire
+        self.sim.set_static(self.sim.equilibrium(y_w), y_w)
+        f_up = float(d.actuator_force[i])
+        self._as_force_input()
+        d.ctrl[i] = -f_up
+        d.qacc_warmstart[:] = 0.0
+        mujoco.mj_getState(m, d, self._state, self._spec)
+        self._holds = None
+        return -f_up
+
+    def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        if dt != self.timestep:
+            raise SolverError(f"Eppinger pantograph (MuJoCo) built for time step {self.timestep:g} s, asked to step "
+                              f"{dt:g} s: build it with the catenary's time step")
+        mujoco.mj_setState(self.m, self.d, self._state, self._spec)
+        # the step's mean contact force (trapezoidal force history), held in the data's ctrl during the one step
+        self.d.ctrl[self.i_cat] = -0.5 * (f0 + f1)
+        # records its two rows of time only; run(1, record=False) would be the natural call, but the core records
+        # step 0 whatever `record` says and then refuses the missing row ("invalid arguments")
+        self.stepper.run(1)
+        y = self._height()
+        mujoco.mj_getState(self.m, self.d, self._pending, self._spec)
+        self._holds = "trial"
+        return y
+
+    def commit(self) -> None:
+        self._state, self._pending = self._pending, self._state
+        # the data still holds the last trial (now committed) unless head()/signals() restored the old state since
+        self._holds = "committed" if self._holds == "trial" else None
+
+    def _sync(self) -> None:
+        if self._holds != "committed":
+            mujoco.mj_setState(self.m, self.d, self._state, self._spec)
+            mujoco.mj_kinematics(self.m, self.d)
+            self._holds = "committed"
+
+    def head(self) -> float:
+        self._sync()
+        xpos = self.d.site_xpos
+        return float(xpos[self.site_c, 2] - xpos[self.site_o, 2]) - self.y_op
+
+    def signals(self) -> dict[str, float]:
+        self._sync()
+        th = q_to_theta(np.array(self.d.qpos[:3]))
+        return {"head_displacement": self.head(), "theta_1": float(th[0]), "theta_2": float(th[1]),
+                "theta_h": float(th[2])}
+
+    def engine_warnings(self) -> dict[str, int]:
+        """MuJoCo warning counters raised during the run (empty if none)."""
+        return warnings_raised(self.d)
+
+
+def make(params: dict[str, Any], effects: dict[str, Any], engine: str, timestep: float):
+    """The Eppinger pantograph under the wire on an engine path: `params` overrides `PantographParams`, `effects` are
+    this model's (defaults for the rest), `timestep` the catenary's step (s)."""
+    if engine == "reference":
+        return EppingerReference(params, effects)
+    if engine == "mujoco":
+        return EppingerMujoco(params, effects, timestep=timestep)
+    raise SceneError(f"the pantograph has no engine path {engine!r} under the wire; valid: {list(ENGINES)}")
+
+
+def static_force(params: dict[str, Any] | None = None, k_contact: float = 5.0e4) -> float:
+    """Static contact force (N) of the Eppinger pantograph at its operating height on an undisturbed rigid wire
+    (contact spring k_contact, N/m)."""
+    return EppingerReference(params).static(0.0, k_contact)
+
+
+def pressure_for_static_force(target: float, params: dict[str, Any] | None = None, k_contact: float = 5.0e4,
+                              tol: float = 1e-9) -> float:
+    """Supply gauge pressure Pg (Pa) that gives the static contact force `target` (N), by the secant method (the
+    static force is nearly affine in Pg: the cylinder's static force is Pg Ap)."""
+    ov = dict(params or {})
+    p0 = ov.get("Pg", PantographParams().Pg)
+    p1 = 1.1 * p0
+    f0 = static_force({**ov, "Pg": p0}, k_contact) - target
+    f1 = static_force({**ov, "Pg": p1}, k_contact) - target
+    for _ in range(30):
+        if abs(f1) < tol * max(1.0, abs(target)):
+            return p1
+        if f1 == f0:
+            break
+        p0, p1, f0 = p1, p1 - f1 * (p1 - p0) / (f1 - f0), f1
+        if p1 <= 0:
+            break
+        f1 = static_force({**ov, "Pg": p1}, k_contact) - target
+    raise ParameterError(f"no supply pressure gives a static contact force of {target} N for {ov}")

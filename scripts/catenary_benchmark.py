@@ -1,7 +1,9 @@
 """Wall and CPU time of one EN 50318 reference run (shipped scene: 0.5 m elements, dt 2e-4 s) and of the finer
-settings, median of --repeats runs, with the cost per step and of the banded solve alone.
+settings, median of --repeats runs, with the cost per step and of the banded solve alone; with --eppinger also one
+passage of the Eppinger pantograph on each engine path (0.5 m, dt 1e-4 s: the eppinger_lab scene's setting), with the
+cost per pantograph trial step.
 
-    .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300]
+    .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--speeds", type=float, nargs="+", default=[250.0, 300.0])
     ap.add_argument("--settings", nargs="+", default=["0.5,2e-4", "0.5,1e-4", "0.25,1e-4"])
+    ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
     a = ap.parse_args()
     rows = []
     for setting in a.settings:
@@ -50,6 +53,24 @@ def main() -> None:
                          f"{solve_us:.0f}"])
     print(format_table(["h (m)", "dt (s)", "km/h", "DOFs", "steps", "wall (s)", "CPU (s)", "CPU us/step",
                         "solve us"], rows))
+    if a.eppinger:
+        rows = []
+        p = CatenaryParams(element_length=0.5)
+        for engine in ("reference", "mujoco"):
+            for v in a.speeds:
+                walls, cpus = [], []
+                for _ in range(a.repeats):
+                    w0, c0 = time.perf_counter(), time.process_time()
+                    run = simulate(p, v, 1e-4, pantograph="eppinger", engine=engine)
+                    walls.append(time.perf_counter() - w0)
+                    cpus.append(time.process_time() - c0)
+                steps, trials = run.timing["steps"], run.result.stats["local_solves"]
+                cpu = statistics.median(cpus)
+                rows.append([engine, v, steps, trials, f"{statistics.median(walls):.2f}", f"{cpu:.2f}",
+                             f"{1e6 * cpu / steps:.0f}"])
+        print()
+        print(format_table(["Eppinger path", "km/h", "steps", "trial steps", "wall (s)", "CPU (s)", "CPU us/step"],
+                           rows))
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Mesh and time-step convergence of the EN 50318 statistics (catenary issue #6).
+"""Mesh and time-step convergence of the EN 50318 statistics of the reference scene.
 
 Runs the reference scene on the grid element length {0.5, 0.25, 0.125} m x time step {2e-4, 1e-4, 5e-5} s at each
 speed and prints every statistic per grid point, then the largest change between the two finest levels (mesh at the

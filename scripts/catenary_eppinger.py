@@ -1,4 +1,8 @@
-"""The Eppinger (Brecknell-Willis) pantograph under the EN 50318 reference catenary (issue #6).
+"""The Eppinger (Brecknell-Willis) pantograph under the EN 50318 reference catenary.
+
+The Eppinger pantograph is the registry model "pantograph", run under the wire as the catenary's `eppinger`
+pantograph on an engine path (`simulate(..., pantograph="eppinger", engine=..., pantograph_section={"params": ...})`,
+the same as a catenary scene with a `[pantograph]` section).
 
 1. Speed sweep 100-300 km/h in 25 km/h steps on the same catenary (slack droppers): contact-force statistics and
    contact loss (count; durations < 5 ms, 5-20 ms, > 20 ms) of
@@ -25,44 +29,41 @@ from pathlib import Path
 
 from mbsuite.errors import MbsuiteError
 from mbsuite.models.catenary.analysis import simulate
-from mbsuite.models.catenary.eppinger import EppingerMujoco, EppingerReference, pressure_for_static_force, static_force
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.pantograph.params import PantographParams
+from mbsuite.models.pantograph.under_wire import pressure_for_static_force, static_force
 from mbsuite.results import format_table, to_jsonable, write_csv
 
 SPEEDS = [100, 125, 150, 175, 200, 225, 250, 275, 300]
 FACTORS = [0.5, 0.75, 1.0, 1.5, 2.0]
 KEYS = ["Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct"]
-COLS = ["label", "speed", "static_force", *KEYS, "n_loss", "loss_lt_5ms", "loss_5_20ms", "loss_gt_20ms", "wall_s"]
+COLS = ["label", "speed", "static_force", *KEYS, "n_loss", "loss_lt_5ms", "loss_5_20ms", "loss_gt_20ms", "wall_s",
+        "cpu_s"]
 
 
 def one(job):
-    label, kind, speed, h, dt, overrides = job
+    """One passage: (label, pantograph, engine, speed, element length, time step, pantograph parameter overrides)."""
+    label, kind, engine, speed, h, dt, overrides = job
     p = dataclasses.replace(CatenaryParams(), element_length=h)
-    if kind == "reference2mass":
-        panto = "reference2mass"
-    elif kind == "eppinger":
-        panto = EppingerReference(overrides)
-    else:
-        panto = EppingerMujoco(overrides, timestep=dt)
-    t0 = time.perf_counter()
-    row = {"label": label, "pantograph": kind, "speed": speed, "overrides": overrides}
+    t0, c0 = time.perf_counter(), time.process_time()
+    row = {"label": label, "pantograph": kind, "engine": engine, "speed": speed, "overrides": overrides}
     try:
-        run = simulate(p, speed, dt, pantograph=panto)
+        run = simulate(p, speed, dt, pantograph=kind, engine=engine,
+                       pantograph_section={"params": overrides} if overrides else None)
     except MbsuiteError as exc:
         row.update({k: float("nan") for k in COLS if k not in row and k != "label"})
-        row.update({"error": str(exc), "wall_s": time.perf_counter() - t0})
+        row.update({"error": str(exc), "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0})
         print(f"{label} {speed} km/h: ERROR {exc}", flush=True)
         return row
     c = run.stats["loss_counts"]
     row.update({**{k: run.stats[k] for k in KEYS}, "static_force": run.static_force,
                 "n_loss": len(run.stats["loss_events"]), "loss_lt_5ms": c["short_lt_5ms"],
                 "loss_5_20ms": c["damaging_5_20ms"], "loss_gt_20ms": c["power_loss_gt_20ms"],
-                "wall_s": time.perf_counter() - t0, "error": ""})
+                "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0, "error": ""})
     print(f"{label:>24s} {speed:3d} km/h  F0 {row['static_force']:7.2f}  Fm {row['Fm']:7.2f}  "
           f"sigma {row['sigma']:6.2f}  min {row['min']:7.2f}  max {row['max']:7.2f}  "
           f"loss {row['loss_pct']:5.2f} % ({row['n_loss']})  "
-          f"{row['wall_s']:.0f} s", flush=True)
+          f"{row['cpu_s']:.0f} s CPU", flush=True)
     return row
 
 
@@ -86,18 +87,18 @@ def main() -> None:
     pg_120 = pressure_for_static_force(120.0)
     jobs = []
     for s in a.speeds:
-        jobs.append(("reference2mass", "reference2mass", s, h, dt, {}))
+        jobs.append(("reference2mass", "reference2mass", "reference", s, h, dt, {}))
         if not a.skip_reference_path:
-            jobs.append(("eppinger", "eppinger", s, h, dt, {}))
-        jobs.append(("eppinger_mujoco", "eppinger_mujoco", s, h, dt, {}))
-        jobs.append(("eppinger_mujoco@120N", "eppinger_mujoco", s, h, dt, {"Pg": pg_120}))
+            jobs.append(("eppinger (reference)", "eppinger", "reference", s, h, dt, {}))
+        jobs.append(("eppinger (mujoco)", "eppinger", "mujoco", s, h, dt, {}))
+        jobs.append(("eppinger (mujoco) @120N", "eppinger", "mujoco", s, h, dt, {"Pg": pg_120}))
     study_jobs = []
     if not a.skip_study:
         for name in ("mh", "kh"):
             for f in FACTORS:
                 ov = {name: f * getattr(base, name)}
                 ov["Pg"] = pressure_for_static_force(f_nominal, ov)
-                study_jobs.append((f"study {name} x{f:g}", "eppinger_mujoco", 250, h, dt, ov))
+                study_jobs.append((f"study {name} x{f:g}", "eppinger", "mujoco", 250, h, dt, ov))
     t0 = time.perf_counter()
     print(f"Eppinger static contact force at the Table 3-I supply pressure {base.Pg:.0f} Pa: {f_nominal:.2f} N; "
           f"120 N needs {pg_120:.0f} Pa", flush=True)
@@ -142,10 +143,11 @@ def main() -> None:
     if study_jobs:
         srows = []
         for r, job in zip(rows[len(jobs):], study_jobs, strict=True):
-            name = "mh" if "mh" in job[5] else "kh"
+            ov = job[6]
+            name = "mh" if "mh" in ov else "kh"
             nominal = getattr(base, name)
-            srows.append({"parameter": name, "value": job[5][name], "factor": job[5][name] / nominal,
-                          "Pg": job[5]["Pg"], "static_force_at_table_Pg": static_force({name: job[5][name]}),
+            srows.append({"parameter": name, "value": ov[name], "factor": ov[name] / nominal,
+                          "Pg": ov["Pg"], "static_force_at_table_Pg": static_force({name: ov[name]}),
                           **{k: r[k] for k in ("static_force", "Fm", "sigma", "min", "max", "loss_pct", "n_loss",
                                                "error")}})
         scols = ["parameter", "value", "factor", "Pg", "static_force_at_table_Pg", "static_force", "Fm", "sigma",

@@ -151,6 +151,22 @@ class Stepper:
             self._hi[col:col + c.size] = c.hi
             col += c.size
         self._check_sizes()
+        # the job's constant part, and the pointers, once: a co-simulation calls run(1) at every step
+        self._idx_cache: dict[tuple[int, ...] | None, np.ndarray] = {}
+        self._job = job = _Job()
+        job.every = self.every
+        job.rec_ncol = self.ncol
+        job.nchan = len(self.channels)
+        job.chan_field, job.chan_start, job.chan_size = _ptr(self._field), _ptr(self._start), _ptr(self._size)
+        job.lo, job.hi = _ptr(self._lo), _ptr(self._hi)
+        job.check_every = self.check_every
+        if hook is not None:
+            job.hook = ctypes.cast(hook.fn, ctypes.c_void_p)
+            job.hook_ud = hook.ud if isinstance(hook.ud, int) else ctypes.cast(hook.ud, ctypes.c_void_p)
+            job.hook_rec = _ptr(hook.record)
+        self._job_ref = ctypes.byref(job)
+        self._m_ptr, self._d_ptr = ctypes.c_void_p(self.model._address), ctypes.c_void_p(self.data._address)
+        self._mbs_run = self.lib.mbs_run
 
     def _check_sizes(self) -> None:
         m = self.model
@@ -172,54 +188,60 @@ class Stepper:
             between: Callable[[int, mujoco.MjData], None] | None = None, period: int = 1,
             record: bool = True) -> Trajectory:
         """Step `nstep` times from the data's current state; returns the recorded trajectory (rows at every
-        `every`-th step and the final state). See the module docstring for the inputs."""
+        `every`-th step and the final state; none with `record=False`). See the module docstring for the inputs."""
         nstep = int(nstep)
         if nstep < 0:
             raise ValueError(f"nstep must be >= 0, got {nstep}")
-        m, d = self.model, self.data
+        job = self._job
         if ctrl is not None:
-            ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
-            if ctrl.ndim == 1:
-                ctrl = ctrl[:, None]
-            idx = np.arange(m.nu, dtype=np.int32) if ctrl_idx is None else np.asarray(ctrl_idx, np.int32)
-            if ctrl.shape[1] != idx.size or ctrl.shape[0] < nstep or np.any((idx < 0) | (idx >= m.nu)):
-                raise ValueError(f"ctrl must have shape (>= {nstep}, {idx.size}) with actuator indices < {m.nu}; "
+            if not (isinstance(ctrl, np.ndarray) and ctrl.dtype == np.float64 and ctrl.flags.c_contiguous):
+                ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
+            idx = self._index(ctrl_idx)
+            ncol = 1 if ctrl.ndim == 1 else ctrl.shape[1]
+            if ctrl.ndim > 2 or ncol != idx.size or ctrl.shape[0] < nstep:
+                raise ValueError(f"ctrl must have shape (>= {nstep}, {idx.size}) for actuators {idx.tolist()}; "
                                  f"got {ctrl.shape}")
+            job.ctrl, job.ctrl_idx, job.ctrl_ncol, job.ctrl_rows = ctrl.ctypes.data, idx.ctypes.data, ncol, \
+                ctrl.shape[0]
         else:
-            idx = None
-        rows = rows_for(nstep, self.every) if record else 0
-        rec = np.empty((max(rows, 1), self.ncol))
-        job = _Job()
-        job.ctrl, job.ctrl_idx = _ptr(ctrl), _ptr(idx)
-        job.ctrl_ncol = 0 if ctrl is None else ctrl.shape[1]
-        job.ctrl_rows = 0 if ctrl is None else ctrl.shape[0]
-        job.every = self.every if record else nstep + 2
-        job.rec, job.rec_cap, job.rec_row, job.rec_ncol = _ptr(rec), rows, 0, self.ncol
-        job.nchan = len(self.channels)
-        job.chan_field, job.chan_start, job.chan_size = _ptr(self._field), _ptr(self._start), _ptr(self._size)
-        job.lo, job.hi = _ptr(self._lo), _ptr(self._hi)
-        job.check_every = self.check_every
-        if self.hook is not None:
-            job.hook = ctypes.cast(self.hook.fn, ctypes.c_void_p)
-            job.hook_ud = self.hook.ud if isinstance(self.hook.ud, int) else ctypes.cast(self.hook.ud, ctypes.c_void_p)
-            job.hook_rec = _ptr(self.hook.record)
-        ma, da = ctypes.c_void_p(m._address), ctypes.c_void_p(d._address)
+            job.ctrl, job.ctrl_idx, job.ctrl_ncol, job.ctrl_rows = None, None, 0, 0
+        if record:
+            rows = rows_for(nstep, self.every)
+            rec = np.empty((rows, self.ncol))
+            job.rec, job.rec_cap = rec.ctypes.data, rows
+        else:
+            rec = None
+            job.rec, job.rec_cap = None, 0
+        job.rec_row = 0
         steps = 0
         chunk = nstep if between is None else max(1, int(period))
         k = 0
         while True:
             n = min(chunk, nstep - k)
             if between is not None and k < nstep:
-                between(k, d)
+                between(k, self.data)
             job.nstep, job.k0, job.final = n, k, int(record and k + n >= nstep)
-            self.lib.mbs_run(ma, da, ctypes.byref(job))
+            self._mbs_run(self._m_ptr, self._d_ptr, self._job_ref)
             steps += job.steps_done
             if job.status != 0:
                 raise self._error(job)
             k += n
             if k >= nstep:
                 break
-        return self._trajectory(rec[:job.rec_row] if record else rec[:0], steps)
+        if rec is None:
+            return Trajectory(np.empty(0), {}, steps, {})
+        return self._trajectory(rec[:job.rec_row], steps)
+
+    def _index(self, ctrl_idx: Sequence[int] | None) -> np.ndarray:
+        """The actuator indices of the input columns (validated once per distinct list)."""
+        key = None if ctrl_idx is None else tuple(int(i) for i in ctrl_idx)
+        idx = self._idx_cache.get(key)
+        if idx is None:
+            idx = np.arange(self.model.nu, dtype=np.int32) if key is None else np.array(key, dtype=np.int32)
+            if np.any((idx < 0) | (idx >= self.model.nu)):
+                raise ValueError(f"ctrl_idx {list(idx)}: the model has {self.model.nu} actuators")
+            self._idx_cache[key] = idx
+        return idx
 
     def _trajectory(self, rec: np.ndarray, steps: int) -> Trajectory:
         out, col = {}, 1

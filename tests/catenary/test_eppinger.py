@@ -1,30 +1,95 @@
-"""The Eppinger pantograph (mbsuite.models.pantograph) under the FE catenary through the thin adapters."""
+"""The Eppinger pantograph (the registry model "pantograph") under the FE catenary: the catenary finds it through the
+registry and drives it through the protocol of `pantographs.py`; the adapters live in the pantograph package
+(`under_wire.py`). One scene schema: the catenary scene with its `[pantograph]` section and `solver.engine`."""
 
 from __future__ import annotations
+
+import ast
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import mbsuite
+from mbsuite.errors import ParameterError, SceneError, SolverError
+from mbsuite.models.catenary import analysis
 from mbsuite.models.catenary.analysis import simulate
-from mbsuite.models.catenary.eppinger import EppingerMujoco, EppingerReference
+from mbsuite.models.catenary.pantographs import build
 from mbsuite.models.catenary.params import CatenaryParams
+from mbsuite.registry import get_model
+from mbsuite.scenes import load_scene
 
 P_SHORT = dict(element_length=0.5, x_end=30.0, window_start=10.0, window_end=28.0)
+ROOT = Path(mbsuite.__file__).parent
+
+
+def _under_wire(engine, params=None, effects=None, dt=1e-4):
+    return get_model("pantograph").under_wire(params or {}, effects or {}, engine, dt)
+
+
+def _imports(path: Path) -> set[str]:
+    """Absolute names of the modules a source file imports (relative imports resolved against its package)."""
+    pkg = ".".join(path.relative_to(ROOT.parent).with_suffix("").parts[:-1])
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = pkg.rsplit(".", node.level - 1)[0] if node.level else ""
+            mod = ".".join(x for x in (base, node.module or "") if x)
+            out |= {mod} | {f"{mod}.{a.name}" for a in node.names}
+    return out
+
+
+def test_no_import_cycle_between_catenary_and_pantograph():
+    """The catenary names no pantograph model (it finds one through the registry); the pantograph's adapters meet the
+    catenary's protocol by structure only."""
+    for path in sorted((ROOT / "models" / "catenary").rglob("*.py")):
+        bad = {m for m in _imports(path) if m.startswith("mbsuite.models.") and
+               not m.startswith("mbsuite.models.catenary")}
+        assert not bad, f"{path.name} imports {bad}"
+    bad = {m for m in _imports(ROOT / "models" / "pantograph" / "under_wire.py") if "catenary" in m}
+    assert not bad
 
 
 def test_static_uplift_from_supply_pressure_same_in_both_paths():
-    f_ref = EppingerReference().static(0.0, 5.0e4)
-    f_mj = EppingerMujoco(timestep=1e-4).static(0.0, 5.0e4)
+    from mbsuite.models.pantograph.under_wire import pressure_for_static_force, static_force
+
+    f_ref = _under_wire("reference").static(0.0, 5.0e4)
+    f_mj = _under_wire("mujoco").static(0.0, 5.0e4)
     assert f_ref == pytest.approx(f_mj, abs=1e-6)
-    assert 20.0 < f_ref < 300.0  # a pantograph pressing on the wire with a plausible static force
-    # more supply pressure, more uplift
-    assert EppingerReference({"Pg": 1.1 * 710185.0}).static(0.0, 5.0e4) > f_ref
+    assert f_ref == pytest.approx(88.77, abs=0.01)  # the thesis' supply pressure (Table 3-I)
+    assert static_force() == f_ref
+    # more supply pressure, more uplift; the section's parameters reach the pantograph
+    p = CatenaryParams(**P_SHORT)
+    assert build("eppinger", p, section={"params": {"Pg": 1.1 * 710185.0}}).static(0.0, 5.0e4) > f_ref
+    pg = pressure_for_static_force(120.0)
+    assert static_force({"Pg": pg}) == pytest.approx(120.0, abs=1e-6) and pg > 710185.0
+
+
+def test_mujoco_adapter_trial_commit_protocol():
+    """A trial leaves the committed state alone (same force, same height, every time); commit accepts the last
+    trial; head() and signals() read the committed state; the time step must be the catenary's."""
+    mj = _under_wire("mujoco")
+    f = mj.static(0.0, 5.0e4)
+    y0 = mj.head()
+    ya = mj.trial(0.0, 1e-4, f, f + 50.0)
+    yb = mj.trial(0.0, 1e-4, f, f - 50.0)
+    assert yb > y0 > ya  # pushed down harder: the head is lower
+    assert mj.head() == y0  # nothing committed yet
+    assert mj.trial(0.0, 1e-4, f, f + 50.0) == ya  # deterministic from the committed state
+    mj.commit()
+    assert mj.head() == ya and mj.signals()["head_displacement"] == ya
+    with pytest.raises(SolverError, match="time step"):
+        mj.trial(0.0, 2e-4, f, f)
+    assert mj.engine == "mujoco" and mj.engine_warnings() == {}
 
 
 def test_eppinger_passage_consistent_contact_and_paths_agree():
     p = CatenaryParams(**P_SHORT)
-    r_ref = simulate(p, 250.0, 1e-4, pantograph=EppingerReference())
-    r_mj = simulate(p, 250.0, 1e-4, pantograph=EppingerMujoco(timestep=1e-4))
+    r_ref = simulate(p, 250.0, 1e-4, pantograph="eppinger", engine="reference")
+    r_mj = simulate(p, 250.0, 1e-4, pantograph="eppinger", engine="mujoco")
+    assert (r_ref.engine, r_mj.engine) == ("reference", "mujoco")
     for r in (r_ref, r_mj):
         res = r.result
         assert np.all(np.isfinite(res.force))
@@ -34,15 +99,97 @@ def test_eppinger_passage_consistent_contact_and_paths_agree():
     assert r_ref.stats["sigma"] == pytest.approx(r_mj.stats["sigma"], abs=0.5)
 
 
-def test_pressure_for_static_force_and_pantograph_that_cannot_hold_the_wire():
-    from mbsuite.errors import ParameterError
-    from mbsuite.models.catenary.eppinger import pressure_for_static_force, static_force
+def test_pantograph_that_cannot_hold_the_wire():
+    from mbsuite.models.pantograph.under_wire import static_force
 
-    pg = pressure_for_static_force(120.0)
-    assert static_force({"Pg": pg}) == pytest.approx(120.0, abs=1e-6)
-    assert pg > 710185.0
     heavy = {"mh": 2 * 13.5}  # doubled head mass: its weight exceeds the uplift at the Table 3-I pressure
     assert static_force(heavy) < 0
     p = CatenaryParams(**P_SHORT)
     with pytest.raises(ParameterError, match="does not press on the wire"):
-        simulate(p, 250.0, 1e-4, pantograph=EppingerReference(heavy))
+        simulate(p, 250.0, 1e-4, pantograph="eppinger", pantograph_section={"params": heavy})
+
+
+def test_pantograph_section_is_validated_against_the_pantograph_model(tmp_path):
+    sc = load_scene("catenary/eppinger_lab")
+    assert sc.sections["pantograph"] == {"effects": {"contact": "unilateral"}, "params": {}}
+    assert sc.to_dict()["pantograph"] == sc.sections["pantograph"]
+    ok = sc.replace(pantograph={"params": {"Pg": 7.5e5}})
+    assert ok.sections["pantograph"]["params"] == {"Pg": 7.5e5}
+    with pytest.raises(SceneError, match=r"unknown effect\(s\) \['damping'\].*valid effects: \['contact'"):
+        sc.replace(pantograph={"effects": {"damping": True}})
+    with pytest.raises(SceneError, match=r"unknown parameter\(s\) \['F0'\].*valid parameters: \[.*'Pg'"):
+        sc.replace(pantograph={"params": {"F0": 120.0}})
+    with pytest.raises(SceneError, match="cylinder"):
+        sc.replace(pantograph={"effects": {"cylinder": "pneumatic"}})
+    with pytest.raises(ParameterError, match="Pg"):
+        sc.replace(pantograph={"params": {"Pg": -1.0}})
+    bad = tmp_path / "bad.toml"
+    bad.write_text('model = "catenary"\n[pantograph]\nmass = 3.0\n')
+    with pytest.raises(SceneError, match=r"unknown key\(s\) \['mass'\] in \[pantograph\]; valid keys"):
+        load_scene(bad)
+    # the engine path is a field, not a pantograph name
+    with pytest.raises(SceneError, match="'reference2mass', 'eppinger'"):
+        sc.replace(effects={"pantograph": "eppinger_mujoco"})
+
+
+def test_scene_combinations_that_make_no_sense_are_errors():
+    p = CatenaryParams(**P_SHORT)
+    with pytest.raises(SceneError, match="only the reference path"):
+        build("reference2mass", p, engine="mujoco")
+    with pytest.raises(SceneError, match="remove the \\[pantograph\\] section"):
+        build("reference2mass", p, section={"params": {"Pg": 7e5}})
+    with pytest.raises(SceneError, match="contradicts the catenary's contact"):
+        build("eppinger", p, section={"effects": {"contact": "bilateral"}}, contact="unilateral")
+    sc = load_scene("catenary").replace(solver={"engine": "mujoco"})
+    with pytest.raises(SceneError, match="only the reference path"):
+        analysis.run_scene(sc)
+
+
+def test_shipped_eppinger_scenes_differ_only_in_the_engine_path():
+    lab, en = load_scene("catenary/eppinger_lab"), load_scene("catenary/en50318_eppinger")
+    assert (lab.solver.engine, en.solver.engine) == ("mujoco", "reference")
+    a, b = lab.to_dict(), en.to_dict()
+    for d in (a, b):
+        for k in ("name", "description"):
+            d.pop(k)
+        d["solver"] = {k: v for k, v in d["solver"].items() if k not in ("engine", "duration")}
+    assert a == b
+    assert lab.input["speed"] == 250.0 and lab.solver.timestep == 1e-4 and lab.params == {"element_length": 0.5}
+    assert lab.effects == {"droppers": "slack", "pantograph": "eppinger", "contact": "unilateral"}
+
+
+def test_supercritical_speed_is_refused_before_integrating(monkeypatch):
+    def boom(*a, **k):
+        raise AssertionError("the pantograph or the integration was started")
+
+    monkeypatch.setattr(analysis, "build_pantograph", boom)
+    monkeypatch.setattr(analysis, "CoupledSimulation", boom)
+    sc = load_scene("catenary/eppinger_lab").replace(input={"speed": 500.0})
+    with pytest.raises(ParameterError, match="speed 500.0 km/h"):
+        mbsuite.run(sc)
+
+
+def test_run_hook_of_an_eppinger_scene_is_a_simresult_of_its_engine():
+    sc = load_scene("catenary/eppinger_lab").replace(
+        params={"x_end": 30.0, "window_start": 10.0, "window_end": 28.0},
+        outputs=["contact_force", "head_height", "uplift"])
+    res = mbsuite.run(sc)
+    assert res.engine == "mujoco" and res.scene["pantograph"] == sc.sections["pantograph"]
+    uplift = {f"uplift_{60 * k}m" for k in range(11)}  # one column per support (the pinned ends stay 0)
+    assert set(res.signals) == {"contact_force", "head_height", *uplift}
+    assert res.units == {"contact_force": "N", "head_height": "m", **dict.fromkeys(uplift, "m")}
+    assert res.stats["static_contact_force"] == pytest.approx(88.77, abs=0.01) and res.stats["warnings"] == {}
+
+
+@pytest.mark.slow
+def test_eppinger_lab_mujoco_and_reference_paths_agree():
+    """The shipped scene on both pantograph paths under the same wire at 250 km/h: the same static force, sigma and
+    Fm within 0.1 N."""
+    sc = load_scene("catenary/eppinger_lab")
+    mj = mbsuite.run(sc)
+    ref = mbsuite.run(sc.replace(solver={"engine": "reference"}))
+    assert (mj.engine, ref.engine) == ("mujoco", "reference")
+    assert mj.stats["static_contact_force"] == pytest.approx(ref.stats["static_contact_force"], abs=1e-6)
+    assert mj.stats["sigma"] == pytest.approx(ref.stats["sigma"], abs=0.1)
+    assert mj.stats["Fm"] == pytest.approx(ref.stats["Fm"], abs=0.1)
+    assert 80.0 < mj.stats["Fm"] < 100.0  # the thesis' supply pressure gives ~89 N static uplift

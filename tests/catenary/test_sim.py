@@ -159,3 +159,26 @@ def test_energy_balance_closes_through_contact_loss_and_recontact(law):
     assert np.max(np.abs(total - total[0] - work)) < 5e-3 * scale
     if law == "linear":
         assert np.sum(np.diff((r.force <= 0).astype(int)) == 1) >= 5  # contact lost and regained repeatedly
+
+
+def test_passage_is_a_step_object_and_run_its_driver():
+    """`start` gives the coupled static state; `step()` advances it by dt; `run` records exactly what stepping by hand
+    gives. The first record is the static state (uplift at the supports included)."""
+    p = CatenaryParams(n_spans=2, element_length=0.5, x_start=30.0, x_end=50.0, window_start=35.0, window_end=45.0)
+    fe = assemble(p)
+    sim = CoupledSimulation(fe, _panto(p), 250 / 3.6, 2e-4, "slack")
+    ps = sim.start(30.0, 50.0)
+    assert (ps.n, ps.t, ps.x, ps.status) == (0, 0.0, 30.0, "running") and ps.force == ps.static_force > 0
+    forces, heads = [ps.force], [ps.head]
+    while ps.status == "running":
+        ps.step()
+        forces.append(ps.force)
+        heads.append(ps.head)
+    assert ps.n == ps.nsteps == 1440 and ps.x == 50.0 and ps.t == pytest.approx(1440 * 2e-4)
+    with pytest.raises(RuntimeError, match="finished"):
+        ps.step()
+    res = CoupledSimulation(fe, _panto(p), 250 / 3.6, 2e-4, "slack").run(30.0, 50.0)
+    assert np.array_equal(res.force, forces) and np.array_equal(res.head, heads)
+    start = sim.start(30.0, 50.0)
+    sup = fe.full_to_free[NDOF_NODE * fe.supports + CW_W]
+    assert res.uplift[0, 1] == start.u[sup[1]] > 0  # the static contact force lifts the support at 60 m

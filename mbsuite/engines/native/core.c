@@ -262,8 +262,9 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
       const double* row = J->ctrl + k * J->ctrl_ncol;
       for (int c = 0; c < J->ctrl_ncol; c++) d->ctrl[J->ctrl_idx[c]] = row[c];
     }
-    const int rec_now = last || (k % J->every == 0);
-    if (split || last || rec_now || J->hook) {
+    const int rec_now = J->rec != NULL && (last || k % J->every == 0);
+    if (last && !rec_now) break;
+    if (split || rec_now || J->hook) {
       mj_checkPos(m, d);
       mj_checkVel(m, d);
       mj_forward(m, d);

@@ -90,7 +90,7 @@ typedef struct {
   const int* ctrl_idx;
   int ctrl_ncol;
   long ctrl_rows;
-  /* recording: rows of rec_ncol doubles; column 0 is time */
+  /* recording: rows of rec_ncol doubles; column 0 is time; rec = NULL records nothing */
   int every;
   double* rec;
   long rec_cap;          /* rows allocated */

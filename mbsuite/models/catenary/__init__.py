@@ -1,11 +1,13 @@
 """Pantograph-catenary interaction: a 2-D finite-element catenary (EN 50318:2002 reference scene), the 2-mass reference
-pantograph, a consistent coupled integrator, the EN 50318 statistics, and an adapter for the Eppinger pantograph."""
+pantograph, a consistent coupled integrator and the EN 50318 statistics. The catenary owns the coupling: any pantograph
+model of the registry that declares `under_wire` runs under the wire through the protocol of `pantographs.py`."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ...registry import Effect, ModelSpec
+from .pantographs import validate_section
 from .params import CatenaryParams
 
 
@@ -27,8 +29,10 @@ SPEC = ModelSpec(
         "droppers": Effect(("slack", "linear"), "slack", "slack: tension-only droppers (status solved each step); "
                                                           "linear: bilateral springs"),
         "pantograph": Effect(("reference2mass", "eppinger"), "reference2mass",
-                             "reference2mass: EN 50318 2-mass pantograph; eppinger: Brecknell-Willis model of "
-                             "mbsuite.models.pantograph (engine reference = hand-derived ODE, mujoco = MuJoCo)"),
+                             "reference2mass: EN 50318 2-mass pantograph (parameters m1 ... F0 in [params]); "
+                             "eppinger: the registry model 'pantograph' (Brecknell-Willis), its own effects and "
+                             "parameters in the [pantograph] section, its path = solver.engine (reference = "
+                             "hand-derived ODE, mujoco = MuJoCo)"),
         "contact": Effect(("unilateral", "bilateral"), "unilateral",
                           "unilateral: penalty spring that only pushes; bilateral: attached (no contact loss)"),
     },
@@ -39,5 +43,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="en50318",
     run=_run,
+    sections={"pantograph": validate_section},
+    cases="mbsuite.models.catenary.cases",
     extra={"solver_defaults": {"engine": "reference", "timestep": 1e-4, "duration": 6.1}},
 )

@@ -1,5 +1,5 @@
 """Run a catenary scene: build the FE catenary and the pantograph, integrate, compute the EN 50318 statistics, and
-package the result for the CLI (table, JSON data, CSV and PNG writers)."""
+package the result for the CLI (table, JSON data, CSV and PNG writers) and as a SimResult (`results.assemble`)."""
 
 from __future__ import annotations
 
@@ -16,8 +16,10 @@ import numpy as np
 
 from ...errors import ParameterError, SceneError
 from ...results import Report, SimResult, format_table, write_csv
+from ...results import assemble as assemble_result
 from .fe import CatenaryFE, assemble
-from .pantographs import Pantograph, TwoMassPantograph
+from .pantographs import Pantograph
+from .pantographs import build as build_pantograph
 from .params import CatenaryParams
 from .sim import CoupledResult, CoupledSimulation
 from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
@@ -61,18 +63,6 @@ def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
     return info
 
 
-def build_pantograph(kind: str, p: CatenaryParams, overrides: dict[str, Any] | None = None,
-                     dt: float = 1e-4) -> Pantograph:
-    """The pantograph named by the scene's `pantograph` effect (`eppinger_mujoco`: the Eppinger model's MuJoCo path)."""
-    if kind == "reference2mass":
-        return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
-    if kind in ("eppinger", "eppinger_mujoco"):
-        from .eppinger import make_eppinger  # the pantograph package, imported only when a scene asks for it
-
-        return make_eppinger(kind, p, overrides or {}, dt=dt)
-    raise SceneError(f"unknown pantograph {kind!r}; valid: ['reference2mass', 'eppinger', 'eppinger_mujoco']")
-
-
 @dataclass
 class CatenaryRun:
     """A coupled run with its EN 50318 statistics."""
@@ -92,12 +82,17 @@ class CatenaryRun:
     static_force: float = 0.0
     engine_warnings: dict[str, int] = field(default_factory=dict)
     is_reference: bool = False  # the EN 50318 reference scene (2-mass pantograph, specification's parameters)
+    engine: str = "reference"  # the pantograph's engine path (the catenary is always the FE reference code)
 
 
 def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = "slack",
              pantograph: str | Pantograph = "reference2mass", contact: str = "unilateral",
-             progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None) -> CatenaryRun:
-    """Build, run and analyse one pantograph passage (the EN 50318 procedure of catenary.md)."""
+             progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
+             engine: str = "reference", pantograph_section: dict[str, Any] | None = None) -> CatenaryRun:
+    """Build, run and analyse one pantograph passage (the EN 50318 procedure). `pantograph` is a name
+    (the scene's `pantograph` effect, built on the engine path `engine` with the `[pantograph]` section
+    `pantograph_section`; see `pantographs.build`) or an object of the pantograph protocol. The speed is checked before
+    anything is built or integrated."""
     if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
         raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
@@ -106,7 +101,10 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     regime = speed_regime(p, V)
     t0, c0 = time.perf_counter(), time.process_time()
     fe = fe if fe is not None else assemble(p)
-    panto = build_pantograph(pantograph, p, dt=dt) if isinstance(pantograph, str) else pantograph
+    if isinstance(pantograph, str):
+        panto = build_pantograph(pantograph, p, engine=engine, dt=dt, section=pantograph_section, contact=contact)
+    else:
+        panto = pantograph
     sim = CoupledSimulation(fe, panto, V, dt, dropper_law=dropper_law, contact=contact)
     t1 = time.perf_counter()
     res = sim.run(p.x_start, p.x_end, progress=progress)
@@ -139,7 +137,8 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     return CatenaryRun(params=p, speed_kmh=float(speed_kmh), dt=float(dt), dropper_law=dropper_law,
                        pantograph=name, result=res, stats=stats, filtered=ff, regime=regime, timing=timing,
                        ranges=check_ranges(stats, speed_kmh) if is_reference else None, warnings=warn,
-                       static_force=float(res.force[0]), engine_warnings=eng_warn, is_reference=is_reference)
+                       static_force=float(res.force[0]), engine_warnings=eng_warn, is_reference=is_reference,
+                       engine=str(getattr(panto, "engine", "reference")))
 
 
 # --- scene plumbing ---------------------------------------------------------------------------------------------
@@ -151,37 +150,33 @@ def scene_speed(scene, speed_kmh: float | None) -> float:
 
 
 def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides) -> CatenaryRun:
+    """One passage of a catenary scene: its parameters (with `overrides`), speed, time step, effects, the pantograph
+    its `pantograph` effect names on the path `solver.engine`, with the `[pantograph]` section."""
     p = scene.build_params()
     if overrides:
         p = dataclasses.replace(p, **overrides)
-    kind = scene.effects["pantograph"]
-    if scene.solver.engine == "mujoco":
-        if kind != "eppinger":
-            raise SceneError(f"pantograph {kind!r} has no MuJoCo path; use solver.engine = 'reference' "
-                             "(the catenary itself is always the FE reference code)")
-        kind = "eppinger_mujoco"
     return simulate(p, scene_speed(scene, speed_kmh), scene.solver.timestep, dropper_law=scene.effects["droppers"],
-                    pantograph=kind, contact=scene.effects["contact"], progress=progress)
+                    pantograph=scene.effects["pantograph"], contact=scene.effects["contact"], progress=progress,
+                    engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"))
 
 
 def to_simresult(run: CatenaryRun, scene) -> SimResult:
+    """The run as a SimResult (`results.assemble`: the scene's output signals with the declared units). The declared
+    signal `uplift` stands for one column per support, `uplift_<x>m` (x = the support's position), in its unit.
+    `stats`: timings, the eight EN 50318 statistics, the static contact force and the pantograph engine's warnings;
+    `events`: the contact losses in the window."""
     r = run.result
     signals = {"contact_force": r.force, "contact_force_filtered": run.filtered, "position": r.x,
                "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
-    units = {"contact_force": "N", "contact_force_filtered": "N", "position": "m", "head_height": "m",
-             "wire_height": "m", "slack_droppers": "-"}
-    for j, xs in enumerate(r.support_x):
-        signals[f"uplift_{xs:g}m"] = r.uplift[:, j]
-        units[f"uplift_{xs:g}m"] = "m"
-    if scene is not None and scene.outputs:
-        keep = set(scene.outputs)
-        signals = {k: v for k, v in signals.items() if k in keep or (k.startswith("uplift_") and "uplift" in keep)}
-    engine = "mujoco" if run.pantograph.endswith("mujoco") else "reference"
-    return SimResult(t=r.t, signals=signals, units={k: units[k] for k in signals}, engine=engine,
-                     events=run.stats["loss_events"],
-                     stats={**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
-                            "warnings": dict(run.engine_warnings)},
-                     scene=scene.to_dict() if scene is not None else {})
+    stats = {**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
+             "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings)}
+    res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats)
+    if "uplift" in scene.outputs:
+        unit = scene.spec.outputs["uplift"]
+        for j, xs in enumerate(r.support_x):
+            res.signals[f"uplift_{xs:g}m"] = r.uplift[:, j]
+            res.units[f"uplift_{xs:g}m"] = unit
+    return res
 
 
 def _scalar_stats(run: CatenaryRun) -> dict:
@@ -204,7 +199,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
             row += [f"{lo:g} .. {hi:g}", "yes" if run.ranges[name]["inside"] else "NO"]
         rows.append(row)
     what = "EN 50318 reference scene" if run.is_reference else "catenary passage (EN 50318 statistics)"
-    lines = [f"{what}, {run.pantograph} pantograph, {run.speed_kmh:g} km/h "
+    path = "" if run.engine == "reference" else f" ({run.engine} path)"
+    lines = [f"{what}, {run.pantograph} pantograph{path}, {run.speed_kmh:g} km/h "
              f"(element {run.params.element_length:g} m, dt {run.dt:g} s)", format_table(headers, rows)]
     for r in runs:
         c = r.stats["loss_counts"]
@@ -218,7 +214,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
                  f"regime: {run.regime['regime']}")
     for w in run.warnings:
         lines.append(f"WARNING: {w}")
-    data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "element_length": run.params.element_length,
+    data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "engine": run.engine,
+            "element_length": run.params.element_length,
             "timestep": run.dt, "regime": {k: v for k, v in run.regime.items() if k != "warnings"},
             "warnings": run.warnings,
             "runs": {r.dropper_law: {"statistics": _scalar_stats(r), "ranges": r.ranges,
@@ -274,7 +271,8 @@ def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
     axes[2].set_ylabel("uplift at support (mm)")
     axes[2].set_xlabel("pantograph position x (m)")
     what = "EN 50318 reference scene" if runs[0].is_reference else "catenary passage"
-    axes[0].set_title(f"{what}, {runs[0].pantograph} pantograph, {runs[0].speed_kmh:g} km/h "
+    path = "" if runs[0].engine == "reference" else f" ({runs[0].engine} path)"
+    axes[0].set_title(f"{what}, {runs[0].pantograph} pantograph{path}, {runs[0].speed_kmh:g} km/h "
                       "(grey: statistics window)")
     fig.tight_layout()
     tag = f"{runs[0].pantograph}_{runs[0].speed_kmh:g}kmh"

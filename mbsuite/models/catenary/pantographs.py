@@ -12,15 +12,32 @@ varies linearly from f_n to f_{n+1}. A pantograph only has to answer:
 - `head()`, `signals()`: current contact-point height and named outputs.
 
 `affine = True` tells the coupler that trial() is exactly affine in f1; such a pantograph may also offer
-`affine_map(dt, f0) -> (P, g)` with head height P - g f1. A nonlinear pantograph (the Eppinger model, `eppinger.py`)
-is coupled by a secant iteration on f1.
+`affine_map(dt, f0) -> (P, g)` with head height P - g f1. A nonlinear pantograph is coupled by a secant iteration on
+f1. Optional: `engine` (the name of the pantograph's engine path, for reports; default "reference"),
+`engine_warnings() -> {name: count}` (warnings of its engine, reported with the run), `energy()` (J, for the energy
+diagnostics).
+
+This protocol is the only contract. The scene's `pantograph` effect names the pantograph: `reference2mass` is built
+here from the catenary's own parameters (m1 ... F0); every other name is a pantograph model of the registry
+(`PANTOGRAPH_MODELS`), found by `mbsuite.registry.get_model(name).under_wire` and built by that model's factory
+`under_wire(params, effects, engine, timestep)` with the `[pantograph]` section of the scene (its own `effects` and
+`params`, validated against that model's spec) and the scene's `solver.engine` as its engine path. The catenary
+imports no pantograph model.
 """
 
 from __future__ import annotations
 
-from typing import Protocol
+from collections.abc import Mapping
+from typing import Any, Protocol
 
 import numpy as np
+
+from ...errors import SceneError
+
+#: the `pantograph` effect's values that name a registry model (value -> model name); reference2mass is built here
+PANTOGRAPH_MODELS = {"eppinger": "pantograph"}
+#: keys of the scene's `[pantograph]` section
+SECTION_KEYS = ("effects", "params")
 
 
 class Pantograph(Protocol):
@@ -116,3 +133,89 @@ class TwoMassPantograph:
     def energy(self) -> float:
         """Kinetic + spring energy (J) minus the potential of F0."""
         return float(0.5 * self.v @ self.Mm @ self.v + 0.5 * self.x @ self.Km @ self.x - self.F0 * self.x[1])
+
+
+# --- pantographs of the registry -----------------------------------------------------------------------------------
+def _model_spec(kind: str):
+    from ...registry import get_model
+
+    spec = get_model(PANTOGRAPH_MODELS[kind])
+    if spec.under_wire is None:
+        raise SceneError(f"model {spec.name!r} (pantograph {kind!r}) does not declare how it runs under the wire "
+                         "(ModelSpec.under_wire)")
+    return spec
+
+
+def _check_section(value: Any, kind: str) -> dict[str, dict[str, Any]]:
+    """The `[pantograph]` section validated against the spec of the model that `kind` names."""
+    if not isinstance(value, Mapping):
+        raise SceneError(f"[pantograph] must be a table with keys {list(SECTION_KEYS)}, got {value!r}")
+    bad = sorted(set(value) - set(SECTION_KEYS))
+    if bad:
+        raise SceneError(f"unknown key(s) {bad} in [pantograph]; valid keys: {list(SECTION_KEYS)}")
+    spec = _model_spec(kind)
+    effects, params = value.get("effects") or {}, value.get("params") or {}
+    for name, v in (("effects", effects), ("params", params)):
+        if not isinstance(v, Mapping):
+            raise SceneError(f"[pantograph] {name} must be a table, got {v!r}")
+    bad = sorted(set(effects) - set(spec.effects))
+    if bad:
+        raise SceneError(f"unknown effect(s) {bad} of the {kind!r} pantograph (model '{spec.name}') in [pantograph]; "
+                         f"valid effects: {sorted(spec.effects)}")
+    for name, v in effects.items():
+        spec.effects[name].check(name, v)
+    valid = spec.param_names()
+    bad = sorted(set(params) - set(valid))
+    if bad:
+        raise SceneError(f"unknown parameter(s) {bad} of the {kind!r} pantograph (model '{spec.name}') in "
+                         f"[pantograph]; valid parameters: {valid}")
+    for k, v in params.items():
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise SceneError(f"[pantograph] parameter {k!r} must be a number (SI units), got {v!r}")
+    spec.params_cls(**params)  # the model's parameter dataclass validates the values
+    return {"effects": dict(effects), "params": dict(params)}
+
+
+def validate_section(value: Any) -> dict[str, dict[str, Any]]:
+    """Validator of the scene's `[pantograph]` section (`ModelSpec.sections`): `effects` and `params` of a registry
+    pantograph, checked against that model's spec (unknown keys are errors listing the valid ones). The section does
+    not see the scene's `pantograph` effect: it must be valid for one of the registry pantographs, and `build` checks
+    it again against the one the scene names."""
+    first = None
+    for kind in PANTOGRAPH_MODELS:
+        try:
+            return _check_section(value, kind)
+        except SceneError as exc:
+            first = first or exc
+    raise first if first is not None else SceneError("no registry pantograph takes a [pantograph] section")
+
+
+def build(kind: str, p, engine: str = "reference", dt: float = 1e-4, section: Mapping[str, Any] | None = None,
+          contact: str | None = None) -> Pantograph:
+    """The pantograph named by the scene's `pantograph` effect, on the engine path `engine`, for a catenary with
+    parameters `p` and time step `dt`. `section`: the scene's `[pantograph]` section (registry pantographs only);
+    `contact`: the catenary's contact law, which a `contact` effect in the section must not contradict (the head-wire
+    contact is the catenary's)."""
+    section = dict(section or {})
+    if kind == "reference2mass":
+        if engine != "reference":
+            raise SceneError(f"the reference2mass pantograph has only the reference path, not {engine!r}: use "
+                             "solver.engine = 'reference' (the catenary itself is always the FE reference code)")
+        if section.get("effects") or section.get("params"):
+            raise SceneError("the reference2mass pantograph takes its parameters from [params] (m1, k1, c1, m2, k2, "
+                             "c2, F0) and has no effects: remove the [pantograph] section")
+        return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
+    if kind not in PANTOGRAPH_MODELS:
+        raise SceneError(f"unknown pantograph {kind!r}; valid: {['reference2mass', *PANTOGRAPH_MODELS]}")
+    spec = _model_spec(kind)
+    if engine not in spec.engines:
+        raise SceneError(f"the {kind!r} pantograph (model '{spec.name}') has no engine path {engine!r}; valid: "
+                         f"{list(spec.engines)}")
+    sec = _check_section(section, kind)
+    effects = dict(sec["effects"])
+    if contact is not None and "contact" in spec.effects:
+        if effects.get("contact", contact) != contact:
+            raise SceneError(f"[pantograph] effects.contact = {effects['contact']!r} contradicts the catenary's "
+                             f"contact = {contact!r}: the head-wire contact is the catenary's effect")
+        effects["contact"] = contact
+    return spec.under_wire(sec["params"], effects, engine, dt)

@@ -194,9 +194,7 @@ class EppingerMujoco:
         mujoco.mj_setState(self.m, self.d, self._state, self._spec)
         # the step's mean contact force (trapezoidal force history), held in the data's ctrl during the one step
         self.d.ctrl[self.i_cat] = -0.5 * (f0 + f1)
-        # records its two rows of time only; run(1, record=False) would be the natural call, but the core records
-        # step 0 whatever `record` says and then refuses the missing row ("invalid arguments")
-        self.stepper.run(1)
+        self.stepper.run(1, record=False)
         y = self._height()
         mujoco.mj_getState(self.m, self.d, self._pending, self._spec)
         self._holds = "trial"

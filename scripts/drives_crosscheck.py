@@ -1,8 +1,10 @@
 """Cross-check the hand-derived (event-exact) and MuJoCo paths on the drive scenes over >= 20 energy cycles:
 lock-up/release times (paired in order; counts must be equal), controller commands, cycle-averaged load speed,
-energy packets (`drive.energy_packets`: energy taken up per extraction), energy-balance residuals.
+energy packets (`drive.energy_packets`: energy taken up per extraction), energy-balance residuals. The MuJoCo path runs
+its state machine as the native core's stepper (C), the controller in Python at its samples; the same controller
+class drives both paths.
 
-Usage: .venv/bin/python scripts/drives_crosscheck.py [scene ...]   (default: the prototype scenes; ~1 minute)
+Usage: .venv/bin/python scripts/drives_crosscheck.py [scene ...]   (default: the prototype scenes; about 30 s)
 """
 
 from __future__ import annotations

@@ -2,35 +2,8 @@
 
 `workprecision(scene)` (CLI: `mbsuite workprecision SCENE [--out DIR] [--json]`) runs the study the scene's model
 declares (`workprecision_study(scene, quick)` in the module named by its `ModelSpec.cases`); this module names no model.
-The studies:
-
-- pantograph scenes: MuJoCo timestep x integrator (euler, implicitfast, implicit, rk4, discrete) and the hand-derived
-  path with scipy methods x rtol. Reference: Radau at rtol 1e-12 (its own accuracy is measured against DOP853 at
-  rtol 1e-12 and reported). Coulomb friction is switched off for the study: MuJoCo's regularised frictionloss and the
-  reference's event-exact stick/slip are different models whose ~0.5 % difference would be an error floor.
-  State error: max over the trajectory (t >= t_settle, 1 ms grid) of |F1, F2, HD, y_d - ref| / A (A = input amplitude,
-  the characteristic scale of every output displacement). Physics metric: max of the relative amplitude errors and
-  the phase errors (rad) of F1 and HD at the forcing frequency (near the first resonance), and the relative errors of
-  the contact-force mean and standard deviation (std as scale).
-- coupler scenes: (a) the double-coupler FPP over one revolution: Gauss-Newton tolerance x continuation steps per
-  revolution; reference: scipy `least_squares` (trust-region, a different method) at xtol = ftol = gtol = 1e-15 on the
-  same equations (4). State error: max |u - u_ref| over the 8 unknowns (angles in rad, lengths in R). Physics metric:
-  max(|phi_c - phi_c,ref| (rad), |c5 - c5_ref| (rad; c5 is ~1e-14 at phi_bc = 0, so not relative), closure residual
-  max |r| / R^2). (b) MuJoCo dynamics,
-  timestep x integrator, 1 s; reference: MuJoCo RK4 at 1e-4 s (the soft closures are part of the model: a
-  different integrator at a 5x smaller step than the finest setting). State error: max of |phi_c - ref| / 1 rad,
-  |omega_c - ref| / omega, |torque_in - ref| / T_load. Physics metric: relative errors of the settled phi_c error
-  (phi_c - phi_c,kin), of the closure residual, and of the input-torque ripple.
-- drives scenes: the hand path (event-exact DOP853) x rtol and MuJoCo (rk4, euler) x timestep; reference: the hand
-  path at rtol 1e-12 (checked against rtol 1e-11; the hand path has one integrator, so the MuJoCo rows are the
-  different-method comparison). State error: max |w - w_ref| / max |w_ref| over the rotors. Physics metric: relative
-  errors of the cycle-mean load speed and of the efficiency E_out/E_in over [t_settle, T], and the lock-up time error
-  (max over matched stick events) over the energy-cycle period (CoupledClutches: over 0.1 s).
-
-- iftomm four-bar: MuJoCo (euler, implicitfast, rk4) x timestep and the Pinocchio path with scipy methods x rtol;
-  reference: the closed form on the parallelogram branch (psi'' = -(6/5) g cos psi, DOP853 rtol 1e-13). State error:
-  max |crank angle - ref| (rad). Physics metric: max(relative error of the crank's turns, closure residual / L,
-  energy drift / initial kinetic energy, coupler angle (branch)).
+Each study (a `Study`: its settings, its reference from a different method, a state error and a physics metric) is
+described where it is declared: the model's `cases` module, and in `docs/accuracy.md`.
 
 Wall time: median of `repeats` (>= 5 by default) runs in this process, one after another, min-max shown.
 The result lists, per engine/method, the cheapest setting reaching 1e-2, 1e-4 and 1e-6 relative physics error.
@@ -117,109 +90,16 @@ class Study:
         raise NotImplementedError
 
 
-# ================================================================================================ drives
-class DrivesStudy(Study):
-    HAND_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
-    MJ_INTEGRATORS = ("rk4", "euler")
-    MJ_STEPS = (1e-4, 5e-5, 2e-5)
-    state_doc = "max_t |w_i - w_i,ref| / max_t,i |w_ref| over the rotor speeds, on the output grid"
-    physics_doc = ("max(rel. error of cycle-mean load speed and of efficiency E_out/E_in over [t_settle, T]; max "
-                   "lock-up time error / energy-cycle period (CoupledClutches: / 0.1 s))")
-
-    def __init__(self, scene: Scene, quick: bool = False, duration: float | None = None):
-        super().__init__(scene, quick)
-        cc = scene.effects["mechanism"] == "coupled_clutches"
-        self.cc = cc
-        T = min(scene.solver.duration, duration or (1.0 if quick else 2.0))
-        ts = 0.0 if cc else T / 2
-        self.speeds = ["w1", "w2", "w3", "w4"] if cc else ["w_motor", "w_spring", "w_load"]
-        self.base = scene.replace(solver={"duration": T, "t_settle": ts}, outputs=[*self.speeds, "E_in", "E_out"])
-        self.ts = ts
-
-    def settings(self) -> list[Setting]:
-        from .. import run
-
-        out = []
-        for r in ((1e-6,) if self.quick else self.HAND_RTOLS):
-            sc = self.base.replace(solver={"engine": "reference", "rtol": r, "atol": r * 1e-2})
-            out.append(Setting("reference", "event-exact DOP853", r, lambda sc=sc: run(sc)))
-        integ = ("rk4",) if self.quick else self.MJ_INTEGRATORS
-        for i in integ:
-            for h in ((1e-4,) if self.quick else self.MJ_STEPS):
-                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
-                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
-        return out
-
-    def reference(self):
-        from .. import run
-
-        ref = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-12, "atol": 1e-14}))
-        chk = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-11, "atol": 1e-13}))
-        err, _ = self.physics_error(chk, ref)
-        return ref, {"reference": "hand path (event-exact DOP853) rtol 1e-12, atol 1e-14",
-                     "check": "hand path rtol 1e-11", "check_state_error": self.state_error(chk, ref),
-                     "check_physics_error": err}
-
-    def state_error(self, res, ref) -> float:
-        scale = max(float(np.max(np.abs(ref[s]))) for s in self.speeds) or 1.0
-        return max(float(np.max(np.abs(np.interp(ref.t, res.t, res[s]) - ref[s]))) for s in self.speeds) / scale
-
-    def _locks(self, res) -> list[tuple[str, float]]:
-        return [(e.get("element", "?"), float(e["t"])) for e in res.events
-                if e.get("to") == "stuck" and e.get("t") is not None and e["t"] >= self.ts]
-
-    def physics_error(self, res, ref):
-        det = {}
-        period = 0.1
-        if not self.cc:
-            cr, cf = res.stats.get("cycles", {}), ref.stats.get("cycles", {})
-            if abs(cf.get("mean_load_speed", 0.0)) > 0:
-                det["load_speed_rel"] = _rel(cr.get("mean_load_speed", math.nan), cf["mean_load_speed"])
-            if cf.get("switching_rate"):
-                period = 1.0 / cf["switching_rate"]
-
-            def eff(r):
-                m = r.t >= self.ts
-                ein = r["E_in"][m][-1] - r["E_in"][m][0]
-                return (r["E_out"][m][-1] - r["E_out"][m][0]) / ein if ein else math.nan
-
-            det["efficiency_rel"] = _rel(eff(res), eff(ref))
-        lr, lf = self._locks(res), self._locks(ref)
-        by_el: dict[str, tuple[list, list]] = {}
-        for el, t in lf:
-            by_el.setdefault(el, ([], []))[1].append(t)
-        for el, t in lr:
-            by_el.setdefault(el, ([], []))[0].append(t)
-        errs = []
-        for a, b in by_el.values():
-            k = min(len(a), len(b))
-            errs += [abs(x - y) for x, y in zip(a[:k], b[:k], strict=True)]
-            if len(a) != len(b):
-                errs.append(period)  # a missing or extra lock-up counts as a whole period
-        if lf:
-            det["lock_time_rel"] = (max(errs) if errs else 0.0) / period
-        det["n_locks_ref"] = len(lf)
-        vals = [v for k, v in det.items() if k != "n_locks_ref"]
-        # nothing to compare (no lock-up and no load speed in the window) is no accuracy: NaN, not 0
-        return (max(vals) if vals else math.nan), det
-
-
-_TRANSITIONAL: dict[str, type[Study]] = {"drives": DrivesStudy}
-
-
 def available() -> list[str]:
     """Models that declare a work-precision study (`workprecision_study` in their `ModelSpec.cases` module)."""
     from ..registry import models
 
-    return sorted(n for n, s in models().items()
-                  if hasattr(s.suite(), "workprecision_study") or n in _TRANSITIONAL)
+    return sorted(n for n, s in models().items() if hasattr(s.suite(), "workprecision_study"))
 
 
 def study_for(scene: Scene, quick: bool = False) -> Study:
     """The study the scene's model declares (its `ModelSpec.cases` module's `workprecision_study`)."""
     make = getattr(scene.spec.suite(), "workprecision_study", None)
-    if make is None and scene.model in _TRANSITIONAL:
-        return _TRANSITIONAL[scene.model](scene, quick=quick)
     if make is None:
         raise MbsuiteError(f"no work-precision study for model '{scene.model}'; available: {available()}")
     return make(scene, quick=quick)

@@ -16,7 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..errors import ModelFileError, SceneError, SolverError
+from ..errors import ModelFileError, SceneError
 from . import native
 
 INTEGRATOR = {
@@ -91,19 +91,6 @@ def callbacks(**cbs: Callable | None) -> Iterator[None]:
         for k in wanted:
             _CALLBACK_SETTERS[k](None)
             _active.pop(k, None)
-
-
-def check_finite(model: mujoco.MjModel, data: mujoco.MjData, what: str) -> None:
-    """Raise SolverError if the state is non-finite or MuJoCo flagged a bad acceleration/instability."""
-    bad_state = not all(np.all(np.isfinite(a)) for a in (data.qpos, data.qvel, data.act))
-    w = data.warning
-    unstable = w[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
-    if bad_state or unstable:
-        raise SolverError(
-            f"{what}: MuJoCo diverged at t = {data.time:.6g} s (integrator "
-            f"{mujoco.mjtIntegrator(model.opt.integrator).name}, timestep {model.opt.timestep:g} s); "
-            "reduce solver.timestep or use an implicit integrator"
-        )
 
 
 def warnings_raised(data: mujoco.MjData) -> dict[str, int]:

@@ -2,7 +2,8 @@
 clutches, switching controllers, losses and Chapter 5 design tools; plus Modelica's CoupledClutches as an outside check.
 
 Two independent paths: the hand-derived event-exact stick/slip simulation (`friction.simulate_reference`) and MuJoCo
-(`mujoco_path.MujocoRotorSim`, hinge rotors with real equality locks). See README.md.
+(`mujoco_path.MujocoRotorSim`, hinge rotors with real equality locks, its state machine a native stepper of mbsuite's
+C core). Suite declarations (hard cases, work-precision study, random inputs) in `cases.py`. See README.md.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="step_up_pwm",
     run=run,
+    cases="mbsuite.models.drives.cases",
     extra={"solver_defaults": {"engine": "reference", "integrator": "rk4", "timestep": 1e-4, "rtol": 1e-9,
                                "atol": 1e-11, "duration": 2.0}},
 )

@@ -1,4 +1,4 @@
-"""Switching controllers of the drives (thesis App. E and App. F, reconstructed in `shared/reference/drives.md` §3).
+"""Switching controllers of the drives (thesis App. E and App. F, reconstructed from the printed C listings).
 
 Every controller is sampled at `fs` and returns the commanded clutch/brake states; the actuation delays are applied by
 `friction.CommandQueue` (quantised to samples, as the thesis' shift registers). Rotor order: motor 0, spring 1, load 2.

@@ -3,7 +3,8 @@
 torque 10 sin(2 pi 5 t) -> J1 -> clutch1 -> J2 -> clutch2 -> J3 -> clutch3 -> J4, J1..J4 = 1 kg m^2, J1.w(0) = 10 rad/s.
 Clutch k: fn = fn_max * f_norm_k(t) with fn_max = 20 N, sliding torque mu * cgeo * fn (mu = 0.5, cgeo = 1), breakaway
 peak = 1.1 x sliding. f_norm_1 = sin(2 pi 0.2 t + pi/2) (released at t = 1.25 s), f_norm_2 and f_norm_3 step 0 -> 1 at
-0.4 s and 0.9 s. Reference: the Modelica Association's Dymola result (MSL 4.1.0), see `reference_path()`.
+0.4 s and 0.9 s. Reference: the Modelica Association's Dymola result (MSL 4.1.0), see `reference_path()`. The schedules
+and the drive torque are `mbsuite.engines.signals` (Sine, Step), evaluated alike by the hand path and in C.
 """
 
 from __future__ import annotations
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ...engines.signals import Signal, Sine, Step
 from ...errors import ModelFileError
+from ...paths import models_root
 from .friction import Friction, Part, RotorSystem, Source
 
 T_END = 1.5
@@ -23,11 +26,11 @@ PEAK = 1.1
 F_DRIVE = 5.0
 
 
-def f_norm(k: int):
+def f_norm(k: int) -> Signal:
+    """Normal-force schedule of clutch k (Modelica's sin1, step1, step2), as a signal both paths evaluate alike."""
     if k == 1:
-        return lambda t: math.sin(2 * math.pi * 0.2 * t + math.pi / 2)
-    t0 = {2: 0.4, 3: 0.9}[k]
-    return lambda t: 1.0 if t >= t0 else 0.0
+        return Sine(amplitude=1.0, frequency=0.2, phase=math.pi / 2)
+    return Step(height=1.0, t0={2: 0.4, 3: 0.9}[k])
 
 
 def build_system() -> RotorSystem:
@@ -35,7 +38,7 @@ def build_system() -> RotorSystem:
         Friction(f"clutch{k}", k - 1, k, [Part(f"clutch{k}", MU * FN_MAX, schedule=f_norm(k))], peak=PEAK)
         for k in (1, 2, 3)
     ]
-    src = Source("torque", 0, 10.0, 0.0, shape=lambda t: math.sin(2 * math.pi * F_DRIVE * t))
+    src = Source("torque", 0, 10.0, 0.0, shape=Sine(amplitude=1.0, frequency=F_DRIVE))
     return RotorSystem(names=["J1", "J2", "J3", "J4"], J=np.ones(4), B=np.zeros(4), frictions=clutches,
                        sources=[src], breaks=[0.4, 0.9, 1.25])
 
@@ -46,12 +49,17 @@ W0 = (10.0, 0.0, 0.0, 0.0)
 MODE_CODE = {"backward": -1, "stuck": 0, "forward": 1, "free": 2}
 
 
+REFERENCE_CSV = "CoupledClutches_MSL-4.1.0_reference.csv"
+
+
 def reference_path() -> Path:
-    for root in (Path(__file__).resolve().parents[4] / "shared", Path("/work/shared")):
-        p = root / "reference" / "data" / "CoupledClutches_MSL-4.1.0_reference.csv"
-        if p.is_file():
-            return p
-    raise ModelFileError("CoupledClutches reference CSV not found (expected ../shared/reference/data/)")
+    """The Modelica Association's reference result (MSL 4.1.0), kept in the repository at `tests/data/msl/`
+    (provenance in the README there)."""
+    p = models_root() / "tests" / "data" / "msl" / REFERENCE_CSV
+    if not p.is_file():
+        raise ModelFileError(f"CoupledClutches reference result not found: {p} (it ships with the repository in "
+                             "tests/data/msl/)")
+    return p
 
 
 def load_reference(path: Path | None = None) -> dict[str, np.ndarray]:

@@ -19,7 +19,8 @@ Sign convention: an element between rotor a and rotor b (b = -1: ground) acts wi
 
 `simulate_reference` integrates the smooth pieces with scipy's DOP853 (dense output) and locates every lock/break
 event by root finding on the dense output (brentq, |dt| ~ 1e-14 s); time breakpoints (controller actions, normal-force
-steps) truncate the step exactly. A discrete controller is sampled at its period through the dense output.
+steps) truncate the step exactly. A discrete controller is sampled at its period through the dense output. It drives
+the step object `ReferenceSimulator` (`step()` = one DOP853 step of the current smooth piece, `advance(t)`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -42,7 +44,11 @@ MODE_NAME = {FWD: "forward", STUCK: "stuck", BWD: "backward", FREE: "free"}
 @dataclass
 class Part:
     """One contribution to a friction element's sliding torque: `level` N m, times the command `command` (0/1, None =
-    always on) times `schedule(t)` (clipped at 0; None = 1). `output=True` marks a useful load (its work is output)."""
+    always on) times `schedule(t)` (clipped at 0; None = 1). `output=True` marks a useful load (its work is output).
+
+    A schedule is best an `mbsuite.engines.signals` signal (Step, Sine, Ramp, Pulse, Table, ...): the hand path calls
+    it, the MuJoCo path evaluates the same signal in C. Any other callable works too; the MuJoCo path then tabulates it
+    on its half-step grid (`mujoco_path.signal_for`)."""
 
     label: str
     level: float
@@ -74,7 +80,8 @@ class Spring:
 
 @dataclass
 class Source:
-    """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w (a DC motor: c0 = Kt Vs / R, c1 = -Kt Ke / R)."""
+    """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w (a DC motor: c0 = Kt Vs / R, c1 = -Kt Ke / R).
+    `shape` (None = 1) is best a signal of `mbsuite.engines.signals`, as `Part.schedule`."""
 
     label: str
     body: int
@@ -266,6 +273,360 @@ class _Config:
         return self.L @ f
 
 
+class ReferenceSimulator:
+    """The event-exact hand path as a step object (in the spirit of scipy's `OdeSolver.step`): it holds the state -
+    time, state vector with the energy terms, modes, commands, the DOP853 solver of the current smooth piece - and
+    `step()` makes one step of that solver (locating lock/break events on its dense output and stopping at time
+    breakpoints: schedule jumps, actuations, controller samples); `advance(t)` steps until t, `result()` returns the
+    sampled `RefResult`. `simulate_reference` drives it from 0 to t_end. See the module docstring for the semantics.
+
+    State vector: q (n), w (n), then the energy terms [source, viscous per rotor (n), per part]."""
+
+    def __init__(self, sys: RotorSystem, q0: Sequence[float], w0: Sequence[float], t_end: float, *,
+                 controller: Controller | None = None, u0: dict[str, int] | None = None, sample_dt: float = 1e-3,
+                 rtol: float = 1e-10, atol: float = 1e-12, max_step: float = np.inf, v_tol: float = 1e-9,
+                 max_events_at_instant: int = 50):
+        self.sys = sys
+        self.n, self.ne = sys.n, len(sys.frictions)
+        self.part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
+        self.peaks = np.array([f.peak for f in sys.frictions])
+        self.labels = sys.part_labels()
+        if len(set(self.labels)) != len(self.labels):
+            raise ParameterError(f"friction part labels must be unique, got {self.labels}")
+        self.t_end = t_end
+        self.controller = controller
+        self.rtol, self.atol, self.max_step, self.v_tol = rtol, atol, max_step, v_tol
+        self.max_events_at_instant = max_events_at_instant
+        self.u = {c: 0 for c in sys.commands()}
+        self.u.update(u0 or {})
+        self.queue = CommandQueue(sys.delays, controller.dt if controller else 1.0, self.u) if controller else None
+        self.modes = np.full(self.ne, FREE)
+        # a level below this is "free" (a schedule crossing zero leaves round-off like 20*cos(pi/2) = 1e-15)
+        self.free_tol = np.array([1e-12 * max(1.0, sum(p.level for p in f.parts)) for f in sys.frictions])
+        self.events: list[dict[str, Any]] = []
+        self.ne_tot = 1 + self.n + len(self.part_owner)
+        self._cfg_cache: dict[tuple, _Config] = {}
+        self.stats: dict[str, Any] = {"nfev": 0, "steps": 0, "restarts": 0, "reset_energy": 0.0, "events": 0}
+        y = np.concatenate([np.asarray(q0, float), np.asarray(w0, float), np.zeros(self.ne_tot)])
+        self.t = 0.0
+        self.y = self._resolve(self.t, y, set(), set())
+        self.t_samples = np.arange(0.0, t_end + 0.5 * sample_dt, sample_dt)
+        self._out_y = np.empty((self.t_samples.size, y.size))
+        self._out_m = np.empty((self.ne, self.t_samples.size), dtype=int)
+        self._out_u = {c: np.empty(self.t_samples.size) for c in self.u}
+        self._out_reset = np.empty(self.t_samples.size)  # cumulative plastic-lock loss, in step with the state
+        self._i_out = 0
+        self._ctrl_k = 0
+        self._breaks = sorted(b for b in sys.breaks if 0.0 < b < t_end)
+        self._bi = 0
+        self._same_instant = 0
+        self._last_event_t = -1.0
+        self.solver: DOP853 | None = None  # the solver of the current smooth piece (None between pieces)
+        self._cfg: _Config | None = None  # the piece's projection and sliding elements (modes fixed on a piece)
+        self._slid: list[tuple[int, int]] = []
+        self._evs: list = []
+        self._g_old: list[float] = []
+        self.done = False
+        if controller is not None:  # controller at t = 0
+            self.queue.issue(0, controller(0, 0.0, self.y[:self.n], self.y[self.n:2 * self.n]))
+            self._ctrl_k = 1
+
+    # ---- levels, configurations, forces --------------------------------------------------------------------------
+    def levels(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Sliding torque of every part and of every element at t under the current commands."""
+        lv = self.sys.levels(t, self.u)
+        el = np.zeros(self.ne)
+        np.add.at(el, self.part_owner, lv)
+        return lv, el
+
+    def config(self, t: float) -> _Config:
+        """The projection of the current set of stuck elements (cached; capacities only matter for closed loops of
+        stuck elements, rebuilt if they changed)."""
+        stuck = [e for e in range(self.ne) if self.modes[e] == STUCK]
+        _, el = self.levels(t)
+        caps = self.peaks[stuck] * el[stuck] if stuck else np.zeros(0)
+        key = tuple(stuck)
+        c = self._cfg_cache.get(key)
+        if c is None or (len(stuck) > 1 and not np.allclose(c.caps, caps)):
+            c = _Config(self.sys, stuck, caps)
+            c.caps = caps  # type: ignore[attr-defined]
+            self._cfg_cache[key] = c
+        return c
+
+    def forces(self, t: float, q: np.ndarray, w: np.ndarray, el: np.ndarray) -> np.ndarray:
+        """Torques on the rotors: sources, springs, viscous bearings and the sliding elements."""
+        f, _ = self.sys.free_torque(t, q, w)
+        for e in range(self.ne):
+            if self.modes[e] in (FWD, BWD):
+                fr = self.sys.frictions[e]
+                tau = self.modes[e] * el[e]
+                f[fr.a] += tau
+                if fr.b >= 0:
+                    f[fr.b] -= tau
+        return f
+
+    def _rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Right-hand side of the current smooth piece (its modes and projection fixed): q' = w, w' = Pa f, and the
+        energy rates [source power, B w^2 per rotor, level |slip| per sliding part]."""
+        n, sys, cfg, slid = self.n, self.sys, self._cfg, self._slid
+        q = y[:n]
+        w = y[n:2 * n]
+        f, p_src = sys.free_torque(t, q, w)
+        lv, el = self.levels(t) if slid else (None, None)
+        dy = np.empty(2 * n + self.ne_tot)
+        dE = dy[2 * n:]
+        dE[:] = 0.0
+        for e, d in slid:
+            fr = sys.frictions[e]
+            tau = d * el[e]
+            f[fr.a] += tau
+            if fr.b >= 0:
+                f[fr.b] -= tau
+            wr = abs((w[fr.b] if fr.b >= 0 else 0.0) - w[fr.a])
+            for i, pe in enumerate(self.part_owner):
+                if pe == e:
+                    dE[1 + n + i] = lv[i] * wr
+        dy[:n] = w
+        dy[n:2 * n] = cfg.Pa @ f
+        dE[0] = p_src
+        dE[1:1 + n] = sys.B * w * w
+        return dy
+
+    def _slip(self, fr: Friction, t: float, y: np.ndarray) -> float:
+        """Event function of a sliding element: its slip w_b - w_a (a lock when it reaches 0)."""
+        n = self.n
+        return (y[n + fr.b] if fr.b >= 0 else 0.0) - y[n + fr.a]
+
+    def _margin(self, r: int, e: int, t: float, y: np.ndarray) -> float:
+        """Event function of stuck element e (row r of the piece's projection): breakaway - |constraint torque|."""
+        n = self.n
+        el = self.levels(t)[1]
+        lam = self._cfg.L[r] @ self.forces(t, y[:n], y[n:2 * n], el)
+        return self.peaks[e] * el[e] - abs(lam)
+
+    def _event_functions(self) -> list:
+        """Event functions g(t, y) of the current piece, the crossing direction that fires them and their tags: a
+        sliding element's slip reaching zero (lock), a stuck element's constraint torque reaching its breakaway torque
+        (break)."""
+        funcs = [(partial(self._slip, self.sys.frictions[e]), -d, ("lock", e)) for e, d in self._slid]
+        funcs += [(partial(self._margin, r, e), -1, ("break", e)) for r, e in enumerate(self._cfg.stuck)]
+        return funcs
+
+    # ---- mode changes ---------------------------------------------------------------------------------------------
+    def _resolve(self, t: float, y: np.ndarray, lock_try: set[int], force_break: set[int]) -> np.ndarray:
+        """Consistent modes at time t (Modelica's event iteration): try to lock every engaged element at zero slip,
+        then release the most overloaded stuck element (torque above breakaway) until every stuck torque fits; the
+        plastic lock equalises the velocities of rigid groups (momentum conserving projection)."""
+        n, ne, modes = self.n, self.ne, self.modes
+        w = y[n:2 * n]
+        _, el = self.levels(t)
+        wr = self.sys.w_rel(w)
+        old = modes.copy()
+        must_break: set[int] = set()
+        for e in range(ne):
+            if el[e] <= self.free_tol[e]:
+                modes[e] = FREE
+            elif modes[e] == FREE:
+                modes[e] = STUCK if abs(wr[e]) <= self.v_tol else int(np.sign(wr[e]))
+            elif modes[e] in (FWD, BWD) and (e in lock_try or abs(wr[e]) <= self.v_tol):
+                modes[e] = STUCK
+            elif modes[e] == STUCK and e in force_break:
+                must_break.add(e)
+        for _ in range(2 * ne + 2):
+            cfg = self.config(t)
+            if not cfg.stuck:
+                break
+            f = self.forces(t, y[:n], cfg.Pw @ w, el)
+            lam = cfg.lam(f)
+            ratio = np.abs(lam) / (self.peaks[cfg.stuck] * el[cfg.stuck])
+            for r, e in enumerate(cfg.stuck):
+                if e in must_break:
+                    ratio[r] = max(ratio[r], 1.0 + 1e-6)
+            r = int(np.argmax(ratio))
+            if ratio[r] <= 1.0 + 1e-12:
+                break
+            e = cfg.stuck[r]
+            modes[e] = FWD if lam[r] > 0 else BWD
+            must_break.discard(e)
+        cfg = self.config(t)
+        y = y.copy()
+        w_new = cfg.Pw @ w
+        self.stats["reset_energy"] += 0.5 * float(np.sum(self.sys.J * (w**2 - w_new**2)))
+        y[n:2 * n] = w_new
+        for e in range(ne):
+            if modes[e] != old[e] and t > 0.0:
+                self.events.append({"t": float(t), "element": self.sys.frictions[e].name,
+                                    "from": MODE_NAME[int(old[e])], "to": MODE_NAME[int(modes[e])]})
+        return y
+
+    def _record(self, tt: float, yy) -> None:
+        """Sample the output grid up to tt from the dense output (or a constant state)."""
+        ts = self.t_samples
+        while self._i_out < ts.size and ts[self._i_out] <= tt + 1e-12:
+            i = self._i_out
+            self._out_y[i] = yy(ts[i]) if callable(yy) else yy
+            self._out_m[:, i] = self.modes
+            for c in self.u:
+                self._out_u[c][i] = self.u[c]
+            self._out_reset[i] = self.stats["reset_energy"]
+            self._i_out += 1
+
+    def _actuate(self) -> bool:
+        """Apply the commands due now; True if a command state changed."""
+        changed = False
+        while self.queue.pending and self.queue.pending[0][0] <= self.t + 1e-12:
+            _, c, v = self.queue.pending.pop(0)
+            if self.u.get(c) != v:
+                self.u[c] = v
+                changed = True
+        return changed
+
+    # ---- stepping -------------------------------------------------------------------------------------------------
+    def _start_piece(self) -> None:
+        """A new smooth piece from the current state: modes fixed, fresh DOP853."""
+        self._cfg = self.config(self.t)
+        self._slid = [(e, int(self.modes[e])) for e in range(self.ne) if self.modes[e] in (FWD, BWD)]
+        self._evs = self._event_functions()
+        self.solver = DOP853(self._rhs, self.t, self.y, self.t_end, rtol=self.rtol, atol=self.atol,
+                             max_step=self.max_step)
+        self.stats["restarts"] += 1
+        self._g_old = [g(self.t, self.y) for g, _, _ in self._evs]
+
+    def _end_piece(self) -> None:
+        self.stats["nfev"] += self.solver.nfev
+        self.solver = None
+
+    def _next_hard_time(self) -> tuple[float, str]:
+        """The next time breakpoint: schedule break, pending actuation, controller sample, or the end."""
+        t = self.t
+        t_hard, kind = self.t_end, "end"
+        while self._bi < len(self._breaks) and self._breaks[self._bi] <= t + 1e-15:
+            self._bi += 1
+        if self._bi < len(self._breaks) and self._breaks[self._bi] < t_hard:
+            t_hard, kind = self._breaks[self._bi], "break"
+        if self.queue is not None and self.queue.pending and self.queue.pending[0][0] < t_hard:
+            t_hard, kind = self.queue.pending[0][0], "actuate"
+        if self.controller is not None and self._ctrl_k * self.controller.dt < t_hard - 1e-15:
+            t_hard, kind = self._ctrl_k * self.controller.dt, "sample"
+        return t_hard, kind
+
+    def step(self) -> None:
+        """One step of the current piece's solver (a new piece is started first if needed); ends the piece at an
+        event (after resolving the modes) or at a breakpoint that changes a command or schedule."""
+        if self.done:
+            return
+        if self.solver is None:
+            if self.t >= self.t_end - 1e-15:
+                self._finish()
+                return
+            self._start_piece()
+        solver = self.solver
+        t_hard, kind = self._next_hard_time()
+        if solver.t < t_hard and solver.status == "running":
+            msg = solver.step()
+            if solver.status == "failed":
+                raise SolverError(f"reference integrator failed at t = {solver.t:.6g} s: {msg}")
+            self.stats["steps"] += 1
+        t_new = min(solver.t, t_hard)
+        sol = solver.dense_output() if solver.t_old is not None else None
+        yfun = sol if sol is not None else _const(self.y)
+        t_lo = solver.t_old if solver.t_old is not None else self.t
+        t_lo = max(t_lo, self.t)
+        y_new = yfun(t_new) if t_new < solver.t else solver.y
+        g_new = [g(t_new, y_new) for g, _, _ in self._evs]
+        fired = self._fired(g_new, yfun, t_lo, t_new)
+        if fired:
+            self._on_event(fired, yfun)
+            self._end_piece()
+        elif t_new >= t_hard - 1e-15 and t_hard < solver.t + 1e-15:
+            self._record(t_hard, yfun)
+            self.y = y_new if t_new < solver.t else solver.y
+            self.t = t_hard
+            if self._on_breakpoint(kind):
+                self._end_piece()
+            else:  # same smooth piece: keep the solver; the rest of its step is scanned in the next pass
+                self._g_old = [g(self.t, self.y) for g, _, _ in self._evs]
+        else:
+            self._record(t_new, yfun)
+            self._g_old = g_new
+            self.t = t_new
+            self.y = solver.y
+            if solver.status == "finished":
+                self._end_piece()
+
+    def _fired(self, g_new: list[float], yfun, t_lo: float, t_new: float) -> list:
+        """Events whose function crossed in its direction within (t_lo, t_new], with their located times."""
+        fired = []
+        for i, (g, d, tag) in enumerate(self._evs):
+            a0, a1 = self._g_old[i], g_new[i]
+            if (d < 0 and a0 > 0 and a1 <= 0) or (d > 0 and a0 < 0 and a1 >= 0):
+                te = _root(lambda tt, g=g, yf=yfun: g(tt, yf(tt)), t_lo, t_new)
+                fired.append((te, tag))
+        return fired
+
+    def _on_event(self, fired: list, yfun) -> None:
+        """Go to the earliest event, resolve the modes there (all events within 1e-13 s of it together)."""
+        te = min(f[0] for f in fired)
+        tags = [tag for tf, tag in fired if tf <= te + 1e-13]
+        self._record(te, yfun)
+        self.y = yfun(te)
+        self.t = te
+        self._same_instant = self._same_instant + 1 if abs(self.t - self._last_event_t) < 1e-12 else 0
+        self._last_event_t = self.t
+        if self._same_instant > self.max_events_at_instant:
+            raise SolverError(f"friction state machine does not settle at t = {self.t:.9g} s (mode chattering)")
+        self.stats["events"] += 1
+        self.y = self._resolve(self.t, self.y, {e for k, e in tags if k == "lock"},
+                               {e for k, e in tags if k == "break"})
+
+    def _on_breakpoint(self, kind: str) -> bool:
+        """At a time breakpoint: apply it; True if the piece ends (a command or schedule changed, or the end)."""
+        changed = False
+        if kind == "break":
+            self._bi += 1
+            changed = True
+        elif kind == "actuate":
+            changed = self._actuate()
+        elif kind == "sample":
+            n = self.n
+            self.queue.issue(self._ctrl_k, self.controller(self._ctrl_k, self.t, self.y[:n], self.y[n:2 * n]))
+            self._ctrl_k += 1
+            if self.queue.pending and self.queue.pending[0][0] <= self.t + 1e-12:
+                changed = self._actuate()
+        if kind == "end":
+            return True
+        if changed:
+            self.y = self._resolve(self.t, self.y, set(), set())
+            return True
+        return False
+
+    def advance(self, t: float) -> ReferenceSimulator:
+        """Step until time t (at most t_end); returns self."""
+        t = min(t, self.t_end)
+        while not self.done and (self.t < t - 1e-15 or (t >= self.t_end - 1e-15 and self.solver is not None)):
+            self.step()
+        if t >= self.t_end - 1e-15:
+            self._finish()
+        return self
+
+    def _finish(self) -> None:
+        if not self.done:
+            y = self.y
+            self._record(self.t_end + 1e-9, lambda tt: y)
+            self.done = True
+
+    def result(self) -> RefResult:
+        """The sampled result of the steps made so far (the whole run after `advance(t_end)`)."""
+        n, m = self.n, self._i_out
+        Y = self._out_y[:m]
+        e_names = ["source"] + [f"viscous_{nm}" for nm in self.sys.names] + self.labels
+        energy = {nm: Y[:, 2 * n + i] for i, nm in enumerate(e_names)}
+        energy["lock_impact"] = self._out_reset[:m]
+        return RefResult(t=self.t_samples[:m], q=Y[:, :n].T, w=Y[:, n:2 * n].T, modes=self._out_m[:, :m],
+                         energy=energy, events=self.events, u={c: v[:m] for c, v in self._out_u.items()},
+                         stats=self.stats)
+
+
 def simulate_reference(
     sys: RotorSystem,
     q0: Sequence[float],
@@ -281,282 +642,10 @@ def simulate_reference(
     v_tol: float = 1e-9,
     max_events_at_instant: int = 50,
 ) -> RefResult:
-    """Event-exact simulation of `sys` from (q0, w0) to t_end; see the module docstring for the semantics."""
-    n, ne = sys.n, len(sys.frictions)
-    part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
-    npart = len(part_owner)
-    peaks = np.array([f.peak for f in sys.frictions])
-    labels = sys.part_labels()
-    if len(set(labels)) != len(labels):
-        raise ParameterError(f"friction part labels must be unique, got {labels}")
-    u = {c: 0 for c in sys.commands()}
-    u.update(u0 or {})
-    queue = CommandQueue(sys.delays, controller.dt if controller else 1.0, u) if controller else None
-
-    def elem_levels(t: float) -> tuple[np.ndarray, np.ndarray]:
-        lv = sys.levels(t, u)
-        el = np.zeros(ne)
-        np.add.at(el, part_owner, lv)
-        return lv, el
-
-    modes = np.full(ne, FREE)
-    # a level below this is "free" (a schedule crossing zero leaves round-off like 20*cos(pi/2) = 1e-15)
-    free_tol = np.array([1e-12 * max(1.0, sum(p.level for p in f.parts)) for f in sys.frictions])
-    events: list[dict[str, Any]] = []
-    # energy layout: [source, viscous per rotor (n), per part (npart)]
-    ne_tot = 1 + n + npart
-
-    cfg_cache: dict[tuple, _Config] = {}
-
-    def config(t: float) -> _Config:
-        stuck = [e for e in range(ne) if modes[e] == STUCK]
-        _, el = elem_levels(t)
-        caps = peaks[stuck] * el[stuck] if stuck else np.zeros(0)
-        key = tuple(stuck)
-        c = cfg_cache.get(key)
-        # capacities only matter for closed loops of stuck elements; rebuild if they changed
-        if c is None or (len(stuck) > 1 and not np.allclose(c.caps, caps)):
-            c = _Config(sys, stuck, caps)
-            c.caps = caps  # type: ignore[attr-defined]
-            cfg_cache[key] = c
-        return c
-
-    def make_rhs(cfg: _Config):
-        slid = [(e, int(modes[e])) for e in range(ne) if modes[e] in (FWD, BWD)]
-        Bw = sys.B
-
-        def rhs(t: float, y: np.ndarray) -> np.ndarray:
-            q = y[:n]
-            w = y[n:2 * n]
-            f, p_src = sys.free_torque(t, q, w)
-            lv, el = elem_levels(t) if slid else (None, None)
-            dy = np.empty(2 * n + ne_tot)
-            dE = dy[2 * n:]
-            dE[:] = 0.0
-            for e, d in slid:
-                fr = sys.frictions[e]
-                tau = d * el[e]
-                f[fr.a] += tau
-                if fr.b >= 0:
-                    f[fr.b] -= tau
-                wr = abs((w[fr.b] if fr.b >= 0 else 0.0) - w[fr.a])
-                for i, pe in enumerate(part_owner):
-                    if pe == e:
-                        dE[1 + n + i] = lv[i] * wr
-            dy[:n] = w
-            dy[n:2 * n] = cfg.Pa @ f
-            dE[0] = p_src
-            dE[1:1 + n] = Bw * w * w
-            return dy
-
-        return rhs, slid
-
-    def event_funcs(cfg: _Config, slid):
-        """Event functions g(t, y) and the crossing direction that fires them."""
-        funcs = []
-        for e, d in slid:
-            fr = sys.frictions[e]
-
-            def g(t, y, fr=fr):
-                return (y[n + fr.b] if fr.b >= 0 else 0.0) - y[n + fr.a]
-
-            funcs.append((g, -d, ("lock", e)))
-        for r, e in enumerate(cfg.stuck):
-
-            def gb(t, y, r=r, e=e):
-                el = elem_levels(t)[1]
-                lam = cfg.L[r] @ forces(t, y[:n], y[n:2 * n], el)
-                return peaks[e] * el[e] - abs(lam)
-
-            funcs.append((gb, -1, ("break", e)))
-        return funcs
-
-    def resolve(t: float, y: np.ndarray, lock_try: set[int], force_break: set[int]) -> np.ndarray:
-        """Consistent modes at time t (Modelica's event iteration): try to lock every engaged element at zero slip,
-        then release the most overloaded stuck element (torque above breakaway) until every stuck torque fits."""
-        w = y[n:2 * n]
-        _, el = elem_levels(t)
-        wr = sys.w_rel(w)
-        old = modes.copy()
-        must_break: set[int] = set()
-        for e in range(ne):
-            if el[e] <= free_tol[e]:
-                modes[e] = FREE
-            elif modes[e] == FREE:
-                modes[e] = STUCK if abs(wr[e]) <= v_tol else int(np.sign(wr[e]))
-            elif modes[e] in (FWD, BWD) and (e in lock_try or abs(wr[e]) <= v_tol):
-                modes[e] = STUCK
-            elif modes[e] == STUCK and e in force_break:
-                must_break.add(e)
-        for _ in range(2 * ne + 2):
-            cfg = config(t)
-            if not cfg.stuck:
-                break
-            f = forces(t, y[:n], cfg.Pw @ w, el)
-            lam = cfg.lam(f)
-            ratio = np.abs(lam) / (peaks[cfg.stuck] * el[cfg.stuck])
-            for r, e in enumerate(cfg.stuck):
-                if e in must_break:
-                    ratio[r] = max(ratio[r], 1.0 + 1e-6)
-            r = int(np.argmax(ratio))
-            if ratio[r] <= 1.0 + 1e-12:
-                break
-            e = cfg.stuck[r]
-            modes[e] = FWD if lam[r] > 0 else BWD
-            must_break.discard(e)
-        # plastic lock: equalise the velocities of rigid groups (momentum conserving projection)
-        cfg = config(t)
-        y = y.copy()
-        w_new = cfg.Pw @ w
-        stats["reset_energy"] += 0.5 * float(np.sum(sys.J * (w**2 - w_new**2)))
-        y[n:2 * n] = w_new
-        for e in range(ne):
-            if modes[e] != old[e] and t > 0.0:
-                events.append({"t": float(t), "element": sys.frictions[e].name, "from": MODE_NAME[int(old[e])],
-                               "to": MODE_NAME[int(modes[e])]})
-        return y
-
-    def forces(t: float, q: np.ndarray, w: np.ndarray, el: np.ndarray) -> np.ndarray:
-        f, _ = sys.free_torque(t, q, w)
-        for e in range(ne):
-            if modes[e] in (FWD, BWD):
-                fr = sys.frictions[e]
-                tau = modes[e] * el[e]
-                f[fr.a] += tau
-                if fr.b >= 0:
-                    f[fr.b] -= tau
-        return f
-
-    stats: dict[str, Any] = {"nfev": 0, "steps": 0, "restarts": 0, "reset_energy": 0.0, "events": 0}
-    y = np.concatenate([np.asarray(q0, float), np.asarray(w0, float), np.zeros(ne_tot)])
-    t = 0.0
-    y = resolve(t, y, set(), set())
-    t_samples = np.arange(0.0, t_end + 0.5 * sample_dt, sample_dt)
-    out_y = np.empty((t_samples.size, y.size))
-    out_m = np.empty((ne, t_samples.size), dtype=int)
-    out_u = {c: np.empty(t_samples.size) for c in u}
-    out_reset = np.empty(t_samples.size)  # cumulative plastic-lock (impact) loss, in step with the recorded state
-    i_out = 0
-    ctrl_k = 0
-    breaks = sorted(b for b in sys.breaks if 0.0 < b < t_end)
-    bi = 0
-    same_instant = 0
-    last_event_t = -1.0
-
-    def record(tt, yy):
-        nonlocal i_out
-        while i_out < t_samples.size and t_samples[i_out] <= tt + 1e-12:
-            out_y[i_out] = yy(t_samples[i_out]) if callable(yy) else yy
-            out_m[:, i_out] = modes
-            for c in u:
-                out_u[c][i_out] = u[c]
-            out_reset[i_out] = stats["reset_energy"]
-            i_out += 1
-
-    # controller at t = 0
-    if controller is not None:
-        queue.issue(0, controller(0, 0.0, y[:n], y[n:2 * n]))
-        ctrl_k = 1
-
-    while t < t_end - 1e-15:
-        cfg = config(t)
-        rhs, slid = make_rhs(cfg)
-        evs = event_funcs(cfg, slid)
-        solver = DOP853(rhs, t, y, t_end, rtol=rtol, atol=atol, max_step=max_step)
-        stats["restarts"] += 1
-        g_old = [g(t, y) for g, _, _ in evs]
-        stop = False
-        while not stop:
-            # next hard time: schedule break, pending actuation, controller sample
-            t_hard = t_end
-            kind = "end"
-            while bi < len(breaks) and breaks[bi] <= t + 1e-15:
-                bi += 1
-            if bi < len(breaks) and breaks[bi] < t_hard:
-                t_hard, kind = breaks[bi], "break"
-            if queue is not None and queue.pending and queue.pending[0][0] < t_hard:
-                t_hard, kind = queue.pending[0][0], "actuate"
-            if controller is not None and ctrl_k * controller.dt < t_hard - 1e-15:
-                t_hard, kind = ctrl_k * controller.dt, "sample"
-            if solver.t < t_hard and solver.status == "running":
-                msg = solver.step()
-                if solver.status == "failed":
-                    raise SolverError(f"reference integrator failed at t = {solver.t:.6g} s: {msg}")
-                stats["steps"] += 1
-            t_new = min(solver.t, t_hard)
-            sol = solver.dense_output() if solver.t_old is not None else None
-            yfun = sol if sol is not None else _const(y)
-            # state events in (t_cur_old, t_new]
-            t_lo = solver.t_old if solver.t_old is not None else t
-            t_lo = max(t_lo, t)
-            y_new = yfun(t_new) if t_new < solver.t else solver.y
-            g_new = [g(t_new, y_new) for g, _, _ in evs]
-            fired = []
-            for i, (g, d, tag) in enumerate(evs):
-                a0, a1 = g_old[i], g_new[i]
-                if (d < 0 and a0 > 0 and a1 <= 0) or (d > 0 and a0 < 0 and a1 >= 0):
-                    te = _root(lambda tt, g=g, yf=yfun: g(tt, yf(tt)), t_lo, t_new)
-                    fired.append((te, tag))
-            if fired:
-                te = min(f[0] for f in fired)
-                tags = [tag for tf, tag in fired if tf <= te + 1e-13]
-                record(te, yfun)
-                y = yfun(te)
-                t = te
-                same_instant = same_instant + 1 if abs(t - last_event_t) < 1e-12 else 0
-                last_event_t = t
-                if same_instant > max_events_at_instant:
-                    raise SolverError(f"friction state machine does not settle at t = {t:.9g} s (mode chattering)")
-                stats["events"] += 1
-                y = resolve(t, y, {e for k, e in tags if k == "lock"}, {e for k, e in tags if k == "break"})
-                stop = True
-            elif t_new >= t_hard - 1e-15 and t_hard < solver.t + 1e-15:
-                record(t_hard, yfun)
-                y = y_new if t_new < solver.t else solver.y
-                t = t_hard
-                changed = False
-                if kind == "break":
-                    bi += 1
-                    changed = True
-                elif kind == "actuate":
-                    while queue.pending and queue.pending[0][0] <= t + 1e-12:
-                        _, c, v = queue.pending.pop(0)
-                        if u.get(c) != v:
-                            u[c] = v
-                            changed = True
-                elif kind == "sample":
-                    queue.issue(ctrl_k, controller(ctrl_k, t, y[:n], y[n:2 * n]))
-                    ctrl_k += 1
-                    if queue.pending and queue.pending[0][0] <= t + 1e-12:
-                        while queue.pending and queue.pending[0][0] <= t + 1e-12:
-                            _, c, v = queue.pending.pop(0)
-                            if u.get(c) != v:
-                                u[c] = v
-                                changed = True
-                if kind == "end":
-                    stop = True
-                elif changed:
-                    y = resolve(t, y, set(), set())
-                    stop = True
-                else:
-                    # same smooth piece: keep the solver; the rest of its step is scanned in the next pass
-                    g_old = [g(t, y) for g, _, _ in evs]
-            else:
-                record(t_new, yfun)
-                g_old = g_new
-                t = t_new
-                y = solver.y
-                if solver.status == "finished":
-                    stop = True
-        stats["nfev"] += solver.nfev
-    record(t_end + 1e-9, lambda tt: y)
-    m = i_out
-    Y = out_y[:m]
-    e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + labels
-    energy = {nm: Y[:, 2 * n + i] for i, nm in enumerate(e_names)}
-    energy["lock_impact"] = out_reset[:m]
-    return RefResult(t=t_samples[:m], q=Y[:, :n].T, w=Y[:, n:2 * n].T, modes=out_m[:, :m], energy=energy,
-                     events=events, u={c: v[:m] for c, v in out_u.items()}, stats=stats)
+    """Event-exact simulation of `sys` from (q0, w0) to t_end (`ReferenceSimulator`); see the module docstring."""
+    return ReferenceSimulator(sys, q0, w0, t_end, controller=controller, u0=u0, sample_dt=sample_dt, rtol=rtol,
+                              atol=atol, max_step=max_step, v_tol=v_tol,
+                              max_events_at_instant=max_events_at_instant).advance(t_end).result()
 
 
 def simulate_velocity_band(

@@ -9,7 +9,7 @@ import numpy as np
 
 from ...errors import SceneError
 from ...paths import mjcf_path
-from ...results import SimResult
+from ...results import SimResult, assemble
 from ...scenes import Scene
 from . import coupled_clutches as cc
 from . import drive
@@ -95,7 +95,6 @@ def run(scene: Scene) -> SimResult:
     sig["E_out"] = sum((res.energy[k] for k in outputs), np.zeros_like(res.t))
     sig["E_loss"] = sum((v for k, v in res.energy.items() if k != "source" and k not in outputs),
                         np.zeros_like(res.t))
-    wanted = [s for s in scene.outputs if s in sig]
     bal = drive.energy_balance(system, res)
     stats: dict[str, Any] = dict(res.stats)
     stats["energy_balance"] = {"input": bal.input, "output": bal.output, "stored": bal.stored,
@@ -104,8 +103,9 @@ def run(scene: Scene) -> SimResult:
         cs = drive.cycle_stats(res, ctrl, t0=scene.solver.t_settle)
         cs.pop("packets", None)
         stats["cycles"] = cs
-    return SimResult(t=res.t, signals={k: sig[k] for k in wanted}, units={k: SIGNALS[k] for k in wanted},
-                     engine=scene.solver.engine, events=res.events, stats=stats, scene=scene.to_dict())
+    # the scene's outputs in its order (an output of the other mechanisms is not computed, so not kept)
+    ordered = {k: sig[k] for k in scene.outputs if k in sig}
+    return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats)
 
 
 def coupled_clutches_table(engines=("reference", "mujoco"), timestep: float = 1e-4) -> dict[str, Any]:

@@ -9,15 +9,24 @@ Conventions of the MJCF files (`mjcf/coupled_clutches.xml`, `mjcf/drive_step_up.
 * spring between two rotors: fixed tendon `spring_X` with stiffness; spring to ground: joint stiffness;
 * torque source L: actuator `src_L` with gain c0 (ctrl = shape(t)) and affine velocity bias c1.
 
-Per step: sliding elements whose slip changed sign are tried for a lock (velocities of the new rigid group are set to
-their momentum-weighted mean, the equality is activated, `mj_forward` gives the constraint torque; if it exceeds the
-breakaway torque the element slides on in the other direction), stuck elements break loose when the equality force at
-the current state (an `mj_forward` at the start of the step) exceeds the breakaway torque, and the sliding torques are
-applied through the actuators. The controller is sampled at its period, not at t_end (as the hand path).
+The step loop is mbsuite's native core (`mbsuite.engines.core.Stepper`) with the drives' state machine as its native
+stepper (`native/drives.c`, packed by `native_stepper.py`): per step, at the core's forward of the current state,
+sliding elements whose slip changed sign are tried for a lock (velocities of the new rigid group set to their
+momentum-weighted mean, the equality activated, `mj_forward` gives the constraint torque; if it exceeds the breakaway
+torque the element slides on in the other direction), stuck elements break loose when the equality force at the
+current state exceeds the breakaway torque, the sliding torques are applied through the actuators, the energy terms
+are accumulated and the row recorded - all in C. Python runs only the discrete controller, at its sample instants (the
+core's `between`), and writes the command states into an array the C side reads. `stepper.RotorStepper` is the same
+state machine in Python (the readable twin, statement for statement; `MujocoRotorSim.run(..., stepper="python")`).
+
+Schedules and source shapes are evaluated in C: a `mbsuite.engines.signals` signal directly, any other Python callable
+tabulated on the run's half-step grid (`signal_for`: exact at every instant the state machine evaluates it).
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,14 +34,38 @@ import mujoco
 import numpy as np
 
 from ...engines import mujoco_engine
-from ...errors import ModelFileError, SceneError
-from .friction import BWD, FREE, FWD, MODE_NAME, STUCK, CommandQueue, Controller, RefResult, RotorSystem
+from ...engines.signals import Signal, Table
+from ...errors import ModelFileError, ParameterError, SceneError
+from .friction import MODE_NAME, CommandQueue, Controller, RefResult, RotorSystem
+
+HINT = "reduce solver.timestep"
+#: steps between two drains of the native event buffer when no controller sets the pace
+CHUNK = 4096
+
+
+def signal_for(fn: Callable[[float], float] | Signal, grid: np.ndarray, what: str) -> Signal:
+    """A signal the native state machine can evaluate: `fn` itself if it is a `mbsuite.engines.signals` signal, else
+    `fn` tabulated on `grid` (the run's instants t_k and t_k + dt/2, at which the state machine evaluates schedules
+    and shapes: exact there, linear between). A non-finite value is refused, naming `what` and the time."""
+    if isinstance(fn, Signal):
+        return fn
+    if not callable(fn):
+        raise ParameterError(f"{what} must be a signal (mbsuite.engines.signals) or a callable of time, got {fn!r}")
+    vals = np.array([float(fn(float(x))) for x in grid])
+    bad = np.nonzero(~np.isfinite(vals))[0]
+    if bad.size:
+        raise ParameterError(f"{what} is not finite at t = {grid[bad[0]]:.6g} s (value {float(vals[bad[0]])!r})")
+    return Table(tuple(grid.tolist()), tuple(vals.tolist()))
 
 
 class MujocoRotorSim:
+    """A `RotorSystem` on its MJCF topology: the compiled model with the system's numbers (see the module docstring).
+    One simulation object per thread: its model and data are its own, `run` resets them."""
+
     def __init__(self, sys: RotorSystem, mjcf: str | Path, *, timestep: float = 1e-4, integrator: str = "rk4",
                  lock_timeconst: float | None = None):
         self.sys = sys
+        self.mjcf = Path(mjcf)
         self.m = mujoco_engine.load_model(mjcf)
         mujoco_engine.set_integrator(self.m, integrator, timestep)
         m = self.m
@@ -49,6 +82,8 @@ class MujocoRotorSim:
         if m.nv != sys.n:
             raise ModelFileError(f"{mjcf}: {m.nv} degrees of freedom, the rotor system has {sys.n}")
         for i, j in enumerate(self.jnt):
+            if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE:
+                raise ModelFileError(f"{mjcf}: joint '{sys.names[i]}' must be a hinge")
             m.body_inertia[m.jnt_bodyid[j]] = sys.J[i]
             m.dof_damping[self.dof[i]] = sys.B[i]
             m.jnt_stiffness[j] = 0.0
@@ -65,15 +100,17 @@ class MujocoRotorSim:
         for s, a in zip(sys.sources, self.src, strict=True):
             m.actuator_gainprm[a, 0] = s.c0
             m.actuator_biasprm[a, :3] = (0.0, 0.0, s.c1)
+        # a few coaxial rotors are one constraint island: island discovery only costs (5 % per step measured; the
+        # results agree to round-off, 1e-11 rad/s)
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ISLAND
         tc = lock_timeconst if lock_timeconst is not None else 2.0 * timestep
         for e in self.eq:
             m.eq_solref[e] = (tc, 1.0)
             m.eq_solimp[e] = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+        labels = sys.part_labels()
+        if len(set(labels)) != len(labels):
+            raise ParameterError(f"friction part labels must be unique, got {labels}")
         self.d = mujoco.MjData(m)
-        self._dof_idx = np.array(self.dof, int)
-        self._qadr_idx = np.array(self.qadr, int)
-        self._eq_pos = {int(e): k for k, e in enumerate(self.eq)}
-        self._G_all = sys.G(list(range(len(sys.frictions))))  # w_rel = G w for every element
         # mujoco 4: run-time inertia changes reach M only after mj_setConst (it refreshes the cached constants)
         mujoco.mj_setConst(m, self.d)
         mujoco.mj_forward(m, self.d)
@@ -81,258 +118,113 @@ class MujocoRotorSim:
         if not np.allclose(Mdiag, sys.J, rtol=1e-9, atol=0):
             raise ModelFileError(f"{mjcf}: joint-space inertia {Mdiag} does not match the rotor inertias {sys.J}")
 
-    # -- helpers -------------------------------------------------------------------------------------------------
-    def _w(self) -> np.ndarray:
-        return self.d.qvel[self._dof_idx]  # fancy indexing: a copy
-
-    def _q(self) -> np.ndarray:
-        return self.d.qpos[self._qadr_idx]
-
-    def _eq_forces(self) -> np.ndarray:
-        """Force of every friction element's lock equality from the last `mj_forward` (0 where inactive)."""
-        d = self.d
-        out = np.zeros(len(self.eq))
-        nefc = d.nefc
-        if nefc:
-            rows = np.nonzero(d.efc_type[:nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)[0]
-            seen = set()
-            for r in rows:  # the first row of each equality (a joint equality has one)
-                k = self._eq_pos.get(int(d.efc_id[r]))
-                if k is not None and k not in seen:
-                    out[k] = d.efc_force[r]
-                    seen.add(k)
-        return out
-
-    def _activate(self, stuck: list[int]) -> float:
-        """Lock the elements `stuck`: project velocities (plastic impact), set the equality offsets and activate.
-        Returns the kinetic energy removed by the projection."""
-        m, d, sys = self.m, self.d, self.sys
-        J = np.array([m.body_inertia[m.jnt_bodyid[j], 2] for j in self.jnt])  # hinge about z through the COM
-        w = self._w()
-        if stuck:
-            G = sys.G(stuck)
-            Minv = np.diag(1.0 / J)
-            S = G @ Minv @ G.T
-            w_new = w - Minv @ G.T @ np.linalg.pinv(S, rcond=1e-12) @ G @ w
-        else:
-            w_new = w
-        dke = 0.5 * float(np.sum(J * (w**2 - w_new**2)))
-        for i, dof in enumerate(self.dof):
-            d.qvel[dof] = w_new[i]
-        q = self._q()
-        for e, f in enumerate(sys.frictions):
-            on = e in stuck
-            if on and not d.eq_active[self.eq[e]]:
-                m.eq_data[self.eq[e], 0] = q[f.a] - (q[f.b] if f.b >= 0 else 0.0)
-                m.eq_data[self.eq[e], 1] = 1.0 if f.b >= 0 else 0.0
-            d.eq_active[self.eq[e]] = on
-        return dke
-
     def run(self, q0, w0, t_end: float, *, controller: Controller | None = None, u0: dict[str, int] | None = None,
-            sample_dt: float = 1e-3) -> RefResult:
-        m, d, sys = self.m, self.d, self.sys
-        n, ne = sys.n, len(sys.frictions)
-        dt = float(m.opt.timestep)
-        mujoco.mj_resetData(m, d)
-        for i in range(n):
-            d.qpos[self.qadr[i]] = q0[i]
-            d.qvel[self.dof[i]] = w0[i]
-        part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
-        labels = sys.part_labels()
-        peaks = np.array([f.peak for f in sys.frictions])
-        u = {c: 0 for c in sys.commands()}
-        u.update(u0 or {})
+            sample_dt: float = 1e-3, stepper: str = "native") -> RefResult:
+        """Simulate from (q0, w0) for t_end seconds, recording every `sample_dt`; the controller is sampled at its
+        period (not at t_end, as the hand path). `stepper`: "native" (the C state machine in the native core) or
+        "python" (its Python twin, `stepper.RotorStepper`: the same results, at Python's cost)."""
+        if stepper not in ("native", "python"):
+            raise ValueError(f"unknown stepper {stepper!r}; valid: ['native', 'python']")
+        run = RotorRun(self, q0, w0, t_end, controller=controller, u0=u0, sample_dt=sample_dt)
+        if stepper == "native":
+            from .native_stepper import NativeRotorRun
+
+            return NativeRotorRun(run).run()
+        from .stepper import RotorStepper
+
+        return RotorStepper(run).advance(t_end).result()
+
+
+class RotorRun:
+    """One run's set-up, used by the native stepper and its Python twin: step counts, the command states and the
+    controller with its actuation queue, the schedules and shapes as signals, the initial state, and the assembly of
+    the recorded rows into a `RefResult`.
+
+    Recorded row: q (n), w (n), modes (n_elements), command states, energy terms [source, viscous per rotor, per part]
+    (cumulative, before the step's work), lock-impact energy (cumulative)."""
+
+    def __init__(self, sim: MujocoRotorSim, q0: Sequence[float], w0: Sequence[float], t_end: float, *,
+                 controller: Controller | None = None, u0: dict[str, int] | None = None, sample_dt: float = 1e-3):
+        self.sim = sim
+        self.sys = sys = sim.sys
+        self.m, self.d = m, d = sim.m, sim.d
+        n = sys.n
+        self.dt = dt = float(m.opt.timestep)
+        q0, w0 = self._state("initial positions q0", q0, n), self._state("initial speeds w0", w0, n)
+        if not (math.isfinite(t_end) and t_end >= 0):
+            raise SceneError(f"duration must be a finite number >= 0 s, got {t_end!r}")
+        if not (math.isfinite(sample_dt) and sample_dt > 0):
+            raise SceneError(f"sample_dt must be positive, got {sample_dt!r}")
+        self.nstep = int(round(t_end / dt))
+        self.every = max(1, int(round(sample_dt / dt)))
+        self.u = {c: 0 for c in sys.commands()}
+        self.u.update(u0 or {})
+        self.commands = list(self.u)
+        self.u_arr = np.array([float(v) for v in self.u.values()])
+        self.controller = controller
+        self.period = CHUNK
+        self.queue = None
         if controller is not None:
             ratio = controller.dt / dt
             if abs(ratio - round(ratio)) > 1e-9:
                 raise SceneError(f"controller period {controller.dt} s is not a multiple of the MuJoCo timestep {dt} s")
-            every = int(round(ratio))
-            queue = CommandQueue(sys.delays, controller.dt, u)
-        modes = np.full(ne, FREE)
-        armed = np.zeros(ne, bool)
-        events: list[dict[str, Any]] = []
-        n_steps = int(round(t_end / dt))
-        out_every = max(1, int(round(sample_dt / dt)))
-        n_out = n_steps // out_every + 1
-        T = np.empty(n_out)
-        Q = np.empty((n, n_out))
-        W = np.empty((n, n_out))
-        MO = np.empty((ne, n_out), int)
-        UU = {c: np.empty(n_out) for c in u}
-        e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + labels
-        E = {k: np.empty(n_out) for k in e_names + ["lock_impact"]}
-        acc = np.zeros(len(e_names))
-        stats = {"reset_energy": 0.0, "lock_trials": 0, "steps": n_steps}
-        k_out = 0
+            self.period = int(round(ratio))
+            self.queue = CommandQueue(sys.delays, controller.dt, self.u)
+        self.part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
+        self.labels = sys.part_labels()
+        self.timevar = any(pt.schedule is not None for f in sys.frictions for pt in f.parts)
+        k = np.arange(self.nstep + 1) * dt
+        grid = np.empty(2 * k.size)
+        grid[0::2], grid[1::2] = k, k + 0.5 * dt  # the instants t_k and t_k + dt/2 the state machine evaluates
+        self.schedules = [None if pt.schedule is None else
+                          signal_for(pt.schedule, grid, f"schedule of friction part '{pt.label}'")
+                          for f in sys.frictions for pt in f.parts]
+        self.shapes = [None if s.shape is None else signal_for(s.shape, grid, f"shape of torque source '{s.label}'")
+                       for s in sys.sources]
+        self.e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + self.labels
+        self.nrec = 2 * n + len(sys.frictions) + len(self.commands) + len(self.e_names) + 1
+        mujoco.mj_resetData(m, d)
+        for i in range(n):
+            d.qpos[sim.qadr[i]] = q0[i]
+            d.qvel[sim.dof[i]] = w0[i]
+        self._qadr = np.array(sim.qadr, int)
+        self._dof = np.array(sim.dof, int)
 
-        # levels depend on time only through schedules: without any, cache them per command state
-        timevar = any(pt.schedule is not None for f in sys.frictions for pt in f.parts)
-        lv_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+    @staticmethod
+    def _state(what: str, x: Sequence[float], n: int) -> np.ndarray:
+        a = np.asarray(x, dtype=float)
+        if a.shape != (n,) or not np.all(np.isfinite(a)):
+            raise ParameterError(f"{what} must be {n} finite numbers (one per rotor), got {x!r}")
+        return a
 
-        def levels(t):
-            key = None if timevar else tuple(u[c] for c in u)
-            if key is not None and key in lv_cache:
-                return lv_cache[key]
-            lv = sys.levels(t, u)
-            el = np.zeros(ne)
-            np.add.at(el, part_owner, lv)
-            if key is not None:
-                lv_cache[key] = (lv, el)
-            return lv, el
-
-        G_all = self._G_all
-        free_tol = np.array([1e-12 * max(1.0, sum(p.level for p in f.parts)) for f in sys.frictions])
-        part_idx = np.arange(len(part_owner))
-        part_el = np.array(part_owner, int)
-        rk4 = m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
-        g_prev = np.full(ne, np.nan)  # event function of each element at the previous step (slip or overload)
-        g_now = np.full(ne, np.nan)
-
-        def note(t, e, old, new):
-            """Record a mode change; the time is the linear interpolation of the event function within the step."""
-            if old != new:
-                te = t
-                if np.isfinite(g_prev[e]) and np.isfinite(g_now[e]) and g_prev[e] != g_now[e]:
-                    frac = g_now[e] / (g_now[e] - g_prev[e])
-                    if 0.0 <= frac <= 1.0:
-                        te = t - frac * dt
-                events.append({"t": float(te), "element": sys.frictions[e].name, "from": MODE_NAME[int(old)],
-                               "to": MODE_NAME[int(new)], "t_step": float(t)})
-
-        def step_work(tm, lv, w0, q0, w1, q1):
-            """Energy terms of one step: constant (held) torques do work torque x displacement (exact for the
-            integrated motion, also when a slip reverses inside the step); velocity-proportional terms trapezoidal."""
-            out = np.zeros(len(e_names))
-            dq = q1 - q0
-            for s in sys.sources:
-                i = s.body
-                out[0] += s.c0 * (s.shape(tm) if s.shape else 1.0) * dq[i] + s.c1 * 0.5 * (w0[i] ** 2 + w1[i] ** 2) * dt
-            out[1:1 + n] = sys.B * 0.5 * (w0**2 + w1**2) * dt
-            sliding = (modes == FWD) | (modes == BWD)
-            if sliding.any():
-                dqr = G_all @ dq  # relative displacement of every element
-                on = sliding[part_el]
-                out[1 + n + part_idx[on]] = modes[part_el[on]] * lv[on] * dqr[part_el[on]]
-            return out
-
-        first = True
-        lam_all = np.zeros(ne)  # lock-equality forces of the last mj_forward
-        for step in range(n_steps + 1):
-            t = step * dt
-            if controller is not None and step % every == 0 and step < n_steps:  # as the hand path: none at t_end
-                k = step // every
-                queue.issue(k, controller(k, t, self._q(), self._w()))
-                while queue.pending and queue.pending[0][0] <= t + 0.5 * dt:
-                    _, c, v = queue.pending.pop(0)
-                    u[c] = v
-            lv, el = levels(t)
-            wr = G_all @ self._w()
-            old = modes.copy()
-            fresh = False  # d holds an mj_forward of the current state and ctrl
-            any_stuck = not first and bool(np.any(modes == STUCK))
-            if any_stuck:
-                mujoco.mj_forward(m, d)  # constraint torques at the current state for the break-loose test
-                lam_all = self._eq_forces()
-                fresh = True
-            trial: list[int] = []
-            g_now[:] = np.nan
-            sl = (modes == FWD) | (modes == BWD)
-            g_now[sl] = modes[sl] * wr[sl]
-            if any_stuck:
-                st = modes == STUCK
-                g_now[st] = peaks[st] * el[st] - np.abs(lam_all[st])
-            for e in range(ne):
-                if el[e] <= free_tol[e]:
-                    modes[e] = FREE
-                elif modes[e] == FREE:
-                    if abs(wr[e]) < 1e-12:
-                        trial.append(e)
-                    else:
-                        modes[e] = int(np.sign(wr[e]))
-                        armed[e] = True
-                elif modes[e] in (FWD, BWD):
-                    if modes[e] * wr[e] > 0:
-                        armed[e] = True
-                    elif armed[e]:
-                        trial.append(e)
-                elif modes[e] == STUCK and not first:
-                    lam = lam_all[e]
-                    if abs(lam) > peaks[e] * el[e]:
-                        modes[e] = FWD if lam > 0 else BWD
-                        armed[e] = False
-            if trial or np.any(modes != old):
-                for e in trial:
-                    modes[e] = STUCK
-                # lock trial: activate, evaluate constraint torques, release the most overloaded until consistent
-                for _ in range(2 * ne + 2):
-                    stuck = [e for e in range(ne) if modes[e] == STUCK]
-                    dke = self._activate(stuck)
-                    stats["reset_energy"] += dke
-                    self._set_ctrl(t, el, modes)
-                    mujoco.mj_forward(m, d)
-                    lam_all = self._eq_forces()
-                    fresh = True
-                    stats["lock_trials"] += 1
-                    if not stuck:
-                        break
-                    lam = lam_all[stuck]
-                    ratio = np.abs(lam) / (peaks[stuck] * el[stuck])
-                    r = int(np.argmax(ratio))
-                    if ratio[r] <= 1.0:
-                        break
-                    e = stuck[r]
-                    modes[e] = FWD if lam[r] > 0 else BWD
-                    armed[e] = False
-                # the KE removed by the plastic lock is slip loss of the locking element(s)
-            if not first:
-                for e in np.nonzero(modes != old)[0]:
-                    note(t, int(e), old[e], modes[e])
-            first = False
-            # event functions of the new modes, for interpolating the next event
-            wr = G_all @ self._w()
-            g_prev[:] = np.nan
-            sl = (modes == FWD) | (modes == BWD)
-            g_prev[sl] = modes[sl] * wr[sl]
-            st = modes == STUCK
-            g_prev[st] = peaks[st] * el[st] - np.abs(lam_all[st])
-            # held over the step: time-varying levels and source shapes at mid-step (second order)
-            lv_mid, el_mid = levels(t + 0.5 * dt) if timevar else (lv, el)
-            ctrl_before = d.ctrl.copy()
-            self._set_ctrl(t + 0.5 * dt, el_mid, modes)
-            fresh = fresh and np.array_equal(ctrl_before, d.ctrl)
-            if step % out_every == 0 and k_out < n_out:
-                T[k_out] = t
-                Q[:, k_out] = self._q()
-                W[:, k_out] = self._w()
-                MO[:, k_out] = modes
-                for c in u:
-                    UU[c][k_out] = u[c]
-                for i, k in enumerate(e_names):
-                    E[k][k_out] = acc[i]
-                E["lock_impact"][k_out] = stats["reset_energy"]
-                k_out += 1
-            if step == n_steps:
-                break
-            w_a, q_a = self._w(), self._q()
-            if fresh and rk4:
-                # the forward of this state and ctrl is already in d: mj_step without repeating it
-                mujoco.mj_checkPos(m, d)
-                mujoco.mj_checkVel(m, d)
-                mujoco.mj_checkAcc(m, d)
-                mujoco.mj_RungeKutta(m, d, 4)
-            else:
-                mujoco.mj_step(m, d)
-            mujoco_engine.check_finite(m, d, "drives MuJoCo path")
-            acc += step_work(t + 0.5 * dt, lv_mid, w_a, q_a, self._w(), self._q())
-        stats["warnings"] = mujoco_engine.warnings_raised(d)
-        return RefResult(t=T[:k_out], q=Q[:, :k_out], w=W[:, :k_out], modes=MO[:, :k_out],
-                         energy={k: v[:k_out] for k, v in E.items()}, events=events,
-                         u={c: v[:k_out] for c, v in UU.items()}, stats=stats)
-
-    def _set_ctrl(self, t: float, el: np.ndarray, modes: np.ndarray) -> None:
+    def sample(self, k: int) -> None:
+        """The controller at step k (a multiple of its period): it sees the state at t_k; the commands due by then
+        (quantised actuation delays) take effect for this step."""
+        t = k * self.dt
+        kc = k // self.period
         d = self.d
-        for e in range(len(self.sys.frictions)):
-            tau = modes[e] * el[e] if modes[e] in (FWD, BWD) else 0.0
-            d.ctrl[self.act[e]] = self.act_sign[e] * tau
-        for s, a in zip(self.sys.sources, self.src, strict=True):
-            d.ctrl[a] = s.shape(t) if s.shape is not None else 1.0
+        self.queue.issue(kc, self.controller(kc, t, d.qpos[self._qadr], d.qvel[self._dof]))
+        pending = self.queue.pending
+        while pending and pending[0][0] <= t + 0.5 * self.dt:
+            _, c, v = pending.pop(0)
+            if c not in self.u:
+                raise SceneError(f"the controller commands {c!r}, which no friction part of the system obeys "
+                                 f"(commands: {self.commands})")
+            self.u[c] = v
+            self.u_arr[self.commands.index(c)] = v
+
+    def event(self, t: float, t_step: float, e: int, old: int, new: int) -> dict[str, Any]:
+        return {"t": float(t), "element": self.sys.frictions[e].name, "from": MODE_NAME[int(old)],
+                "to": MODE_NAME[int(new)], "t_step": float(t_step)}
+
+    def result(self, rows: np.ndarray, events: list[dict[str, Any]], stats: dict[str, Any]) -> RefResult:
+        """The recorded rows (one per `every` steps from step 0) as a RefResult; times are step x dt."""
+        n, ne = self.sys.n, len(self.sys.frictions)
+        t = np.arange(rows.shape[0]) * self.every * self.dt
+        c0 = 2 * n + ne
+        e0 = c0 + len(self.commands)
+        energy = {k: rows[:, e0 + i].copy() for i, k in enumerate(self.e_names)}
+        energy["lock_impact"] = rows[:, -1].copy()
+        return RefResult(t=t, q=rows[:, :n].T.copy(), w=rows[:, n:2 * n].T.copy(),
+                         modes=rows[:, 2 * n:c0].T.astype(int), energy=energy, events=events,
+                         u={c: rows[:, c0 + i].copy() for i, c in enumerate(self.commands)}, stats=stats)

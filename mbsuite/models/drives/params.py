@@ -1,7 +1,8 @@
-"""Parameters of the switched-mode drives (Oldaker 1997, seed 004) and of Modelica's CoupledClutches.
+"""Parameters of the switched-mode drives (R. S. Oldaker, The Design and Control of Mechanical Switched Mode Drives,
+PhD thesis, University of Hull, 1997) and of Modelica's CoupledClutches.
 
 `DriveParams` holds scene overrides (SI units); every field left at None takes the value of the scene's parameter set
-(`PARAM_SETS`, chosen by the `param_set` effect). Line numbers `Lnnn` refer to `shared/seeds/004_2c13465951241a5f.txt`.
+(`PARAM_SETS`, chosen by the `param_set` effect). `Lnnn` are line numbers of the thesis' plain-text transcription.
 """
 
 from __future__ import annotations

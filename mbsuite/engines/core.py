@@ -213,6 +213,7 @@ class Stepper:
             rec = None
             job.rec, job.rec_cap = None, 0
         job.rec_row = 0
+        t0 = float(self.data.time)
         steps = 0
         chunk = nstep if between is None else max(1, int(period))
         k = 0
@@ -230,7 +231,7 @@ class Stepper:
                 break
         if rec is None:
             return Trajectory(np.empty(0), {}, steps, {})
-        return self._trajectory(rec[:job.rec_row], steps)
+        return self._trajectory(rec[:job.rec_row], steps, t0, nstep)
 
     def _index(self, ctrl_idx: Sequence[int] | None) -> np.ndarray:
         """The actuator indices of the input columns (validated once per distinct list)."""
@@ -243,13 +244,24 @@ class Stepper:
             self._idx_cache[key] = idx
         return idx
 
-    def _trajectory(self, rec: np.ndarray, steps: int) -> Trajectory:
+    def _trajectory(self, rec: np.ndarray, steps: int, t0: float, nstep: int) -> Trajectory:
+        """The recorded rows as named arrays. Times are the nominal grid t0 + k h of the recorded steps k: MuJoCo's
+        `d.time` is a running sum of h, off the grid by rounding (1e-13 s after 10^4 steps), which would move samples
+        across a window boundary such as t >= t_settle."""
         out, col = {}, 1
         for c in self.channels:
             a = rec[:, col:col + c.size]
             out[c.name] = a[:, 0].copy() if c.size == 1 else a.copy()
             col += c.size
-        return Trajectory(rec[:, 0].copy(), out, steps, warnings_raised(self.data))
+        k = np.arange(0, nstep + 1, self.every)
+        if k[-1] != nstep:
+            k = np.append(k, nstep)
+        k = k[:rec.shape[0]]
+        t = t0 + k * self.model.opt.timestep
+        if not np.allclose(t, rec[:, 0], rtol=0, atol=1e-9 * max(1.0, abs(t[-1]) if t.size else 1.0)):
+            raise SolverError(f"{self.what}: recorded times left the step grid (the data's time was changed "
+                              "during the run)")
+        return Trajectory(t, out, steps, warnings_raised(self.data))
 
     def _column_name(self, col: int) -> str:
         c0 = 1

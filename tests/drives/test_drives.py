@@ -303,7 +303,7 @@ def test_delay_samples_one_conversion():
 
 
 def test_anti_windup_default_and_printed_variant():
-    """Energy-packet PI: anti-windup unless a scene asks otherwise (issue #5); the step-up closed-loop scene selects
+    """Energy-packet PI: anti-windup unless a scene asks otherwise; the step-up closed-loop scene selects
     the printed, winding-up t_k PI explicitly (the thesis reproduction)."""
     sc = load_scene("drives/susd_500w_step")
     assert "anti_windup" not in sc.to_dict().get("effects", {}) or sc.effects["anti_windup"] is True

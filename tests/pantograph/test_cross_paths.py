@@ -80,7 +80,7 @@ def test_mujoco_accelerations_match_hand_derived(random_thetas, cylinder, elbow_
 
 @pytest.mark.parametrize("cylinder", ["linear", "nonlinear", "constant"])
 def test_equilibrium_same_in_three_paths(lab_scene, cylinder):
-    """Operating height 1.58 m, supply pressure of Table 3-I: theta agree to 1e-8 rad (issue #2)."""
+    """Operating height 1.58 m, supply pressure of Table 3-I: theta agree to 1e-8 rad."""
     from mbsuite.models.pantograph.analysis import equilibrium_all_paths
 
     paths = equilibrium_all_paths(lab_scene.replace(effects={"cylinder": cylinder}))

@@ -1,4 +1,4 @@
-"""Frequency response: linearisation vs the thesis, MuJoCo vs the reference (issue #2 acceptance figures)."""
+"""Frequency response: linearisation vs the thesis, MuJoCo vs the reference."""
 
 import math
 

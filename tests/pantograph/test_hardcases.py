@@ -1,4 +1,4 @@
-"""Hard cases stay numerically stable; bad input gives clear errors (issue #2, section 4)."""
+"""Hard cases stay numerically stable; bad input gives clear errors."""
 
 import math
 

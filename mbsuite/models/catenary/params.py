@@ -1,4 +1,4 @@
-"""EN 50318:2002 reference catenary and reference pantograph, as fixed by mbsuite (`shared/reference/catenary.md`).
+"""EN 50318:2002 reference catenary and reference pantograph, as fixed by mbsuite (see the model README).
 
 Every default below is the reference scene; SI units throughout. The dropper positions are measured from the support
 at the start of each span and repeat in every span. Validation raises `ParameterError` naming the parameter and value.

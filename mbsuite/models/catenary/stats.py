@@ -1,4 +1,4 @@
-"""EN 50318 statistics of a coupled run, as fixed in `shared/reference/catenary.md`.
+"""EN 50318 statistics of a coupled run, as the model README states them.
 
 - The contact force is low-pass filtered at 20 Hz by a 4th-order Butterworth applied forwards and backwards (zero
   phase, `scipy.signal.sosfiltfilt`) on the whole record, then windowed to x in [240, 360] m.

@@ -1,7 +1,8 @@
 """Parameters of the single and double 4-link (SS-link) coupler.
 
-Geometry follows Maniowski & Czauderna (seed 001, Sect. 2, Table 1) with the platform layout of
-`shared/reference/coupler.md` (B1): joint centres on a circle of radius R at polar angles pi/2 +- gamma, -pi/2 +- gamma,
+Geometry follows Maniowski & Czauderna, "Spatial kinematic analysis of double 4-link coupler used in low-floor tram
+powertrains" (Sect. 2, Table 1), with the platform layout stated in the model README: joint centres on a circle of
+radius R at polar angles pi/2 +- gamma, -pi/2 +- gamma,
 link k joins A-point k to B-point k+1. Lengths are in metres; the paper's non-dimensional model is R = 1.
 """
 

@@ -1,5 +1,5 @@
-"""Hand-derived pantograph dynamics in plain numpy/scipy (Eppinger 1984, seed 000), with the errata of
-`shared/reference/pantograph.md` applied.
+"""Hand-derived pantograph dynamics in plain numpy/scipy (Eppinger 1984, "An experimental and analytical study of
+pantograph dynamics"), with the corrections stated in the model README applied.
 
 Coordinates are the thesis' absolute angles theta = (theta_1, theta_2, theta_h) (Fig 3-3). With K12 = m2 l1 d2 + mh
 l1 l2,

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..engines.core import n_workers
-from ..errors import MbsuiteError, SceneError
+from ..errors import MbsuiteError, SceneError, SolverError
 from ..results import Progress, to_jsonable
 
 EXECUTORS = ("local", "threads", "dask")
@@ -251,6 +251,12 @@ def rollout_sweep(models: Any, initial_states: np.ndarray, controls: np.ndarray,
     datas = [mujoco.MjData(m0) for _ in range(nt)]
     state, sens = rollout.rollout(models, datas, np.asarray(initial_states, float), np.asarray(controls, float),
                                   nstep=nstep)
+    from ..engines.core import check_plugin_faults
+
+    for d in datas:  # a fault of an mbsuite plugin in any trajectory stays recorded in the data that ran it
+        check_plugin_faults(m0, d, "mujoco.rollout batch")
+    if not np.all(np.isfinite(state)):
+        raise SolverError("mujoco.rollout batch: a trajectory became non-finite (NaN/inf); reduce the timestep")
     return state, sens
 
 

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import SolverError
 from . import native
+from .mujoco_engine import _active as _scoped_callbacks
 from .mujoco_engine import warnings_raised
 
 #: recordable MjData quantities (order mirrors the MBS_F_* enum of native/mbsuite.h)
@@ -43,7 +44,7 @@ FIELDS = ("time", "qpos", "qvel", "act", "ctrl", "actuator_force", "actuator_len
 _FIELD_ID = {f: i for i, f in enumerate(FIELDS)}
 _STATUS = {0: "ok", 1: "non-finite state", 2: "MuJoCo warning", 3: "plugin fault", 4: "implausible value",
            5: "native stepper error", 6: "invalid arguments"}
-DEFAULT_HINT = "reduce solver.timestep or use an implicit integrator"
+DEFAULT_HINT = "reduce solver.timestep"
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,18 @@ class NativeHook:
     describe: Callable[[int], str] = field(default=lambda code: f"native stepper error {code}")
 
 
+def _refuse_python_callbacks(what: str) -> None:
+    installed = [name for name, get in _CALLBACK_GETTERS.items() if get() is not None]
+    if installed:
+        raise SolverError(f"{what}: MuJoCo Python callback(s) {installed} are installed in this process and would act "
+                          "on this run as well (they are process-global); remove them first")
+
+
+_CALLBACK_GETTERS = {"passive": mujoco.get_mjcb_passive, "act_dyn": mujoco.get_mjcb_act_dyn,
+                     "act_gain": mujoco.get_mjcb_act_gain, "act_bias": mujoco.get_mjcb_act_bias,
+                     "control": mujoco.get_mjcb_control, "sensor": mujoco.get_mjcb_sensor}
+
+
 class _Job(ctypes.Structure):
     _fields_ = [
         ("nstep", ctypes.c_long), ("k0", ctypes.c_long), ("final", ctypes.c_int),
@@ -91,7 +104,7 @@ class _Job(ctypes.Structure):
         ("hook", ctypes.c_void_p), ("hook_ud", ctypes.c_void_p), ("hook_rec", ctypes.c_void_p),
         ("status", ctypes.c_int), ("fail_step", ctypes.c_long), ("fail_time", ctypes.c_double),
         ("fail_col", ctypes.c_int), ("fail_value", ctypes.c_double), ("fail_plugin", ctypes.c_int),
-        ("fail_code", ctypes.c_int), ("steps_done", ctypes.c_long),
+        ("fail_code", ctypes.c_int), ("fail_what", ctypes.c_char_p), ("steps_done", ctypes.c_long),
     ]
 
 
@@ -121,11 +134,13 @@ class Stepper:
     """A model and its data, stepped by the native core (module docstring).
 
     `what` names the run in error messages (e.g. "pantograph scene lab (MuJoCo)"); `hint` is the advice appended to
-    numerical failures."""
+    numerical failures. MuJoCo's Python callbacks are process-global: one installed anywhere in the process would act on
+    this run too, so a Stepper refuses to run while one is installed, unless `allow_callbacks` (a model that is meant
+    to run with its Python twins)."""
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData | None = None, channels: Sequence[Channel] = (), *,
                  every: int = 1, check_every: int = 64, hook: NativeHook | None = None, what: str = "MuJoCo run",
-                 hint: str = DEFAULT_HINT):
+                 hint: str = DEFAULT_HINT, allow_callbacks: bool = False):
         self.lib = native.load()
         self.model = model
         self.data = data if data is not None else mujoco.MjData(model)
@@ -136,6 +151,14 @@ class Stepper:
         self.check_every = int(check_every)
         if self.every < 1 or self.check_every < 1:
             raise ValueError("every and check_every must be >= 1")
+        if self.data.signature != model.signature:
+            raise ValueError(f"{what}: the MjData was not made for this MjModel (signatures differ)")
+        if native.job_size() != ctypes.sizeof(_Job):
+            raise native.NativeBuildError(f"native job layout {native.job_size()} bytes, Python's "
+                                          f"{ctypes.sizeof(_Job)}: rebuild (mbsuite.native.build(force=True))")
+        self.allow_callbacks = allow_callbacks
+        if not allow_callbacks:
+            _refuse_python_callbacks(what)
         self.hook = hook
         self.what = what
         self.hint = hint
@@ -192,6 +215,8 @@ class Stepper:
         nstep = int(nstep)
         if nstep < 0:
             raise ValueError(f"nstep must be >= 0, got {nstep}")
+        if _scoped_callbacks and not self.allow_callbacks:
+            _refuse_python_callbacks(self.what)
         job = self._job
         if ctrl is not None:
             if not (isinstance(ctrl, np.ndarray) and ctrl.dtype == np.float64 and ctrl.flags.c_contiguous):
@@ -273,34 +298,69 @@ class Stepper:
 
     def _error(self, job: _Job) -> SolverError:
         m = self.model
-        setting = (f"integrator {mujoco.mjtIntegrator(m.opt.integrator).name[6:].lower()}, timestep "
-                   f"{m.opt.timestep:g} s")
+        integ = mujoco.mjtIntegrator(m.opt.integrator).name[6:].lower()
+        setting = f"integrator {integ}, timestep {m.opt.timestep:g} s"
+        hint = self.hint
+        if hint == DEFAULT_HINT and integ in ("euler", "rk4"):
+            hint += " or use an implicit integrator"
         at = f"at t = {job.fail_time:.6g} s"
-        if job.status == 3 and job.fail_time < 0:
-            at = "in the model's configuration (found at load)"
         if job.status == 3:
-            inst = job.fail_plugin
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PLUGIN, inst) or f"instance {inst}"
-            text = self.lib.mbs_fault_text(job.fail_code).decode()
-            return SolverError(f"{self.what}: effect '{name}': {text} (value {job.fail_value:.6g}) {at} ({setting}); "
-                               "the state is non-physical: check the parameters and the input, or " + self.hint)
+            return plugin_error(m, job.fail_plugin, job.fail_code, job.fail_value, job.fail_time,
+                                job.fail_what.decode() if job.fail_what else None, self.what, setting, hint)
         if job.status == 4:
             c = self.channels_flat_bound(job.fail_col)
             return SolverError(f"{self.what}: {self._column_name(job.fail_col)} = {job.fail_value:.6g} is outside its "
-                               f"plausible range [{c[0]:g}, {c[1]:g}] {at} ({setting}); {self.hint}")
+                               f"plausible range [{c[0]:g}, {c[1]:g}] {at} ({setting}); {hint}")
         if job.status == 5 and self.hook is not None:
             return SolverError(f"{self.what}: {self.hook.describe(job.fail_code)} {at} ({setting})")
         if job.status == 6:
-            return SolverError(f"{self.what}: invalid arguments to the native core")
+            return SolverError(f"{self.what}: invalid arguments to the native core (a recording buffer too small or a "
+                               "bad input array)")
         if job.status == 2:
-            warning = mujoco.mjtWarning(job.fail_code).name[7:].lower()
-            return SolverError(f"{self.what}: MuJoCo diverged (warning {warning}: a non-finite or huge value) {at} "
-                               f"({setting}); {self.hint}")
+            w = mujoco.mjtWarning(job.fail_code)
+            name = w.name[7:].lower()
+            if w in (mujoco.mjtWarning.mjWARN_CNSTRFULL, mujoco.mjtWarning.mjWARN_CONTACTFULL):
+                return SolverError(f"{self.what}: MuJoCo's {name.replace('full', '')} arrays are full {at} "
+                                   f"({setting}); give the model more memory (MJCF <size memory=...>)")
+            return SolverError(f"{self.what}: MuJoCo diverged (warning {name}: a non-finite or huge value) {at} "
+                               f"({setting}); {hint}")
         return SolverError(f"{self.what}: MuJoCo diverged ({_STATUS.get(job.status, job.status)}) {at} ({setting}); "
-                           f"{self.hint}")
+                           f"{hint}")
 
     def channels_flat_bound(self, col: int) -> tuple[float, float]:
         return float(self._lo[col]), float(self._hi[col])
+
+
+def plugin_error(m: mujoco.MjModel, instance: int, code: int, value: float, time: float, what: str | None,
+                 run: str, setting: str, hint: str) -> SolverError:
+    """The error of an mbsuite plugin fault: the effect (plugin instance) by name, the fault, the offending attribute or
+    value, and when."""
+    lib = native.load()
+    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PLUGIN, instance) or f"instance {instance}"
+    text = lib.mbs_fault_text(code).decode()
+    if time < 0:  # found when the data was created: the model's configuration, nothing to do with the run's numerics
+        bad = f" '{what}'" if what else ""
+        val = "" if value != value else f" (value {value:.6g})"
+        return SolverError(f"{run}: effect '{name}': {text}: attribute{bad}{val} in the model's plugin "
+                           "configuration (found at load)")
+    detail = f" ({what})" if what else ""
+    return SolverError(f"{run}: effect '{name}': {text}{detail} (value {value:.6g}) at t = {time:.6g} s ({setting}); "
+                       f"the state is non-physical: check the parameters and the input, or {hint}")
+
+
+def check_plugin_faults(m: mujoco.MjModel, d: mujoco.MjData, run: str) -> None:
+    """Raise the SolverError of the first fault an mbsuite plugin of (m, d) recorded (after any MuJoCo call outside
+    the core: an equilibrium's mj_forward, a `mujoco.rollout`)."""
+    if not m.nplugin:
+        return
+    lib = native.load()
+    code, time, value, what = ctypes.c_int(), ctypes.c_double(), ctypes.c_double(), ctypes.c_char_p()
+    i = lib.mbs_plugin_fault(ctypes.c_void_p(m._address), ctypes.c_void_p(d._address), ctypes.byref(code),
+                             ctypes.byref(time), ctypes.byref(value), ctypes.byref(what))
+    if i >= 0:
+        setting = f"timestep {m.opt.timestep:g} s"
+        raise plugin_error(m, i, code.value, value.value, time.value, what.value.decode() if what.value else None,
+                           run, setting, DEFAULT_HINT)
 
 
 def n_workers(workers: int = 0) -> int:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -65,9 +66,11 @@ def mujoco_dirs() -> tuple[Path, Path]:
     return inc, libs[0]
 
 
-def _compiler() -> str:
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
-    if not cc:
+def _compiler() -> list[str]:
+    """The C compiler command: $CC (may carry arguments, e.g. "ccache gcc"), else cc, gcc or clang."""
+    cc = shlex.split(os.environ.get("CC", "")) or [shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+                                                   or ""]
+    if not cc[0]:
         raise NativeBuildError("mbsuite's native layer needs a C compiler (cc, gcc or clang, or $CC) to compile its "
                                "MuJoCo plugins once per mujoco version; install one (e.g. apt install gcc)")
     return cc
@@ -91,11 +94,13 @@ def build_key() -> str:
         h.update(p.name.encode())
         h.update(p.read_bytes())
     h.update(" ".join(CFLAGS).encode())
-    h.update(_compiler().encode())
+    cc = _compiler()
+    h.update(" ".join(cc).encode())
+    h.update(subprocess.run([*cc, "--version"], capture_output=True, text=True, check=False).stdout.encode())
     h.update(mujoco.__version__.encode())
     h.update(str(lib).encode())
-    h.update((inc / "mujoco" / "mjdata.h").read_bytes())
-    h.update((inc / "mujoco" / "mjmodel.h").read_bytes())
+    for header in sorted((inc / "mujoco").glob("*.h")):
+        h.update(header.read_bytes())
     h.update(sys.platform.encode())
     return h.hexdigest()[:20]
 
@@ -115,7 +120,7 @@ def build(force: bool = False) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".build-", suffix=".so", dir=out.parent)
     os.close(fd)
-    cmd = [_compiler(), *CFLAGS, f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),
+    cmd = [*_compiler(), *CFLAGS, f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),
            f"-Wl,-rpath,{lib.parent}", "-lm"]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
@@ -143,6 +148,12 @@ def load() -> ctypes.CDLL:
         lib.mbs_abi_version.restype = ctypes.c_int
         if lib.mbs_abi_version() != ABI_VERSION:
             raise NativeBuildError(f"{path} has native ABI {lib.mbs_abi_version()}, mbsuite expects {ABI_VERSION}")
+        lib.mbs_plugin_overflow.restype = ctypes.c_int
+        if lib.mbs_plugin_overflow():
+            raise NativeBuildError("more engine plugins registered than the native core tracks (MBS_MAX_PLUGINS)")
+        lib.mbs_job_size.restype = ctypes.c_int
+        lib.mbs_plugin_fault.restype = ctypes.c_int
+        lib.mbs_plugin_fault.argtypes = [ctypes.c_void_p] * 6
         lib.mbs_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
         lib.mbs_run.restype = ctypes.c_int
         lib.mbs_fault_text.argtypes = [ctypes.c_int]
@@ -151,6 +162,11 @@ def load() -> ctypes.CDLL:
         lib.mbs_signal.restype = ctypes.c_double
         _lib = lib
         return lib
+
+
+def job_size() -> int:
+    """sizeof(mbs_job) of the loaded library (checked against the ctypes layout)."""
+    return int(load().mbs_job_size())
 
 
 def plugin_names() -> list[str]:

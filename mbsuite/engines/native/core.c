@@ -15,15 +15,22 @@
 #include "mbsuite.h"
 
 /* ------------------------------------------------------------------------------------------------ plugins */
-#define MBS_MAX_PLUGINS 32
+#define MBS_MAX_PLUGINS 64
 static int own_slots[MBS_MAX_PLUGINS];
 static int n_own_slots = 0;
+static int own_overflow = 0;
 
 int mbs_register_plugin(const mjpPlugin* plugin) {
   int slot = mjp_registerPlugin(plugin);
-  if (n_own_slots < MBS_MAX_PLUGINS) own_slots[n_own_slots++] = slot;
+  if (n_own_slots < MBS_MAX_PLUGINS) {
+    own_slots[n_own_slots++] = slot;
+  } else {
+    own_overflow = 1;
+  }
   return slot;
 }
+
+int mbs_plugin_overflow(void) { return own_overflow; }
 
 int mbs_is_own_instance(const mjModel* m, int instance) {
   int slot = m->plugin[instance];
@@ -42,23 +49,60 @@ void mbs_fault(mjData* d, int instance, int code, double value) {
   }
 }
 
-double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback, int* bad) {
+void mbs_config_fault(mbs_plugin_header* h, const char* what, double value) {
+  if (h && !h->fault) {
+    h->fault = MBS_FAULT_CONFIG;
+    h->at_load = 1;
+    h->fault_time = 0.0;
+    h->fault_value = value;
+    h->what = what;
+  }
+}
+
+int mbs_config_require(mbs_plugin_header* h, int ok, const char* what, double value) {
+  if (!ok) mbs_config_fault(h, what, value);
+  return ok;
+}
+
+double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback,
+                         mbs_plugin_header* h) {
   const char* s = mj_getPluginConfig(m, instance, key);
-  if (!s || !s[0]) return fallback;
-  char* end = NULL;
-  double v = strtod(s, &end);
-  if (end == s || !isfinite(v)) {
-    *bad = 1;
+  if (!s || !s[0]) {
+    if (isnan(fallback)) mbs_config_fault(h, key, NAN); /* required */
     return fallback;
   }
-  while (*end == ' ') end++;
-  if (*end) *bad = 1;
+  char* end = NULL;
+  double v = strtod(s, &end);
+  int bad = end == s || !isfinite(v);
+  if (!bad) {
+    while (*end == ' ') end++;
+    bad = *end != 0;
+  }
+  if (bad) {
+    mbs_config_fault(h, key, NAN);
+    return fallback;
+  }
   return v;
+}
+
+int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what) {
+  for (int i = 0; i < m->nplugin; i++) {
+    if (!mbs_is_own_instance(m, i)) continue;
+    const mbs_plugin_header* h = (const mbs_plugin_header*)d->plugin_data[i];
+    if (h && h->fault) {
+      *code = h->fault;
+      *time = h->at_load ? -1.0 : h->fault_time; /* < 0: found when the data was created */
+      *value = h->fault_value;
+      *what = h->what;
+      return i;
+    }
+  }
+  return -1;
 }
 
 const char* mbs_fault_text(int code) {
   switch (code) {
-    case MBS_FAULT_CONFIG: return "a configuration attribute is missing or not a finite number";
+    case MBS_FAULT_CONFIG: return "a configuration attribute is missing, not a finite number or out of its range";
     case MBS_FAULT_NONFINITE: return "non-finite state (NaN or inf) reached the effect";
     case MBS_FAULT_VOLUME: return "cylinder chamber volume V0 + Ap x_p became <= 0 (m^3)";
     case MBS_FAULT_PRESSURE: return "absolute cylinder pressure became <= 0 (Pa)";
@@ -216,28 +260,30 @@ static const int bad_warnings[] = {mjWARN_BADQPOS, mjWARN_BADQVEL, mjWARN_BADQAC
                                    mjWARN_CONTACTFULL};
 #define N_BAD_WARNINGS ((int)(sizeof(bad_warnings) / sizeof(bad_warnings[0])))
 
-/* index of the first bad warning whose counter grew since `base`, or -1 */
-static int new_bad_warning(const mjData* d, const int* base) {
+/* the first bad warning counted during this call (the counters were zeroed at entry), or -1 */
+static int new_bad_warning(const mjData* d) {
   for (int i = 0; i < N_BAD_WARNINGS; i++) {
-    if (d->warning[bad_warnings[i]].number > base[i]) return bad_warnings[i];
+    if (d->warning[bad_warnings[i]].number > 0) return bad_warnings[i];
   }
   return -1;
 }
 
-static int plugin_faults(const mjModel* m, const mjData* d, mbs_job* J, long k) {
-  for (int i = 0; i < m->nplugin; i++) {
-    if (!mbs_is_own_instance(m, i)) continue;
-    const mbs_plugin_header* h = (const mbs_plugin_header*)d->plugin_data[i];
-    if (h && h->fault) {
-      fail(J, MBS_FAIL_PLUGIN, k, h->fault_time);
-      J->fail_plugin = i;
-      J->fail_code = h->fault;
-      J->fail_value = h->fault_value;
-      return MBS_FAIL_PLUGIN;
-    }
-  }
-  return MBS_OK;
+static int plugin_faults(const mjModel* m, const mjData* d, mbs_job* J, long k, double tk) {
+  if (!m->nplugin) return MBS_OK;
+  int code;
+  double time, value;
+  const char* what;
+  int i = mbs_plugin_fault(m, d, &code, &time, &value, &what);
+  if (i < 0) return MBS_OK;
+  fail(J, MBS_FAIL_PLUGIN, k, time);
+  J->fail_plugin = i;
+  J->fail_code = code;
+  J->fail_value = value;
+  J->fail_what = what;
+  return MBS_FAIL_PLUGIN;
 }
+
+int mbs_job_size(void) { return (int)sizeof(mbs_job); }
 
 int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
   J->status = MBS_OK;
@@ -245,6 +291,7 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
   J->fail_col = -1;
   J->fail_plugin = -1;
   J->fail_code = 0;
+  J->fail_what = NULL;
   if (J->every < 1 || J->check_every < 1 || J->nstep < 0 || (J->ctrl && (!J->ctrl_idx || J->ctrl_ncol < 1))) {
     fail(J, MBS_FAIL_ARGS, J->k0, d->time);
     return J->status;
@@ -252,12 +299,19 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
   const int integrator = m->opt.integrator;
   const int split = integrator == mjINT_EULER || integrator == mjINT_RK4 || integrator == mjINT_IMPLICIT ||
                     integrator == mjINT_IMPLICITFAST;
+  /* MuJoCo resets the data when it meets a broken state, which zeroes every warning counter and then counts the new
+   * warning: a counter compared with its value at entry could miss it. The counters are zeroed here, any count is a
+   * failure, and the caller's counts are added back on the way out. */
   int warn0[N_BAD_WARNINGS];
-  for (int i = 0; i < N_BAD_WARNINGS; i++) warn0[i] = d->warning[bad_warnings[i]].number;
+  for (int i = 0; i < N_BAD_WARNINGS; i++) {
+    warn0[i] = d->warning[bad_warnings[i]].number;
+    d->warning[bad_warnings[i]].number = 0;
+  }
   const long n = J->nstep + (J->final ? 1 : 0);
   for (long i = 0; i < n; i++) {
     const long k = J->k0 + i;
     const int last = i == J->nstep;
+    const double tk = d->time; /* the state's time (a reset by MuJoCo would zero d->time) */
     if (!last && J->ctrl && k < J->ctrl_rows) {
       const double* row = J->ctrl + k * J->ctrl_ncol;
       for (int c = 0; c < J->ctrl_ncol; c++) d->ctrl[J->ctrl_idx[c]] = row[c];
@@ -269,25 +323,27 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
       mj_checkVel(m, d);
       mj_forward(m, d);
       mj_checkAcc(m, d);
-      int w = new_bad_warning(d, warn0);
+      if (plugin_faults(m, d, J, k, tk)) goto done;
+      int w = new_bad_warning(d);
       if (w >= 0) {
-        fail(J, MBS_FAIL_BADQACC, k, d->time);
+        fail(J, MBS_FAIL_BADQACC, k, tk);
         J->fail_code = w;
-        return J->status;
+        goto done;
       }
       if (J->hook) {
         int r = J->hook(m, d, J->hook_ud, k, MBS_STAGE_POST_FORWARD);
         if (r < 0) {
-          fail(J, MBS_FAIL_HOOK, k, d->time);
+          fail(J, MBS_FAIL_HOOK, k, tk);
           J->fail_code = r;
-          return J->status;
+          goto done;
         }
         if (r > 0) {
           mj_forward(m, d);
           mj_checkAcc(m, d);
+          if (plugin_faults(m, d, J, k, tk)) goto done;
         }
       }
-      if (rec_now && record(m, d, J, k)) return J->status;
+      if (rec_now && record(m, d, J, k)) goto done;
     }
     if (last) break;
     switch (integrator) {
@@ -301,22 +357,24 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
     if (J->hook) {
       int r = J->hook(m, d, J->hook_ud, k, MBS_STAGE_POST_STEP);
       if (r < 0) {
-        fail(J, MBS_FAIL_HOOK, k, d->time);
+        fail(J, MBS_FAIL_HOOK, k, tk);
         J->fail_code = r;
-        return J->status;
+        goto done;
       }
     }
-    int w = new_bad_warning(d, warn0);
+    if (plugin_faults(m, d, J, k, tk)) goto done;
+    int w = new_bad_warning(d);
     if (w >= 0) {
-      fail(J, MBS_FAIL_BADQACC, k, d->time);
+      fail(J, MBS_FAIL_BADQACC, k, tk);
       J->fail_code = w;
-      return J->status;
+      goto done;
     }
-    if (m->nplugin && plugin_faults(m, d, J, k)) return J->status;
     if ((k + 1) % J->check_every == 0 && !finite_state(m, d)) {
-      fail(J, MBS_FAIL_NONFINITE, k, d->time);
-      return J->status;
+      fail(J, MBS_FAIL_NONFINITE, k, tk);
+      goto done;
     }
   }
+done:
+  for (int i = 0; i < N_BAD_WARNINGS; i++) d->warning[bad_warnings[i]].number += warn0[i];
   return J->status;
 }

@@ -16,8 +16,10 @@
  * and the time. A plugin cannot raise: this is its only way out. */
 typedef struct {
   int fault;          /* 0 = none; else a model-specific code, described by mbs_fault_text */
-  double fault_time;  /* d->time of the first fault; < 0: found when the model was loaded (a configuration fault) */
+  int at_load;        /* 1: found when the data was created (a configuration fault): survives mj_resetData */
+  double fault_time;  /* d->time of the first fault */
   double fault_value; /* the offending value */
+  const char* what;   /* the offending configuration attribute or quantity (a static string), or NULL */
 } mbs_plugin_header;
 
 /* Register a plugin and remember its slot, so that the core can find mbsuite's instances in any model. */
@@ -26,8 +28,18 @@ int mbs_register_plugin(const mjpPlugin* plugin);
 int mbs_is_own_instance(const mjModel* m, int instance);
 /* Record a fault on an instance (the first one wins). */
 void mbs_fault(mjData* d, int instance, int code, double value);
-/* Parse a numeric config attribute; `fallback` if absent. Sets *bad to 1 if present but not a finite number. */
-double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback, int* bad);
+/* Record a configuration fault found at init (names the attribute; survives mj_resetData). */
+void mbs_config_fault(mbs_plugin_header* h, const char* what, double value);
+/* Parse a numeric config attribute; `fallback` if absent (a NaN fallback makes it required). On a missing required,
+ * malformed or non-finite value: records a configuration fault naming `key` on h and returns the fallback. */
+double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback, mbs_plugin_header* h);
+/* Configuration check: if !ok, records a configuration fault naming `what` with `value`. Returns ok. */
+int mbs_config_require(mbs_plugin_header* h, int ok, const char* what, double value);
+/* Scan the mbsuite plugin instances of (m, d) for a fault: returns the instance id (or -1) and fills the rest; the
+ * time is < 0 for a fault found when the data was created (a configuration fault). */
+int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what);
+/* 1 if more plugins were registered than the core can track (their faults would go unseen). */
+int mbs_plugin_overflow(void);
 
 /* Fault codes (all models); texts in core.c. */
 enum {
@@ -114,11 +126,14 @@ typedef struct {
   int fail_col;
   double fail_value;
   int fail_plugin;        /* plugin instance id (MBS_FAIL_PLUGIN) */
-  int fail_code;          /* plugin fault code or hook error */
+  int fail_code;          /* plugin fault code, hook error, or the MuJoCo warning (mjtWarning) */
+  const char* fail_what;  /* plugin fault: the offending attribute or quantity, or NULL */
   long steps_done;        /* steps integrated in this call */
 } mbs_job;
 
 int mbs_run(const mjModel* m, mjData* d, mbs_job* job);
+/* sizeof(mbs_job): the Python side compares it with its ctypes layout */
+int mbs_job_size(void);
 
 /* Version of the job layout; the Python side refuses a library with another. */
 int mbs_abi_version(void);

@@ -89,6 +89,7 @@ class MujocoPantograph:
         self.cfg = config or PantographConfig()
         self.integrator = integrator
         self.timestep = float(timestep)
+        self.plugins = plugins  # False: the model of the Python twins, which runs with their MuJoCo callbacks
         self.model = compiled_model(self.p, self.cfg, integrator, self.timestep, plugins)
         self.data = mujoco.MjData(self.model)
         self.hold_offset = hold_offset(integrator)
@@ -115,6 +116,7 @@ class MujocoPantograph:
         if m.na:
             d.act[m.actuator_actadr[self.i_cyl]] = self.cylinder_rest(float(q[0]))
         mujoco.mj_forward(m, d)
+        core.check_plugin_faults(m, d, "pantograph statics (MuJoCo)")
 
     def static_residual(self, q: np.ndarray, y_w: float) -> np.ndarray:
         """qfrc_passive + qfrc_actuator - qfrc_bias at rest (friction-free), from MuJoCo's own force evaluation."""
@@ -169,7 +171,8 @@ class MujocoPantograph:
 
     def stepper(self, every: int = 1, what: str = "pantograph (MuJoCo)",
                 data: mujoco.MjData | None = None) -> core.Stepper:
-        return core.Stepper(self.model, self.data if data is None else data, self.channels(), every=every, what=what)
+        return core.Stepper(self.model, self.data if data is None else data, self.channels(), every=every, what=what,
+                            allow_callbacks=not self.plugins)
 
     def simulate(self, y_w: Callable[[np.ndarray], np.ndarray], t_end: float, q0: np.ndarray | None = None, *,
                  every: int = 1, what: str = "pantograph (MuJoCo)", data: mujoco.MjData | None = None,

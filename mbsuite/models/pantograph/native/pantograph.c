@@ -38,45 +38,57 @@ static int cyl_nstate(const mjModel* m, int instance) { return 0; }
 static int cyl_init(const mjModel* m, mjData* d, int instance) {
   Cylinder* c = calloc(1, sizeof(Cylinder));
   if (!c) return -1;
-  int bad = 0;
+  d->plugin_data[instance] = (uintptr_t)c;
+  mbs_plugin_header* h = &c->h;
   const char* model = mj_getPluginConfig(m, instance, "model");
-  if (!model || (strcmp(model, "linear") && strcmp(model, "nonlinear"))) bad = 1;
+  mbs_config_require(h, model && (!strcmp(model, "linear") || !strcmp(model, "nonlinear")), "model", NAN);
   c->nonlinear = model && !strcmp(model, "nonlinear");
-  c->lb = mbs_config_number(m, instance, "lb", NAN, &bad);
-  c->alpha = mbs_config_number(m, instance, "alpha", NAN, &bad);
-  c->kc = mbs_config_number(m, instance, "kc", NAN, &bad);
-  c->bc = mbs_config_number(m, instance, "bc", NAN, &bad);
-  c->Pg = mbs_config_number(m, instance, "Pg", NAN, &bad);
-  c->Pa = mbs_config_number(m, instance, "Pa", NAN, &bad);
-  c->Ap = mbs_config_number(m, instance, "Ap", NAN, &bad);
-  c->V0 = mbs_config_number(m, instance, "V0", NAN, &bad);
-  c->R = mbs_config_number(m, instance, "R_gas", NAN, &bad);
-  c->T = mbs_config_number(m, instance, "T", NAN, &bad);
-  c->gamma = mbs_config_number(m, instance, "gamma", NAN, &bad);
-  c->cd = mbs_config_number(m, instance, "cd", NAN, &bad);
-  c->Ao = mbs_config_number(m, instance, "Ao", NAN, &bad);
-  c->r_lam = mbs_config_number(m, instance, "r_laminar", NAN, &bad);
+  c->lb = mbs_config_number(m, instance, "lb", NAN, h);
+  c->alpha = mbs_config_number(m, instance, "alpha", NAN, h);
+  c->kc = mbs_config_number(m, instance, "kc", NAN, h);
+  c->bc = mbs_config_number(m, instance, "bc", NAN, h);
+  c->Pg = mbs_config_number(m, instance, "Pg", NAN, h);
+  c->Pa = mbs_config_number(m, instance, "Pa", NAN, h);
+  c->Ap = mbs_config_number(m, instance, "Ap", NAN, h);
+  c->V0 = mbs_config_number(m, instance, "V0", NAN, h);
+  c->R = mbs_config_number(m, instance, "R_gas", NAN, h);
+  c->T = mbs_config_number(m, instance, "T", NAN, h);
+  c->gamma = mbs_config_number(m, instance, "gamma", NAN, h);
+  c->cd = mbs_config_number(m, instance, "cd", NAN, h);
+  c->Ao = mbs_config_number(m, instance, "Ao", NAN, h);
+  c->r_lam = mbs_config_number(m, instance, "r_laminar", NAN, h);
+  /* the ranges of PantographParams */
+  mbs_config_require(h, c->lb > 0, "lb", c->lb);
+  mbs_config_require(h, c->kc > 0, "kc", c->kc);
+  mbs_config_require(h, c->bc > 0, "bc", c->bc);
+  mbs_config_require(h, c->Pg > 0, "Pg", c->Pg);
+  mbs_config_require(h, c->Pa > 0, "Pa", c->Pa);
+  mbs_config_require(h, c->Ap > 0, "Ap", c->Ap);
+  mbs_config_require(h, c->V0 > 0, "V0", c->V0);
+  mbs_config_require(h, c->R > 0, "R_gas", c->R);
+  mbs_config_require(h, c->T > 0, "T", c->T);
+  mbs_config_require(h, c->gamma > 1 && c->gamma < 2, "gamma", c->gamma);
+  mbs_config_require(h, c->cd > 0 && c->cd <= 1, "cd", c->cd);
+  mbs_config_require(h, c->Ao > 0, "Ao", c->Ao);
+  mbs_config_require(h, c->r_lam > 0.5283 && c->r_lam < 1, "r_laminar", c->r_lam);
   c->actuator = -1;
   for (int i = 0; i < m->nu; i++) {
     if (m->actuator_plugin[i] == instance) c->actuator = i;
   }
-  if (c->actuator < 0 || m->actuator_actnum[c->actuator] != 1 || m->actuator_trntype[c->actuator] != mjTRN_JOINT ||
-      m->jnt_type[m->actuator_trnid[2 * c->actuator]] != mjJNT_HINGE) {
-    bad = 1;
+  int a = c->actuator;
+  if (mbs_config_require(h, a >= 0, "actuator (none uses this instance)", NAN)) {
+    mbs_config_require(h, m->actuator_actnum[a] == 1, "actdim (must be 1)", m->actuator_actnum[a]);
+    mbs_config_require(h, m->actuator_trntype[a] == mjTRN_JOINT && m->jnt_type[m->actuator_trnid[2 * a]] == mjJNT_HINGE,
+                       "transmission (must be the base hinge joint)", NAN);
+    mbs_config_require(h, m->actuator_gear[6 * a] == 1.0, "gear (must be 1)", m->actuator_gear[6 * a]);
   }
-  if (c->nonlinear) {
+  if (h->fault) c->actuator = -1; /* a configured model only */
+  if (c->nonlinear && !h->fault) {
     c->Ps = c->Pg + c->Pa;
     c->gas = c->cd * c->Ao * sqrt(2.0 * c->gamma / (c->R * (c->gamma - 1.0))) / sqrt(c->T);
     double rl = c->r_lam;
     c->dp_lam = c->Ps * (1.0 - rl);
     c->m_lam = c->gas * c->Ps * pow(rl, 1.0 / c->gamma) * sqrt(1.0 - pow(rl, (c->gamma - 1.0) / c->gamma));
-  }
-  d->plugin_data[instance] = (uintptr_t)c;
-  if (bad) {
-    /* reported by the core as a configuration fault at the first step (a plugin cannot raise) */
-    c->h.fault = MBS_FAULT_CONFIG;
-    c->h.fault_time = -1.0; /* at load: survives mj_resetData */
-    c->h.fault_value = NAN;
   }
   return 0;
 }
@@ -86,18 +98,26 @@ static void plugin_destroy(mjData* d, int instance) {
   d->plugin_data[instance] = 0;
 }
 
+/* mj_copyData: the destination keeps its own block (MuJoCo restores dst's plugin_data pointers before calling copy) */
+static void copy_block(mjData* dst, const mjData* src, int instance, size_t size) {
+  void* block = (void*)dst->plugin_data[instance];
+  if (!block) block = malloc(size);
+  if (!block) return;
+  memcpy(block, (const void*)src->plugin_data[instance], size);
+  dst->plugin_data[instance] = (uintptr_t)block;
+}
+
 static void cyl_copy(mjData* dst, const mjModel* m, const mjData* src, int instance) {
-  Cylinder* c = malloc(sizeof(Cylinder));
-  memcpy(c, (const void*)src->plugin_data[instance], sizeof(Cylinder));
-  dst->plugin_data[instance] = (uintptr_t)c;
+  copy_block(dst, src, instance, sizeof(Cylinder));
 }
 
 static void plugin_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
   mbs_plugin_header* h = (mbs_plugin_header*)plugin_data;
-  if (h && h->fault_time >= 0.0) { /* a fault found at load (fault_time < 0) stays */
+  if (h && !h->at_load) { /* a configuration fault stays */
     h->fault = 0;
     h->fault_time = 0.0;
     h->fault_value = 0.0;
+    h->what = NULL;
   }
 }
 
@@ -197,39 +217,39 @@ static int joint_address(const mjModel* m, const char* name, int* qadr, int* vad
 static int elbow_init(const mjModel* m, mjData* d, int instance) {
   Elbow* e = calloc(1, sizeof(Elbow));
   if (!e) return -1;
-  int bad = 0;
-  e->l1 = mbs_config_number(m, instance, "l1", NAN, &bad);
-  e->xf = mbs_config_number(m, instance, "xf", NAN, &bad);
-  e->yf = mbs_config_number(m, instance, "yf", NAN, &bad);
-  e->le = mbs_config_number(m, instance, "le", NAN, &bad);
-  e->theta_e0 = mbs_config_number(m, instance, "theta_e0", NAN, &bad);
-  e->ke = mbs_config_number(m, instance, "ke", NAN, &bad);
-  e->be = mbs_config_number(m, instance, "be", 0.0, &bad);
-  const char* kin = mj_getPluginConfig(m, instance, "kinematics");
-  if (kin && kin[0] && strcmp(kin, "B6") && strcmp(kin, "exact")) bad = 1;
-  e->exact = kin && !strcmp(kin, "exact");
-  if (!joint_address(m, mj_getPluginConfig(m, instance, "joint1"), &e->q1, &e->v1)) bad = 1;
-  if (!joint_address(m, mj_getPluginConfig(m, instance, "joint2"), &e->q2, &e->v2)) bad = 1;
-  double dphi, dl;
-  int geometry = !bad && !chain(e, 0.0, &e->phi1_0, &dphi, &e->lfb0, &dl);
   d->plugin_data[instance] = (uintptr_t)e;
-  if (bad || geometry) {
-    e->h.fault = bad ? MBS_FAULT_CONFIG : MBS_FAULT_GEOMETRY;
-    e->h.fault_time = -1.0; /* at load: survives mj_resetData */
-    e->h.fault_value = bad ? NAN : 0.0;
+  mbs_plugin_header* h = &e->h;
+  e->l1 = mbs_config_number(m, instance, "l1", NAN, h);
+  e->xf = mbs_config_number(m, instance, "xf", NAN, h);
+  e->yf = mbs_config_number(m, instance, "yf", NAN, h);
+  e->le = mbs_config_number(m, instance, "le", NAN, h);
+  e->theta_e0 = mbs_config_number(m, instance, "theta_e0", NAN, h);
+  e->ke = mbs_config_number(m, instance, "ke", NAN, h);
+  e->be = mbs_config_number(m, instance, "be", 0.0, h);
+  mbs_config_require(h, e->l1 > 0, "l1", e->l1);
+  mbs_config_require(h, e->le > 0, "le", e->le);
+  mbs_config_require(h, e->ke >= 0, "ke", e->ke);
+  mbs_config_require(h, e->be >= 0, "be", e->be);
+  const char* kin = mj_getPluginConfig(m, instance, "kinematics");
+  mbs_config_require(h, !kin || !kin[0] || !strcmp(kin, "B6") || !strcmp(kin, "exact"), "kinematics", NAN);
+  e->exact = kin && !strcmp(kin, "exact");
+  mbs_config_require(h, joint_address(m, mj_getPluginConfig(m, instance, "joint1"), &e->q1, &e->v1), "joint1", NAN);
+  mbs_config_require(h, joint_address(m, mj_getPluginConfig(m, instance, "joint2"), &e->q2, &e->v2), "joint2", NAN);
+  double dphi, dl;
+  if (!h->fault && !chain(e, 0.0, &e->phi1_0, &dphi, &e->lfb0, &dl)) {
+    mbs_config_fault(h, "le, xf, yf (the chain base lies inside the pinion circle)", 0.0);
+    h->fault = MBS_FAULT_GEOMETRY;
   }
   return 0;
 }
 
 static void elbow_copy(mjData* dst, const mjModel* m, const mjData* src, int instance) {
-  Elbow* e = malloc(sizeof(Elbow));
-  memcpy(e, (const void*)src->plugin_data[instance], sizeof(Elbow));
-  dst->plugin_data[instance] = (uintptr_t)e;
+  copy_block(dst, src, instance, sizeof(Elbow));
 }
 
 static void elbow_compute(const mjModel* m, mjData* d, int instance, int capability_bit) {
   Elbow* e = (Elbow*)d->plugin_data[instance];
-  if (e->h.fault) return;
+  if (e->h.at_load) return; /* not configured: the core reports it before this force is ever used */
   double q1 = d->qpos[e->q1], q2 = d->qpos[e->q2];
   if (!isfinite(q1) || !isfinite(q2)) {
     mbs_fault(d, instance, MBS_FAULT_NONFINITE, q1);

@@ -117,7 +117,13 @@ def build(force: bool = False) -> Path:
     if out.is_file() and not force:
         return out
     inc, lib = mujoco_dirs()
-    out.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError:  # an unwritable home: the system's temporary directory, per user
+        out = Path(tempfile.gettempdir()) / f"mbsuite-{os.getuid()}" / out.parent.name / LIB_NAME
+        if out.is_file() and not force:
+            return out
+        out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".build-", suffix=".so", dir=out.parent)
     os.close(fd)
     cmd = [*_compiler(), *CFLAGS, f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import SceneError
-from ...results import SimResult
+from ...results import SimResult, assemble
 from ...scenes import Scene
 from .mechanisms import PinocchioMechanism, initial_velocity, mujoco_model, simulate_mujoco
 
@@ -37,9 +37,8 @@ def run(scene: Scene) -> SimResult:
                          rtol=sv.rtol, atol=sv.atol, max_step=sv.max_step)
     sig = {"input_angle": tr.q[:, 0], "input_rate": tr.v[:, 0], "branch_angle": branch_angle(mech, tr.q),
            "energy": tr.energy, "energy_drift": tr.energy - tr.energy[0], "closure_residual": tr.closure}
-    keep = {k: v for k, v in sig.items() if not scene.outputs or k in scene.outputs}
     stats = dict(tr.stats)
     stats.update({"energy_drift_max": float(np.max(np.abs(sig["energy_drift"]))),
                   "closure_residual_max": float(np.max(tr.closure)),
                   "branch_angle_max": float(np.max(np.abs(sig["branch_angle"])))})
-    return SimResult(tr.t, keep, {k: OUTPUTS[k] for k in keep}, sv.engine, stats=stats, scene=scene.to_dict())
+    return assemble(scene, tr.t, sig, engine=sv.engine, stats=stats)

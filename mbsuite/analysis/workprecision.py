@@ -105,6 +105,14 @@ def study_for(scene: Scene, quick: bool = False) -> Study:
     return make(scene, quick=quick)
 
 
+def find_row(report: Report, engine: str, method: str, setting: Any) -> dict:
+    """The one row of a study's report with this engine, method and setting (KeyError if there is not exactly one)."""
+    rows = [r for r in report.data["rows"] if (r["engine"], r["method"], r["setting"]) == (engine, method, setting)]
+    if len(rows) != 1:
+        raise KeyError(f"{len(rows)} rows for {engine} {method} {setting!r}")
+    return rows[0]
+
+
 def cheapest(rows: list[Row], tols=TOLS) -> list[dict]:
     """Per engine/method and overall: the cheapest (median wall time) setting reaching each physics tolerance."""
     ok = [r for r in rows if r.error is None and math.isfinite(r.physics_error)]

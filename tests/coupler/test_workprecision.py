@@ -3,13 +3,8 @@
 from __future__ import annotations
 
 from mbsuite import load_scene
+from mbsuite.analysis.workprecision import find_row as _row
 from mbsuite.analysis.workprecision import workprecision
-
-
-def _row(rep, engine, method, setting):
-    rows = [r for r in rep.data["rows"] if (r["engine"], r["method"], r["setting"]) == (engine, method, setting)]
-    assert len(rows) == 1
-    return rows[0]
 
 
 def test_coupler_fpp_tolerance_and_mujoco_step():

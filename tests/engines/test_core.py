@@ -255,3 +255,13 @@ def test_rollout_reports_a_plugin_fault():
     x0 = get_state(m, d)
     with pytest.raises(SolverError, match=r"effect 'cylinder': absolute cylinder pressure"):
         rollout_sweep(m, x0[None], np.full((1, 10, m.nu), 1.58), workers=1)
+
+
+def test_recorded_times_are_exactly_the_step_grid():
+    """Row times are t0 + k h exactly: MuJoCo's running sum of h drifts off the grid (by ~1e-13 s after 10^4 steps)
+    and would move samples across a window boundary such as t >= t_settle."""
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    d = mujoco.MjData(m)
+    tr = Stepper(m, d, [Channel("q", "qpos")]).run(20_000)
+    assert np.array_equal(tr.t, np.arange(20_001) * m.opt.timestep)
+    assert np.sum(tr.t >= 20.0) == 1 and np.sum(tr.t >= 10.0) == 10_001

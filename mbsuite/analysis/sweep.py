@@ -48,7 +48,7 @@ from typing import Any
 
 import numpy as np
 
-from ..engines.core import n_workers
+from ..engines.core import callbacks_installed, n_workers
 from ..errors import MbsuiteError, SceneError, SolverError
 from ..results import Progress, to_jsonable
 
@@ -221,16 +221,6 @@ def run_sweep(fn: Callable[[Any], Any], points: Sequence[Any], *, workers: int =
 
 
 # ------------------------------------------------------------------------------------------------------ rollout
-def callbacks_installed() -> list[str]:
-    """Names of the MuJoCo callbacks currently installed in this process (any, not only mbsuite's)."""
-    import mujoco
-
-    getters = {"act_dyn": mujoco.get_mjcb_act_dyn, "act_gain": mujoco.get_mjcb_act_gain,
-               "act_bias": mujoco.get_mjcb_act_bias, "passive": mujoco.get_mjcb_passive,
-               "control": mujoco.get_mjcb_control, "sensor": mujoco.get_mjcb_sensor}
-    return sorted(k for k, g in getters.items() if g() is not None)
-
-
 def rollout_sweep(models: Any, initial_states: np.ndarray, controls: np.ndarray, *, workers: int = 0,
                   nstep: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Open-loop trajectories of a batch in MuJoCo's C threads (`mujoco.rollout`), `workers` threads (0 = all cores).

@@ -80,8 +80,13 @@ class NativeHook:
     describe: Callable[[int], str] = field(default=lambda code: f"native stepper error {code}")
 
 
+def callbacks_installed() -> list[str]:
+    """Names of the MuJoCo Python callbacks currently installed in this process (any, not only mbsuite's)."""
+    return sorted(name for name, get in _CALLBACK_GETTERS.items() if get() is not None)
+
+
 def _refuse_python_callbacks(what: str) -> None:
-    installed = [name for name, get in _CALLBACK_GETTERS.items() if get() is not None]
+    installed = callbacks_installed()
     if installed:
         raise SolverError(f"{what}: MuJoCo Python callback(s) {installed} are installed in this process and would act "
                           "on this run as well (they are process-global); remove them first")

@@ -17,6 +17,7 @@ from .errors import (  # noqa: E402
     SceneError,
     SolverError,
 )
+from .health import AccuracyError, judge  # noqa: E402
 from .registry import get_model, models  # noqa: E402
 from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
 
@@ -30,10 +31,14 @@ def run(scene: Scene | str, engine: str | None = None):
         raise SceneError(f"model '{spec.name}' has no time simulation")
     if engine is not None:
         scene = scene.replace(solver={"engine": engine})
-    return spec.run(scene)
+    res = spec.run(scene)
+    res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate,
+                              what=f"{spec.name} scene {scene.name or scene.source or ''}".strip()))
+    return res
 
 
 __all__ = [
+    "AccuracyError",
     "GeometryError",
     "MbsuiteError",
     "ModelFileError",

@@ -59,7 +59,7 @@ class ModelSpec:
     summary: str
     params_cls: type
     effects: Mapping[str, Effect]
-    inputs: Mapping[str, Mapping[str, str]]  # input type -> {key: doc}
+    inputs: Mapping[str, Mapping[str, Any]]  # input type -> {key: mbsuite.limits.Limit (range, unit, doc, default)}
     outputs: Mapping[str, str]  # signal -> SI unit
     engines: tuple[str, ...]
     scenes_dir: Path

@@ -30,6 +30,8 @@ class SimResult:
     events: list[dict[str, Any]] = field(default_factory=list)
     stats: dict[str, Any] = field(default_factory=dict)
     scene: dict[str, Any] = field(default_factory=dict)
+    health: list[Any] = field(default_factory=list)  # mbsuite.health.Figure: the run's own accuracy figures
+    warnings: list[str] = field(default_factory=list)  # accepted health violations (allow_inaccurate), loud
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]
@@ -42,6 +44,9 @@ class SimResult:
         }
         out["events"] = self.events
         out["stats"] = self.stats
+        out["health"] = [f.to_dict() for f in self.health]
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
         return out
 
     def write_csv(self, path: str | Path) -> Path:
@@ -58,13 +63,18 @@ class SimResult:
             for e in self.events:
                 kinds[e.get("kind", "event")] = kinds.get(e.get("kind", "event"), 0) + 1
             table += "\nevents: " + ", ".join(f"{k} x{n}" for k, n in sorted(kinds.items()))
-        table += f"\nengine {self.engine}; " + ", ".join(f"{k} = {v}" for k, v in self.stats.items())
+        table += f"\nengine {self.engine}; " + ", ".join(f"{k} = {_plain(v)}" for k, v in self.stats.items())
+        if self.health:
+            table += "\nhealth: " + ", ".join(
+                f"{f.name} {f.value:.3g} (bound {f.bound:.3g}{'' if f.ok else ', EXCEEDED'})" for f in self.health)
+        for w in self.warnings:
+            table += f"\n{w}"
         return Report(self.summary(), table, lambda out: [self.write_csv(Path(out) / "run.csv")])
 
 
 def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, engine: str,
              events: Sequence[dict[str, Any]] = (), stats: Mapping[str, Any] | None = None,
-             always: Sequence[str] = ()) -> SimResult:
+             always: Sequence[str] = (), health: Sequence[Any] = ()) -> SimResult:
     """The one place that turns a model's signals into a `SimResult`: keeps the signals the scene asks for (its
     `outputs`; all when it names none) plus `always`, takes their units from the model's declared output table
     (`scene.spec.outputs`, SI) and attaches the scene. A signal missing from the table is an error, not a unitless
@@ -76,7 +86,16 @@ def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, en
     if missing:
         raise KeyError(f"model '{scene.model}' declares no unit for signal(s) {missing}; add them to its outputs")
     return SimResult(np.asarray(t), keep, {k: table[k] for k in keep}, engine, events=list(events),
-                     stats=dict(stats or {}), scene=scene.to_dict())
+                     stats=dict(stats or {}), scene=scene.to_dict(), health=list(health))
+
+
+def _plain(v: Any) -> str:
+    """A stats value for a table: numpy scalars as plain numbers, floats to 6 significant digits."""
+    if isinstance(v, np.generic):
+        v = v.item()
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
 
 
 def write_csv(path: str | Path, columns: Sequence[tuple[str, str, Any]]) -> Path:

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import SceneError
+from .limits import Limit
 from .registry import ModelSpec, get_model, models
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver")
@@ -58,6 +59,7 @@ class SolverSettings:
     duration: float = 10.0
     t_settle: float = 0.0
     sample_dt: float = 0.0  # output sampling interval; 0 = every step (MuJoCo) / solver's dense output at timestep
+    allow_inaccurate: bool = False  # keep a result whose health figures exceed their bounds (with a loud warning)
 
     def check(self, engines: tuple[str, ...]) -> None:
         if self.engine not in engines:
@@ -181,6 +183,13 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
                 f"unknown input key(s) {bad} for input type {itype!r}{where}; valid keys: {sorted(spec.inputs[itype])}"
             )
         inp["type"] = itype
+        for key, decl in spec.inputs[itype].items():
+            if not isinstance(decl, Limit):
+                continue
+            if key in inp:
+                inp[key] = decl.check(f"input.{key}{where}", inp[key], SceneError)
+            elif decl.has_default:
+                inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
 
     outputs = data.get("outputs") or {}
     if isinstance(outputs, Mapping):

@@ -1,0 +1,140 @@
+"""Valid ranges declared beside each value: one `Limit` per parameter field, scene input key and CLI number.
+
+A parameter dataclass declares its fields with `param(default, lo=..., hi=..., unit=..., doc=...)`; its
+`__post_init__` calls `check_fields(self, "pantograph parameter")`. Scene input keys are declared the same way
+(`Limit(...)` in `ModelSpec.inputs`). The scene validator, the error messages and the docs (`limits_table`) all read the
+same declaration, so a range is written once.
+
+Numbers must be finite real numbers (bools are not numbers here); a range end may be open or closed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from .errors import ParameterError
+
+_NO_DEFAULT = object()
+
+
+@dataclass(frozen=True)
+class Limit:
+    """The valid values of one number or word.
+
+    - `kind`: `float` (any finite real), `int` (an integral number) or `str` (one of `choices`);
+    - `lo`, `hi`: range ends (None: unbounded), open when `lo_open` / `hi_open`;
+    - `choices`: allowed values for `str` (or a fixed set of numbers);
+    - `unit`: SI unit, `doc`: one line; `default`: the value used when a scene omits the key (shown in outputs).
+    """
+
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    unit: str = ""
+    doc: str = ""
+    kind: type = float
+    choices: tuple[Any, ...] | None = None
+    default: Any = _NO_DEFAULT
+
+    @property
+    def has_default(self) -> bool:
+        return self.default is not _NO_DEFAULT
+
+    def describe(self) -> str:
+        """The valid range in words, e.g. `(0, inf) m` or `one of ['equilibrium', 'fortran']`."""
+        if self.choices is not None:
+            return f"one of {list(self.choices)}"
+        lo = "-inf" if self.lo is None else f"{self.lo:g}"
+        hi = "inf" if self.hi is None else f"{self.hi:g}"
+        left = "(" if (self.lo is None or self.lo_open) else "["
+        right = ")" if (self.hi is None or self.hi_open) else "]"
+        kind = "integer in " if self.kind is int else ""
+        return f"{kind}{left}{lo}, {hi}{right}" + (f" {self.unit}" if self.unit else "")
+
+    def check(self, name: str, value: Any, error: type[Exception] = ParameterError) -> Any:
+        """Return `value` (as float/int/str) if valid, else raise `error` naming `name`, the value and the range."""
+        bad = f"{name} = {value!r} is invalid; valid: {self.describe()}"
+        if self.kind is str or (self.choices is not None and all(isinstance(c, str) for c in self.choices)):
+            if not isinstance(value, str) or (self.choices is not None and value not in self.choices):
+                raise error(bad)
+            return value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise error(f"{name} = {value!r} is not a number; valid: {self.describe()}")
+        if not math.isfinite(value):
+            raise error(bad)
+        if self.kind is int:
+            if float(value) != int(value):
+                raise error(bad)
+            value = int(value)
+        else:
+            value = float(value)
+        if self.choices is not None and value not in self.choices:
+            raise error(bad)
+        if self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo)):
+            raise error(bad)
+        if self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi)):
+            raise error(bad)
+        return value
+
+
+def positive(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) -> Limit:
+    """A number > 0 (optionally <= hi)."""
+    return Limit(lo=0.0, lo_open=True, hi=hi, unit=unit, doc=doc, **kw)
+
+
+def non_negative(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) -> Limit:
+    """A number >= 0 (optionally <= hi)."""
+    return Limit(lo=0.0, hi=hi, unit=unit, doc=doc, **kw)
+
+
+def param(default: Any, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
+          hi_open: bool = False, unit: str = "", doc: str = "", kind: type = float,
+          choices: tuple[Any, ...] | None = None) -> Any:
+    """A dataclass field with its valid range: `l1: float = param(1.95, lo=0, lo_open=True, unit="m", doc=...)`."""
+    lim = Limit(lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, unit=unit, doc=doc, kind=kind, choices=choices,
+                default=default)
+    if isinstance(default, list | dict | set):
+        raise TypeError("param() defaults must be immutable")
+    return dataclasses.field(default=default, metadata={"limit": lim})
+
+
+def limit_of(cls_or_obj: Any, name: str) -> Limit | None:
+    """The declared `Limit` of dataclass field `name` (None if the field declares none)."""
+    for f in dataclasses.fields(cls_or_obj):
+        if f.name == name:
+            return f.metadata.get("limit")
+    raise KeyError(name)
+
+
+def check_fields(obj: Any, owner: str, error: type[Exception] = ParameterError) -> None:
+    """Check every field of dataclass instance `obj` that declares a `Limit`; coerce ints to floats where the field
+    is a float (frozen dataclasses are updated with `object.__setattr__`). Errors read `<owner> <field> = ...`."""
+    for f in dataclasses.fields(obj):
+        lim = f.metadata.get("limit")
+        if lim is None:
+            continue
+        v = lim.check(f"{owner} {f.name}", getattr(obj, f.name), error)
+        if v is not getattr(obj, f.name):
+            object.__setattr__(obj, f.name, v)
+
+
+def limits_table(cls: Any) -> list[tuple[str, str, str, str, str]]:
+    """Rows (name, default, valid range, unit, doc) of every declared field: for docs and `mbsuite list --params`."""
+    rows = []
+    for f in dataclasses.fields(cls):
+        lim = f.metadata.get("limit")
+        if lim is None:
+            continue
+        default = f.default if f.default is not dataclasses.MISSING else ""
+        rows.append((f.name, repr(default), lim.describe(), lim.unit, lim.doc))
+    return rows
+
+
+def undeclared(cls: Any) -> Iterable[str]:
+    """Fields of `cls` that declare no `Limit` (a test asserts every model declares all)."""
+    return [f.name for f in dataclasses.fields(cls) if "limit" not in f.metadata]

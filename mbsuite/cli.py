@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -20,8 +21,9 @@ import numpy as np
 from . import registry
 from .analysis.sweep import EXECUTORS, sweep_options
 from .errors import MbsuiteError
+from .limits import Limit
 from .results import Report, SimResult, format_table, to_jsonable
-from .scenes import load_scene
+from .scenes import DEFAULT_MAX_STEPS, load_scene
 
 
 def _emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> None:
@@ -151,7 +153,7 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
     from .analysis.sweep import run_sweep, scene_point
     from .results import write_csv
 
-    scene = load_scene(args.scene)
+    scene = _load(args)
     axes = []
     for spec in args.vary or []:
         key, sep, vals = spec.partition("=")
@@ -201,18 +203,63 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
     _emit(Report(data, table, write), args, scene.to_dict())
 
 
+def _scene_opts(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--allow-inaccurate", action="store_true",
+                   help="keep a result whose health figures exceed their bounds (with a loud warning) instead of an "
+                        "error")
+    p.add_argument("--max-steps", type=float, metavar="N",
+                   help=f"size guard: most steps a run may take (default {DEFAULT_MAX_STEPS:.0e})")
+
+
+def _load(args: argparse.Namespace):
+    """The command's scene with the command-line solver overrides applied (and validated)."""
+    scene = load_scene(args.scene)
+    solver: dict = {}
+    if getattr(args, "engine", None):
+        solver["engine"] = args.engine
+    if getattr(args, "allow_inaccurate", False):
+        solver["allow_inaccurate"] = True
+    if getattr(args, "max_steps", None) is not None:
+        solver["max_steps"] = args.max_steps
+    return scene.replace(solver=solver) if solver else scene
+
+
+FREQ_LIMITS = {
+    "--f-min": Limit(lo=1e-3, hi=1e3, unit="Hz"),
+    "--f-max": Limit(lo=1e-3, hi=1e3, unit="Hz"),
+    "--df": Limit(lo=1e-3, hi=1e3, unit="Hz"),
+}
+MAX_FREQUENCIES = 2000
+
+
+def _freq_args(args: argparse.Namespace) -> dict:
+    f_min, f_max, df = (lim.check(flag, getattr(args, flag[2:].replace("-", "_")), MbsuiteError)
+                        for flag, lim in FREQ_LIMITS.items())
+    if f_max < f_min:
+        raise MbsuiteError(f"--f-max {f_max:g} Hz is below --f-min {f_min:g} Hz")
+    n = int((f_max - f_min) / df) + 1
+    if n > MAX_FREQUENCIES:
+        raise MbsuiteError(f"--f-min/--f-max/--df give {n} frequencies; at most {MAX_FREQUENCIES} (enlarge --df)")
+    methods = [m for m in args.methods.split(",") if m]
+    bad = sorted(set(methods) - {"linear", "mujoco", "reference"})
+    if bad or not methods:
+        raise MbsuiteError(f"--methods {args.methods!r}: valid methods are linear, mujoco, reference")
+    if args.workers < 0:
+        raise MbsuiteError(f"--workers {args.workers} must be >= 0 (0: all cores)")
+    return {"f_min": f_min, "f_max": f_max, "df": df, "methods": args.methods, "workers": args.workers}
+
+
 def _hook_command(hook: str):
     def run(args: argparse.Namespace) -> None:
-        scene = load_scene(args.scene)
-        if getattr(args, "engine", None):
-            scene = scene.replace(solver={"engine": args.engine})
+        from . import run as run_scene
+
+        scene = _load(args)
         fn = getattr(scene.spec, hook)
         if fn is None:
             raise MbsuiteError(f"model '{scene.model}' does not support '{hook}'")
-        kwargs = {}
-        if hook == "freqresp":
-            kwargs = {"f_min": args.f_min, "f_max": args.f_max, "df": args.df, "methods": args.methods,
-                      "workers": args.workers}
+        kwargs = _freq_args(args) if hook == "freqresp" else {}
+        if hook == "run":
+            fn = run_scene  # judges the run's health figures
         with _sweeping(args):
             report = fn(scene, **kwargs)
         if isinstance(report, SimResult):
@@ -223,7 +270,10 @@ def _hook_command(hook: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     ap = argparse.ArgumentParser(prog="mbsuite", description=__doc__.splitlines()[0])
+    ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("list", help="models and their shipped scenes")
@@ -239,6 +289,8 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(hook, help=helptext)
         p.add_argument("scene", help="scene TOML path, model name (default scene) or model/scene")
         _common(p)
+        if hook in ("run", "freqresp"):
+            _scene_opts(p)
         if hook == "run":
             p.add_argument("--engine", choices=["mujoco", "reference"], help="override the scene's engine")
         if hook == "freqresp":
@@ -259,6 +311,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
     p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
     _sweep_args(p)
+    _scene_opts(p)
     _common(p)
     p.set_defaults(func=_cmd_sweep)
 
@@ -289,14 +342,76 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    ap = build_parser()
-    args = ap.parse_args(argv)
+def _fail(message: str, as_json: bool, kind: str) -> int:
+    """One line on stderr (and, under --json, a JSON object on stdout); exit status 2."""
+    if as_json:
+        print(json.dumps({"error": {"type": kind, "message": message}}))
+    print(f"mbsuite: error: {message}", file=sys.stderr)
+    return 2
+
+
+def _check_out(out: str | None) -> None:
+    """`--out DIR` must be a directory we can write, checked before any work is done."""
+    if not out:
+        return
+    path = Path(out)
+    if path.exists() and not path.is_dir():
+        raise MbsuiteError(f"--out {out}: exists and is not a directory")
     try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".mbsuite-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise MbsuiteError(f"--out {out}: cannot write there ({exc.strerror or exc})") from exc
+
+
+def _quiet_stdout() -> None:
+    """After a closed pipe: send the rest of stdout to /dev/null so the interpreter's final flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line. Exit status: 0 success, 2 any error (one line naming the input; under --json also a JSON
+    object `{"error": {...}}` on stdout), 130 interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
+    ap = build_parser()
+    try:
+        args = ap.parse_args(argv)
+    except SystemExit as exc:  # argparse: usage errors exit 2, --help / --version exit 0
+        return int(exc.code or 0)
+    as_json = bool(getattr(args, "json", False))
+    try:
+        _check_out(getattr(args, "out", None))
         args.func(args)
     except MbsuiteError as exc:
-        print(f"mbsuite: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(str(exc), as_json, type(exc).__name__)
+    except KeyboardInterrupt:
+        store = getattr(args, "store", None)
+        saved = f"finished points are kept in {store} (rerun the command to resume)" if store else "nothing was saved"
+        print(f"mbsuite: interrupted; {saved}", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        _quiet_stdout()
+        return 0
+    except MemoryError:
+        return _fail("out of memory: the job is too large for this machine; make it smaller (fewer points, shorter "
+                     "run, larger step)", as_json, "MemoryError")
+    except OSError as exc:
+        name = f" {exc.filename}" if exc.filename else ""
+        return _fail(f"cannot access{name}: {exc.strerror or exc}", as_json, "OSError")
+    except Exception as exc:  # a defect in mbsuite: still one line, the traceback on request
+        if os.environ.get("MBSUITE_DEBUG"):
+            raise
+        return _fail(f"internal error ({type(exc).__name__}: {exc}); this is a bug in mbsuite, please report it with "
+                     "the command line (MBSUITE_DEBUG=1 prints the traceback)", as_json, "InternalError")
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_stdout()
     return 0
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -42,12 +43,17 @@ from .registry import ModelSpec, get_model, models
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver")
 INTEGRATORS = ("euler", "implicit", "implicitfast", "rk4", "discrete")
 SCIPY_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+MAX_SCENE_BYTES = 1_000_000
+DEFAULT_MAX_STEPS = 5e7  # size guard; a scene or --max-steps may raise it
 
 
 @dataclass(frozen=True)
 class SolverSettings:
     """Solver settings. MuJoCo uses `integrator` and `timestep`; the reference path uses `method`, `rtol`, `atol`,
-    `max_step`. `duration` is the simulated time (s); `t_settle` the part of it treated as start-up transient."""
+    `max_step`. `duration` is the simulated time (s); `t_settle` the part of it treated as start-up transient.
+    `max_steps` guards against a legal but enormous job (duration / timestep steps, also the sample count): raise it
+    deliberately for a long run. `allow_inaccurate` keeps a result whose health figures exceed their bounds, with a
+    loud warning in the result (default: such a run is an error)."""
 
     engine: str = "mujoco"
     integrator: str = "implicitfast"
@@ -59,26 +65,52 @@ class SolverSettings:
     duration: float = 10.0
     t_settle: float = 0.0
     sample_dt: float = 0.0  # output sampling interval; 0 = every step (MuJoCo) / solver's dense output at timestep
-    allow_inaccurate: bool = False  # keep a result whose health figures exceed their bounds (with a loud warning)
+    allow_inaccurate: bool = False
+    max_steps: float = DEFAULT_MAX_STEPS
 
     def check(self, engines: tuple[str, ...]) -> None:
+        for name in ("engine", "integrator", "method"):
+            v = getattr(self, name)
+            if not isinstance(v, str):
+                raise SceneError(f"solver.{name} = {v!r} must be a string")
         if self.engine not in engines:
             raise SceneError(f"solver.engine = {self.engine!r} is not available; valid engines: {list(engines)}")
         if self.integrator not in INTEGRATORS:
             raise SceneError(f"solver.integrator = {self.integrator!r}; valid integrators: {list(INTEGRATORS)}")
         if self.method not in SCIPY_METHODS:
             raise SceneError(f"solver.method = {self.method!r}; valid methods: {list(SCIPY_METHODS)}")
-        for name in ("timestep", "rtol", "atol", "duration"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and v > 0):
-                raise SceneError(f"solver.{name} must be a positive number, got {v!r}")
-        for name in ("max_step", "t_settle", "sample_dt"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and v >= 0):
-                raise SceneError(f"solver.{name} must be a non-negative number, got {v!r}")
+        if not isinstance(self.allow_inaccurate, bool):
+            raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r} must be true or false")
+        for name, lim in SOLVER_LIMITS.items():
+            lim.check(f"solver.{name}", getattr(self, name), SceneError)
         if self.t_settle >= self.duration:
             raise SceneError(
                 f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
+        if self.timestep >= self.duration:
+            raise SceneError(f"solver.timestep ({self.timestep} s) must be shorter than solver.duration "
+                             f"({self.duration} s)")
+        steps = self.duration / self.timestep
+        if steps > self.max_steps:
+            raise SceneError(
+                f"solver.duration / solver.timestep = {self.duration:g} s / {self.timestep:g} s = {steps:.3g} steps "
+                f"exceeds solver.max_steps = {self.max_steps:.3g}; shorten the run, enlarge the step, or raise "
+                "solver.max_steps (CLI: --max-steps) if you mean it")
+        if self.sample_dt > 0 and self.sample_dt > self.duration:
+            raise SceneError(f"solver.sample_dt ({self.sample_dt} s) must not exceed solver.duration "
+                             f"({self.duration} s)")
+
+
+# the valid range of every numeric solver setting (the error message and the docs read this table)
+SOLVER_LIMITS = {
+    "timestep": Limit(lo=0.0, lo_open=True, hi=1.0, unit="s", doc="MuJoCo step / output grid of the reference path"),
+    "rtol": Limit(lo=1e-14, hi=0.1, doc="relative tolerance of the reference path"),
+    "atol": Limit(lo=0.0, lo_open=True, hi=1.0, doc="absolute tolerance of the reference path"),
+    "max_step": Limit(lo=0.0, hi=1.0, unit="s", doc="largest step of the reference path (0: unlimited)"),
+    "duration": Limit(lo=0.0, lo_open=True, hi=1e5, unit="s", doc="simulated time"),
+    "t_settle": Limit(lo=0.0, hi=1e5, unit="s", doc="start-up transient left out of statistics"),
+    "sample_dt": Limit(lo=0.0, hi=1e5, unit="s", doc="output sampling interval (0: every step)"),
+    "max_steps": Limit(lo=1.0, hi=1e12, doc="size guard: most steps (and samples) a run may take"),
+}
 
 
 SOLVER_KEYS = tuple(f.name for f in dataclasses.fields(SolverSettings))
@@ -146,7 +178,17 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     data = copy.deepcopy(dict(data))
     if "model" not in data:
         raise SceneError(f"scene{where} does not name a model; valid models: {sorted(models())}")
+    if not isinstance(data["model"], str):
+        raise SceneError(f"model = {data['model']!r}{where} must be a model name; valid models: {sorted(models())}")
     spec = get_model(data["model"])
+    for key in ("name", "description"):
+        if key in data and not isinstance(data[key], str):
+            raise SceneError(f"{key} = {data[key]!r}{where} must be a string")
+    for key in ("effects", "params", "input", "solver", *spec.sections):
+        if key in data and not isinstance(data[key], Mapping):
+            raise SceneError(f"{key} = {data[key]!r}{where} must be a table ([{key}] section with key = value lines)")
+    if "outputs" in data and not isinstance(data["outputs"], Mapping | list | tuple):
+        raise SceneError(f"outputs = {data['outputs']!r}{where} must be a table with signals = [...]")
     unknown = sorted(set(data) - set(TOP_KEYS) - set(spec.sections))
     if unknown:
         raise SceneError(f"unknown scene key(s) {unknown}{where}; valid keys: {[*TOP_KEYS, *spec.sections]}")
@@ -171,11 +213,13 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     for k, v in params.items():
         if isinstance(v, bool) or not isinstance(v, int | float | str | list):
             raise SceneError(f"parameter {k!r}{where} must be a number (SI units), got {v!r}")
+        if isinstance(v, float) and not math.isfinite(v):
+            raise SceneError(f"parameter {k} = {v!r}{where} must be a finite number (SI units)")
 
     inp = dict(data.get("input") or {})
     if spec.inputs:
         itype = inp.get("type", next(iter(spec.inputs)))
-        if itype not in spec.inputs:
+        if not isinstance(itype, str) or itype not in spec.inputs:
             raise SceneError(f"input type {itype!r}{where} unknown for '{spec.name}'; valid types: {list(spec.inputs)}")
         bad = sorted(set(inp) - set(spec.inputs[itype]) - {"type"})
         if bad:
@@ -190,15 +234,25 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
                 inp[key] = decl.check(f"input.{key}{where}", inp[key], SceneError)
             elif decl.has_default:
                 inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
+    for key, v in inp.items():  # keys without a declared Limit: at least finite, never a nested table
+        if isinstance(v, float) and not math.isfinite(v):
+            raise SceneError(f"input.{key} = {v!r}{where} must be a finite number")
+        if isinstance(v, Mapping):
+            raise SceneError(f"input.{key}{where} must be a value, not a table")
 
     outputs = data.get("outputs") or {}
     if isinstance(outputs, Mapping):
         bad = sorted(set(outputs) - {"signals"})
         if bad:
             raise SceneError(f"unknown key(s) {bad} in [outputs]{where}; valid keys: ['signals']")
-        signals = tuple(outputs.get("signals", tuple(spec.outputs)))
+        signals = outputs.get("signals", tuple(spec.outputs))
     else:
-        signals = tuple(outputs)
+        signals = outputs
+    if isinstance(signals, str) or not isinstance(signals, list | tuple) or not all(
+            isinstance(x, str) for x in signals):
+        raise SceneError(f"outputs.signals = {signals!r}{where} must be a list of signal names; valid signals: "
+                         f"{list(spec.outputs)}")
+    signals = tuple(signals)
     bad = [s for s in signals if s not in spec.outputs]
     if bad:
         raise SceneError(f"unknown output signal(s) {bad}{where}; valid signals: {list(spec.outputs)}")
@@ -208,7 +262,10 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     if bad:
         raise SceneError(f"unknown solver key(s) {bad}{where}; valid keys: {list(SOLVER_KEYS)}")
     defaults = spec.extra.get("solver_defaults", {})
-    solver = SolverSettings(**{**defaults, **solver_in})
+    try:
+        solver = SolverSettings(**{**defaults, **solver_in})
+    except TypeError as exc:
+        raise SceneError(f"[solver]{where}: {exc}") from exc
     solver.check(spec.engines)
 
     scene = Scene(
@@ -234,7 +291,17 @@ def load_scene(ref: str | Path) -> Scene:
         if not p.is_file():
             raise SceneError(f"scene file not found: {p}")
         try:
-            data = tomllib.loads(p.read_text())
+            raw = p.read_bytes()
+        except OSError as exc:
+            raise SceneError(f"cannot read scene file {p}: {exc.strerror or exc}") from exc
+        if len(raw) > MAX_SCENE_BYTES:
+            raise SceneError(f"scene file {p} is {len(raw)} bytes; a scene is at most {MAX_SCENE_BYTES} bytes")
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise SceneError(f"scene file {p} is not UTF-8 text (byte {exc.start}): TOML files are UTF-8") from exc
+        try:
+            data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise SceneError(f"scene file {p} is not valid TOML: {exc}") from exc
         data.setdefault("name", p.stem)

@@ -1,0 +1,365 @@
+"""No silent garbage, no traceback: bad scene files, bad values and bad command lines end in exit 2 with one line that
+names the bad input; legal but enormous jobs are refused before they start; Ctrl-C and a closed pipe end cleanly.
+
+The scene schema is checked three ways: every declared limit of every model is attacked with the values that break
+it (NaN, ±inf, a string, a bool, just outside each end); hypothesis draws arbitrary scene tables and asserts that the
+loader answers with a Scene or an mbsuite error, never anything else; and every shipped scene is run through
+`mbsuite run` with one mutated value, asserting exit 0 with finite output or exit 2 with a message.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import hypothesis.strategies as st
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+import mbsuite
+from mbsuite import registry
+from mbsuite.cli import main
+from mbsuite.errors import MbsuiteError, SceneError
+from mbsuite.limits import Limit
+from mbsuite.scenes import SOLVER_LIMITS, load_scene, scene_from_dict
+
+MODELS = sorted(registry.models())
+
+
+def _run_cli(argv: list[str], capsys) -> tuple[int, str, str]:
+    rc = main(argv)
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+def _write(tmp_path: Path, text: str | bytes, name: str = "scene.toml") -> str:
+    p = tmp_path / name
+    if isinstance(text, bytes):
+        p.write_bytes(text)
+    else:
+        p.write_text(text)
+    return str(p)
+
+
+# --- regressions: each ended in a traceback, NaN or a silently accepted value -----------------------------------
+
+BAD_FILES = [
+    (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "not UTF-8"),
+    ("model = \"pantograph\"\nname = \"K\xf6ln\"\n".encode("latin-1"), "not UTF-8"),
+    (b'model = ["pantograph"]\n', "model = ['pantograph']"),
+    (b'model = "pantograph"\nparams = 5\n', "params = 5"),
+    (b'model = "pantograph"\ninput = "sine"\n', "input = 'sine'"),
+    (b'model = "pantograph"\n[input]\nfrequency = "abc"\n', "input.frequency"),
+    (b'model = "pantograph"\n[input]\ntype = "step"\nheight = nan\n', "input.height"),
+    (b'model = "iftomm"\n[input]\nrate = nan\n', "input.rate"),
+    (b'model = "pantograph"\n[solver]\ntimestep = inf\n', "solver.timestep"),
+    (b'model = "pantograph"\n[solver]\nduration = inf\n', "solver.duration"),
+    (b'model = "pantograph"\n[solver]\nduration = 1e12\n', "solver.duration"),
+    (b'model = "pantograph"\n[solver]\nsample_dt = inf\n', "solver.sample_dt"),
+    (b'model = "pantograph"\n[solver]\ntimestep = 1e-9\nt_settle = 0.0\n', "solver.max_steps"),
+    (b'model = "pantograph"\n[solver]\nallow_inaccurate = 1\n', "solver.allow_inaccurate"),
+    (b'model = "pantograph"\n[outputs]\nsignals = "F1"\n', "outputs.signals"),
+    (b'model = "pantograph"\n[solver]\nintegrator = 4\n', "solver.integrator"),
+    (b'model = "pantograph"\n[params]\nm1 = nan\n', "m1"),
+    (b'model = "pantograph"\n[effects]\ncoulomb = 1\n', "coulomb"),
+    (b'model = "nosuch"\n', "nosuch"),
+    (b'model = "pantograph"\n[solver\n', "not valid TOML"),
+]
+
+
+@pytest.mark.parametrize(("text", "named"), BAD_FILES, ids=[b[1] for b in BAD_FILES])
+def test_bad_scene_file_is_one_line_naming_the_input(tmp_path, capsys, text, named):
+    rc, out, err = _run_cli(["run", _write(tmp_path, text)], capsys)
+    assert rc == 2 and out == ""
+    assert err.startswith("mbsuite: error: ") and err.count("\n") == 1, err
+    assert named in err and "Traceback" not in err
+
+
+def test_json_error_is_an_object_on_stdout(tmp_path, capsys):
+    rc, out, err = _run_cli(["run", _write(tmp_path, b'model = "pantograph"\n[solver]\ntimestep = -1\n'), "--json"],
+                            capsys)
+    assert rc == 2
+    error = json.loads(out)["error"]
+    assert error["type"] == "SceneError" and "solver.timestep" in error["message"]
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["freqresp", "pantograph", "--f-max", "inf"], "--f-max"),
+    (["freqresp", "pantograph", "--df", "1e-9"], "--df"),
+    (["freqresp", "pantograph", "--f-min", "10", "--f-max", "5"], "--f-max"),
+    (["freqresp", "pantograph", "--methods", "fem"], "--methods"),
+    (["freqresp", "pantograph", "--workers", "-3"], "--workers"),
+    (["run", "pantograph", "--max-steps", "10"], "max_steps"),
+    (["run", "pantograph/nosuch"], "nosuch"),
+    (["sweep", "iftomm/fourbar", "--vary", "input.rate"], "--vary"),
+    (["sweep", "iftomm/fourbar", "--vary", "nosection.rate=1,2"], "--vary"),
+])
+def test_bad_command_line_names_the_argument(capsys, argv, named):
+    rc, _, err = _run_cli(argv, capsys)
+    assert rc == 2 and named in err and "Traceback" not in err
+
+
+def test_out_must_be_a_writable_directory(tmp_path, capsys):
+    f = tmp_path / "file.csv"
+    f.write_text("x")
+    rc, _, err = _run_cli(["run", "iftomm/fourbar", "--out", str(f)], capsys)
+    assert rc == 2 and "--out" in err and "not a directory" in err
+    rc, _, err = _run_cli(["run", "iftomm/fourbar", "--out", str(f / "sub")], capsys)
+    assert rc == 2 and "--out" in err and "cannot write" in err
+
+
+def test_ctrl_c_exits_130_and_says_what_was_saved(monkeypatch, capsys):
+    import mbsuite.cli as cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_cmd_list", interrupted)
+    rc, _, err = _run_cli(["list"], capsys)
+    assert rc == 130 and "interrupted" in err and "nothing was saved" in err and "Traceback" not in err
+
+
+def test_internal_error_is_one_line_not_a_traceback(monkeypatch, capsys):
+    import mbsuite.cli as cli
+
+    def broken(args):
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.setattr(cli, "_cmd_list", broken)
+    monkeypatch.delenv("MBSUITE_DEBUG", raising=False)
+    rc, _, err = _run_cli(["list"], capsys)
+    assert rc == 2 and "internal error" in err and "ZeroDivisionError" in err and "Traceback" not in err
+
+
+def test_closed_pipe_is_quiet():
+    proc = subprocess.run(f"'{sys.executable}' -m mbsuite.cli list --json | head -c 10", shell=True,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.stdout == '{\n  "caten'[:10]
+    assert proc.stderr == "", proc.stderr
+
+
+def test_version(capsys):
+    rc, out, _ = _run_cli(["--version"], capsys)
+    assert rc == 0 and out.strip() == f"mbsuite {mbsuite.__version__}"
+
+
+# --- every declared limit of every model, attacked at its edges --------------------------------------------------
+
+def _breakers(lim: Limit) -> list:
+    """Values outside `lim`: non-numbers, non-finite numbers, and just past each finite end."""
+    if lim.choices is not None and all(isinstance(c, str) for c in lim.choices):
+        return [1.0, "not-a-choice", True]
+    vals: list = [math.nan, math.inf, -math.inf, "abc", True, [1.0]]
+    for end, sign, is_open in ((lim.lo, -1.0, lim.lo_open), (lim.hi, 1.0, lim.hi_open)):
+        if end is None:
+            continue
+        vals.append(end if is_open else end + sign * max(abs(end) * 1e-6, 1e-12))
+    if lim.kind is int:
+        vals.append(0.5 + (lim.lo or 0.0))
+    return vals
+
+
+def _declared(spec) -> list[tuple[str, str, Limit]]:
+    """(section, key, limit) of every declared limit of a model's scene: params, input keys, solver settings."""
+    out = [("params", f.name, f.metadata["limit"]) for f in dataclasses.fields(spec.params_cls)
+           if "limit" in f.metadata]
+    scene = load_scene(spec.name)
+    itype = scene.input.get("type")
+    for key, decl in (spec.inputs.get(itype, {}) if itype else {}).items():
+        if isinstance(decl, Limit):
+            out.append(("input", key, decl))
+    out += [("solver", k, lim) for k, lim in SOLVER_LIMITS.items()]
+    return out
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_every_declared_limit_rejects_what_breaks_it(model):
+    spec = registry.get_model(model)
+    base = load_scene(model).to_dict()
+    checked = 0
+    for section, key, lim in _declared(spec):
+        for bad in _breakers(lim):
+            d = copy.deepcopy(base)
+            d.setdefault(section, {})[key] = bad
+            with pytest.raises(MbsuiteError) as exc:
+                scene_from_dict(d)
+            msg = str(exc.value)
+            assert key in msg, f"{section}.{key} = {bad!r}: the error does not name it: {msg}"
+            checked += 1
+    assert checked >= 8 * len(SOLVER_LIMITS)
+
+
+# --- hypothesis: arbitrary tables never get past the loader as anything but a Scene or an mbsuite error ------------
+
+_scalars = st.one_of(st.none(), st.booleans(), st.integers(-10**12, 10**12), st.floats(allow_nan=True),
+                     st.text(max_size=12))
+_values = st.one_of(_scalars, st.lists(_scalars, max_size=3), st.dictionaries(st.text(max_size=6), _scalars,
+                                                                                max_size=2))
+
+
+@st.composite
+def _mutated_scene(draw):
+    model = draw(st.sampled_from(MODELS))
+    d = load_scene(model).to_dict()
+    section = draw(st.sampled_from(["params", "input", "solver", "effects", "outputs", "model", "name", "extra"]))
+    spec = registry.get_model(model)
+    known = {"params": spec.param_names(), "input": [k for v in spec.inputs.values() for k in v] + ["type"],
+             "solver": list(SOLVER_LIMITS) + ["engine", "integrator", "method", "allow_inaccurate"],
+             "effects": list(spec.effects)}.get(section, [])
+    value = draw(_values)
+    if section in ("model", "name", "extra"):
+        d[section] = value
+    elif section == "outputs":
+        d["outputs"] = value
+    else:
+        key = draw(st.sampled_from(known)) if known and draw(st.booleans()) else draw(st.text(max_size=8))
+        if not isinstance(d.get(section), dict):
+            d[section] = {}
+        d[section][key] = value
+    return d
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_mutated_scene())
+def test_loader_answers_with_a_scene_or_an_mbsuite_error(d):
+    try:
+        scene = scene_from_dict(d)
+    except MbsuiteError as exc:
+        assert str(exc)  # a message, never an empty error
+        return
+    # accepted: every number that reached the scene is finite
+    for section in (scene.input, scene.params):
+        for v in section.values():
+            assert not (isinstance(v, float) and not math.isfinite(v))
+
+
+# --- fuzz: every shipped scene, one mutated value, through `mbsuite run` -------------------------------------------
+
+def _short(d: dict) -> dict:
+    """A short run of a scene (so the fuzz can afford every shipped scene)."""
+    s = d.setdefault("solver", {})
+    s["duration"] = min(float(s.get("duration", 1.0)), 0.4)
+    s["t_settle"] = 0.0
+    return d
+
+
+def _fuzz_scenes() -> list[str]:
+    out = []
+    for name, spec in sorted(registry.models().items()):
+        if name == "catenary":  # a passage is a fixed length of line (seconds of CPU): in the slow fuzz
+            continue
+        out += [f"{name}/{s}" for s in sorted(spec.scene_files())]
+    return out
+
+
+MUTATIONS = [("solver", "timestep", 0.0), ("solver", "timestep", -1e-3), ("solver", "rtol", math.nan),
+             ("solver", "duration", math.inf), ("solver", "sample_dt", -1.0), ("solver", "integrator", "leapfrog"),
+             ("input", "frequency", math.nan), ("input", "type", 3), ("outputs", "signals", ["nosuch"])]
+
+
+def _inside(lim: Limit, rng: np.random.Generator):
+    """A random value inside `lim` (log-uniform over positive ranges, clipped to a plausible span)."""
+    if lim.choices is not None:
+        return lim.choices[rng.integers(len(lim.choices))]
+    lo = lim.lo if lim.lo is not None else -1e3
+    hi = lim.hi if lim.hi is not None else max(1e3, 10 * abs(lo))
+    if lo > 0 and hi / lo > 100:
+        v = float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+    else:
+        v = float(rng.uniform(lo, hi))
+    v = min(max(v, lo), hi)
+    if (lim.lo_open and v == lim.lo) or (lim.hi_open and v == lim.hi):
+        v = 0.5 * (lo + hi)
+    return int(round(v)) if lim.kind is int else v
+
+
+def _run_json(tmp_path: Path, capsys, d: dict, name: str) -> tuple[int, str, str]:
+    return _run_cli(["run", _write(tmp_path, _toml(d), name), "--json"], capsys)
+
+
+def _assert_finite_or_refused(rc: int, out: str, err: str, what: str) -> None:
+    if rc == 0:
+        sig = json.loads(out)["signals"]
+        assert all(v is not None for s in sig.values() for v in (s["min"], s["max"], s["final"])), (what, sig)
+    else:
+        assert rc == 2 and err.startswith("mbsuite: error: ") and err.count("\n") == 1, (what, err)
+        assert "internal error" not in err and "Traceback" not in err, (what, err)
+
+
+@pytest.mark.parametrize("ref", _fuzz_scenes())
+def test_fuzz_shipped_scene_mutated_exits_0_finite_or_2_naming_the_key(tmp_path, capsys, ref):
+    base = _short(load_scene(ref).to_dict())
+    _assert_finite_or_refused(*_run_json(tmp_path, capsys, base, "base.toml"), what=ref)
+    for section, key, value in MUTATIONS:  # each breaks the scene: exit 2 naming the key
+        d = copy.deepcopy(base)
+        d.setdefault(section, {})[key] = value
+        rc, _, err = _run_json(tmp_path, capsys, d, "bad.toml")
+        assert rc == 2 and key in err and "internal error" not in err, (ref, section, key, value, err)
+    # values drawn inside the declared ranges: a run with finite numbers, or a refusal that is a message
+    rng = np.random.default_rng(zlib.crc32(ref.encode()))
+    decl = [x for x in _declared(registry.get_model(base["model"])) if x[0] in ("params", "input")]
+    for i in rng.choice(len(decl), size=min(4, len(decl)), replace=False) if decl else []:
+        section, key, lim = decl[i]
+        d = copy.deepcopy(base)
+        d.setdefault(section, {})[key] = _inside(lim, rng)
+        _assert_finite_or_refused(*_run_json(tmp_path, capsys, d, "drawn.toml"),
+                                  what=f"{ref} {section}.{key} = {d[section][key]!r}")
+
+
+def _toml(d: dict) -> str:
+    """A minimal TOML writer for scene dictionaries (tables of scalars and lists; non-finite floats as nan/inf)."""
+    def val(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, float):
+            return "nan" if math.isnan(v) else ("inf" if v == math.inf else "-inf" if v == -math.inf else repr(v))
+        if isinstance(v, int):
+            return str(v)
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, list | tuple):
+            return "[" + ", ".join(val(x) for x in v) + "]"
+        raise TypeError(type(v))
+
+    lines = [f"{k} = {val(v)}" for k, v in d.items() if not isinstance(v, dict)]
+    for k, v in d.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            lines += [f"{kk} = {val(vv)}" for kk, vv in v.items() if not isinstance(vv, dict)]
+    return "\n".join(lines) + "\n"
+
+
+def test_toml_writer_round_trips_every_shipped_scene():
+    import tomllib
+
+    for ref in _fuzz_scenes():
+        d = load_scene(ref).to_dict()
+        assert scene_from_dict(tomllib.loads(_toml(d))).to_dict() == d, ref
+
+
+# --- threads never mix models ---------------------------------------------------------------------------------------
+
+def test_two_models_in_two_threads_equal_their_serial_runs():
+    from concurrent.futures import ThreadPoolExecutor
+
+    scenes = [load_scene("pantograph").replace(solver={"duration": 1.0, "t_settle": 0.0}),
+              load_scene("iftomm/fourbar"),
+              load_scene("coupler/double_friction").replace(solver={"duration": 0.5, "t_settle": 0.0})]
+    serial = [mbsuite.run(s) for s in scenes]
+    with ThreadPoolExecutor(3) as ex:
+        threaded = list(ex.map(mbsuite.run, scenes))
+    for s, a, b in zip(scenes, serial, threaded, strict=True):
+        for k in a.signals:
+            np.testing.assert_array_equal(a[k], b[k], err_msg=f"{s.model}: {k} differs when run beside others")
+
+
+def test_scene_errors_are_scene_errors():
+    with pytest.raises(SceneError, match="solver.timestep"):
+        load_scene("pantograph").replace(solver={"timestep": math.nan})

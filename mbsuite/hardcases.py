@@ -107,13 +107,20 @@ class Outcome:
 
 
 def run_case(case: HardCase) -> Outcome:
+    """Run one case. Every warning raised inside is recorded in `measured["warnings"]`; a RuntimeWarning (overflow,
+    invalid value, a solver's complaint) is a failed check: a hard case must stay numerically clean."""
     ck = Checker()
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             case.check(ck)
     except Exception as e:  # noqa: BLE001 - an unexpected error is a failed hard case, reported with its message
         return Outcome(case, ck.checks, ck.measured, f"{type(e).__name__}: {e}")
+    if caught:
+        ck.measured["warnings"] = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
+    runtime = sorted({str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)})
+    if runtime:
+        ck.true("no RuntimeWarning", False, "; ".join(runtime)[:200])
     return Outcome(case, ck.checks, ck.measured)
 
 

@@ -18,6 +18,7 @@ from .errors import (  # noqa: E402
     SolverError,
 )
 from .health import AccuracyError, judge  # noqa: E402
+from .paths import model_file, model_files  # noqa: E402
 from .registry import get_model, models  # noqa: E402
 from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
 
@@ -48,6 +49,8 @@ __all__ = [
     "SolverError",
     "get_model",
     "load_scene",
+    "model_file",
+    "model_files",
     "models",
     "run",
     "scene_from_dict",

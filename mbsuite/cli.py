@@ -44,15 +44,44 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", metavar="DIR", help="write CSV/PNG/summary.json into DIR")
 
 
+ANALYSES = ("run", "equilibrium", "modes", "freqresp")
+CLI_GROUPS: dict[str, str] = {}  # model -> its own command group (filled when the parser is built)
+
+
+def _analyses(spec: registry.ModelSpec) -> list[str]:
+    """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
+    out = [a for a in ANALYSES if getattr(spec, a) is not None]
+    if spec.run is not None:
+        out.append("sweep")
+    if spec.cases:
+        out += ["workprecision", "hardcases"]
+    group = CLI_GROUPS.get(spec.name)
+    if group:
+        out.append(f"mbsuite {group} ...")
+    return out
+
+
 def _cmd_list(args: argparse.Namespace) -> None:
     rows = []
     data = {}
+    blocks = []
     for name, spec in sorted(registry.models().items()):
         scenes = sorted(spec.scene_files())
-        rows.append([name, spec.default_scene, ", ".join(scenes), ", ".join(spec.engines), spec.summary])
+        analyses = _analyses(spec)
+        rows.append([name, spec.default_scene, len(scenes), "/".join(spec.engines)])
         data[name] = {"summary": spec.summary, "default_scene": spec.default_scene, "scenes": scenes,
-                      "engines": list(spec.engines), "effects": {k: list(e.choices) for k, e in spec.effects.items()}}
-    _emit(Report(data, format_table(["model", "default", "scenes", "engines", "summary"], rows)), args, None)
+                      "engines": list(spec.engines), "analyses": analyses,
+                      "effects": {k: list(e.choices) for k, e in spec.effects.items()}}
+        blocks.append(_wrap(f"{name}: {spec.summary}", indent="") + "\n" + _wrap("analyses: " + ", ".join(analyses))
+                      + "\n" + _wrap("scenes: " + ", ".join(scenes)))
+    table = format_table(["model", "default scene", "scenes", "engines"], rows) + "\n\n" + "\n\n".join(blocks)
+    _emit(Report(data, table), args, None)
+
+
+def _wrap(text: str, width: int = 100, indent: str = "  ") -> str:
+    import textwrap
+
+    return textwrap.fill(text, width=width, initial_indent=indent, subsequent_indent=indent + "  ")
 
 
 def _sweep_args(p: argparse.ArgumentParser) -> None:
@@ -272,7 +301,10 @@ def _hook_command(hook: str):
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
-    ap = argparse.ArgumentParser(prog="mbsuite", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(
+        prog="mbsuite", description="Cross-checked multibody models of railway mechanisms on Pinocchio and MuJoCo: "
+        "run scenes, sweeps, frequency responses, work-precision studies and hard cases; `mbsuite list` shows the "
+        "models and what each offers.")
     ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
@@ -338,7 +370,10 @@ def build_parser() -> argparse.ArgumentParser:
             if exc.name != f"mbsuite.models.{name}.cli":
                 raise
             continue
+        before = set(sub.choices)
         mod.register(sub, _common, _emit)
+        for group in sorted(set(sub.choices) - before):
+            CLI_GROUPS[name] = group
     return ap
 
 

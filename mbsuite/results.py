@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 import platform
 import sys
 from collections.abc import Mapping, Sequence
@@ -178,30 +179,32 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence[Any]], floatfmt
 
 
 class Progress:
-    """A minimal progress bar on stderr (only when stderr is a terminal, or `force=True`)."""
+    """A progress bar on stderr (tqdm): shown when stderr is a terminal, when `MBSUITE_PROGRESS=1`, or with
+    `enabled=True`; on a non-terminal it prints a line at most every 5 s instead of redrawing."""
 
     def __init__(self, total: int, desc: str = "", enabled: bool | None = None):
+        from tqdm import tqdm
+
+        tty = sys.stderr.isatty()
+        if enabled is None:
+            enabled = tty or os.environ.get("MBSUITE_PROGRESS", "") not in ("", "0")
+        self.enabled = bool(enabled)
         self.total = max(int(total), 1)
-        self.n = 0
-        self.desc = desc
-        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+        self._bar = tqdm(total=self.total, desc=desc, disable=not self.enabled, file=sys.stderr, ncols=100,
+                         mininterval=0.2 if tty else 5.0, leave=True)
+
+    @property
+    def n(self) -> int:
+        return int(self._bar.n)
 
     def update(self, k: int = 1) -> None:
-        self.n += k
-        if self.enabled:
-            frac = self.n / self.total
-            bar = "#" * int(30 * frac)
-            sys.stderr.write(f"\r{self.desc} [{bar:<30}] {self.n}/{self.total}")
-            if self.n >= self.total:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
+        self._bar.update(k)
 
     def __enter__(self) -> Progress:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        if self.enabled and self.n < self.total:
-            sys.stderr.write("\n")
+        self._bar.close()
 
 
 @dataclass

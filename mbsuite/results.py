@@ -43,6 +43,9 @@ class SimResult:
             k: {"unit": self.units.get(k, ""), "min": float(np.min(v)), "max": float(np.max(v)), "final": float(v[-1])}
             for k, v in self.signals.items()
         }
+        if self.scene:  # every resolved input, defaults included, so a result says what it was computed for
+            out["input"] = dict(self.scene.get("input") or {})
+            out["solver"] = dict(self.scene.get("solver") or {})
         out["events"] = self.events
         out["stats"] = self.stats
         out["health"] = [f.to_dict() for f in self.health]
@@ -59,6 +62,9 @@ class SimResult:
         rows = [[k, self.units.get(k, ""), float(np.min(v)), float(np.max(v)), float(v[-1])]
                 for k, v in self.signals.items()]
         table = format_table(["signal", "unit", "min", "max", "final"], rows, ".6g")
+        if self.scene.get("input"):
+            table = "input (resolved, defaults included): " + ", ".join(
+                f"{k} = {_plain(v)}" for k, v in self.scene["input"].items()) + "\n" + table
         if self.events:
             kinds: dict[str, int] = {}
             for e in self.events:

@@ -9,19 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...registry import Effect, ModelSpec
-from .mujoco import INPUT_KEYS, OUTPUTS, run
+from .mujoco import INPUTS, OUTPUTS, run
 from .params import CouplerParams
-
-_INPUT_DOCS = {
-    "omega": "input shaft speed after the ramp [rad/s]",
-    "load_torque": "load torque on the output shaft, opposing its rotation [N m]",
-    "alpha_cx": "output shaft inclination about x [rad]",
-    "alpha_cz": "output shaft inclination about z [rad]",
-    "x_c": "output shaft lateral offset along x [m]",
-    "z_c": "output shaft lateral offset along z [m]",
-    "t_ramp": "duration of the smooth speed and load ramp from rest [s]",
-}
-assert set(_INPUT_DOCS) == set(INPUT_KEYS)
 
 SPEC = ModelSpec(
     name="coupler",
@@ -33,7 +22,7 @@ SPEC = ModelSpec(
                                "real link mass/inertia, or the massless limit (scaled by massless_factor)"),
         "friction": Effect((False, True), False, "dry friction joint_friction in the S joints and output bearing"),
     },
-    inputs={"constant_speed": _INPUT_DOCS},
+    inputs={"constant_speed": INPUTS},
     outputs=OUTPUTS,
     engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).resolve().parent / "scenes",

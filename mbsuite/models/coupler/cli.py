@@ -16,6 +16,13 @@ from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
 
 
+def mbsuite_run(scene):
+    """`mbsuite.run` (imported late: the package imports this module's model while it loads)."""
+    from ... import run
+
+    return run(scene)
+
+
 def _finite(name: str):
     def conv(s: str) -> float:
         try:
@@ -55,10 +62,28 @@ def _cmd_jacobian(emit):
     return run
 
 
+#: default size guard of `coupler fpp`: samples per revolution (about 0.2 ms each; 1e5 take ~20 s); --max-n raises it
+FPP_MAX_N = 100_000
+
+
+def _count(name: str):
+    def conv(s: str) -> int:
+        try:
+            v = float(s)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
+        if not math.isfinite(v) or v != int(v):
+            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {s!r}")
+        return int(v)
+
+    return conv
+
+
 def _cmd_fpp(emit):
     def run(args: argparse.Namespace) -> None:
-        if args.n < 3:
-            raise ParameterError(f"--n = {args.n} must be >= 3")
+        if not 3 <= args.n <= args.max_n:
+            raise ParameterError(f"--n = {args.n} is invalid; valid: integer in [3, {args.max_n}] (the size guard "
+                                 f"--max-n, default {FPP_MAX_N}; each sample is one FPP solve, ~0.2 ms)")
         emit(analysis.fpp_report(_params(args), args.alpha_bx, args.alpha_bz, args.n, args.engine), args, None)
 
     return run
@@ -81,10 +106,17 @@ def _cmd_dynamics(emit):
         scene = load_scene(args.scene)
         if args.engine:
             scene = scene.replace(solver={"engine": args.engine})
-        res = scene.spec.run(scene)
+        res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)
         st = res.stats
+        inputs = {k: v for k, v in scene.input.items()}  # resolved: declared defaults filled in by the scene loader
+        table = ("input (resolved, defaults included): "
+                 + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in inputs.items())
+                 + "\n")
         rows = [[k, v] for k, v in st.items() if isinstance(v, int | float)]
-        table = format_table(["quantity", "value"], rows, ".6g")
+        table += format_table(["quantity", "value"], rows, ".6g")
+        if res.health:
+            table += "\nhealth: " + ", ".join(f"{f.name} {f.value:.3g} {f.unit} (bound {f.bound:.3g})"
+                                              for f in res.health)
         if st.get("warnings"):
             table += f"\nMuJoCo warnings: {st['warnings']}"
         if "link_force_mean" in st:
@@ -94,7 +126,8 @@ def _cmd_dynamics(emit):
         def write(out: Path) -> list[Path]:
             return [res.write_csv(out / "timeseries.csv")]
 
-        emit(Report({"stats": st, "summary": res.summary()}, table, write), args, scene.to_dict())
+        emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": st, "summary": res.summary()}, table, write),
+             args, scene.to_dict())
 
     return run
 
@@ -116,7 +149,9 @@ def register(sub, add_common, emit) -> None:
     _geometry_args(p, 0.1)
     p.add_argument("--alpha-bx", type=_finite("--alpha-bx"), default=0.0525, help="inclination about x [rad]")
     p.add_argument("--alpha-bz", type=_finite("--alpha-bz"), default=0.0, help="inclination about z [rad]")
-    p.add_argument("--n", type=int, default=73, help="samples over the revolution (both ends included)")
+    p.add_argument("--n", type=_count("--n"), default=73, help="samples over the revolution (both ends included)")
+    p.add_argument("--max-n", type=_count("--max-n"), default=FPP_MAX_N,
+                   help=f"size guard: the largest --n accepted (default {FPP_MAX_N})")
     p.add_argument("--engine", choices=["reference", "pinocchio"], default="reference",
                    help="pinocchio: also solve with the URDF model and report the difference")
     add_common(p)

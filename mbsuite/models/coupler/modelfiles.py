@@ -277,6 +277,111 @@ def mjcf_text(p: CouplerParams, kind: str) -> str:
     return s + "  </equality>\n</mujoco>\n"
 
 
+# ------------------------------------------------------------------------------------------------- checks at load
+#: largest gap (relative to the link length) between a link's stated geometry and the model file at its assembled pose
+#: q = 0: the files are written to 15 digits (gaps ~1e-16 l); a file rounded to 6 digits still passes, a changed link
+#: length or a moved joint point fails by orders of magnitude
+CLOSURE_RTOL = 1e-6
+
+
+def required_names(kind: str) -> dict[str, list[str]]:
+    """Bodies, joints, sites and equalities the MJCF of `kind` must hold (the model and its runs look them up)."""
+    _check_kind(kind)
+    nl = 4 if kind == "single" else 8
+    driven = ["B"] if kind == "single" else ["BA", "BC", "C"]
+    chain = (["x_b", "y_b", "z_b", "alpha_bz", "alpha_bx", "phi_b"]
+             + ([] if kind == "single" else ["x_c", "y_c", "z_c", "alpha_cz", "alpha_cx", "phi_c"]))
+    return {"body": ["coupler", "shaft_a", *(["platform_b"] if kind == "single" else ["shaft_b", "shaft_c"]),
+                     *(f"link{k + 1}" for k in range(nl))],
+            "joint": ["phi_a", *chain, *(f"link{k + 1}_ball" for k in range(nl))],
+            "site": [f"{pre}_S{k + 1}" for pre in ["A", *driven] for k in range(4)]
+                    + [f"link{k + 1}_end" for k in range(nl)],
+            "equality": [f"link{k + 1}" for k in range(nl)]}
+
+
+def raise_on_gaps(path: str | Path, gaps: list[tuple[str, str, float]], length: float, engine: str) -> None:
+    """ModelFileError naming the file, the worst closure/body and its residual if any gap exceeds CLOSURE_RTOL x the
+    link length. gaps: (closure, body, residual in m)."""
+    bad = [g for g in gaps if not g[2] <= CLOSURE_RTOL * length]
+    if bad:
+        name, body, r = max(bad, key=lambda g: g[2] if math.isfinite(g[2]) else math.inf)
+        raise ModelFileError(
+            f"{path}: loop closure {name!r} (body {body!r}) does not assemble at the initial pose q = 0 ({engine}): "
+            f"residual {r:.4g} m > {CLOSURE_RTOL:g} x link length {length:.6g} m ({len(bad)} of {len(gaps)} "
+            "closures); the file's joint points and link lengths must match the stated geometry")
+
+
+def check_inertias_mujoco(m, path: str | Path) -> None:
+    """Every moving body (one with joints) of a compiled MuJoCo model has positive mass and a positive definite,
+    physically consistent inertia (principal moments > 0 satisfying the triangle inequality); else ModelFileError."""
+    import mujoco
+
+    for b in range(1, m.nbody):
+        if m.body_jntnum[b] == 0:
+            continue
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+        I = np.sort(m.body_inertia[b])
+        if not (m.body_mass[b] > 0 and I[0] > 0 and I[0] + I[1] >= I[2] * (1 - 1e-12)):
+            raise ModelFileError(f"{path}: body {name!r} has mass {m.body_mass[b]:g} kg and principal inertia "
+                                 f"{m.body_inertia[b].tolist()} kg m^2: a moving body needs mass > 0 and a positive "
+                                 "definite inertia (triangle inequality)")
+
+
+def check_mjcf(m, path: str | Path, kind: str, stated: CouplerParams | None = None) -> None:
+    """The checks at load of a coupler MJCF compiled from `path` (unedited, at q = 0 = the assembled pose): every name
+    the model needs is present, every <connect> is a connect between its link and the driven shaft, each link body
+    starts at its driving joint point, its anchor lies at the stated link length (`stated`: the geometry the file is
+    generated from, default `CouplerParams()`) and lands on the driven joint point, the link's end site sits on the
+    anchor, and every moving body has a positive definite inertia. MuJoCo places the driven shaft's side of a connect
+    at compile time, so any geometry would "close" in MuJoCo: these gaps are what shows a wrong file."""
+    import mujoco
+
+    stated = stated or CouplerParams()
+    ob = mujoco.mjtObj
+    kinds = {"body": ob.mjOBJ_BODY, "joint": ob.mjOBJ_JOINT, "site": ob.mjOBJ_SITE, "equality": ob.mjOBJ_EQUALITY}
+    missing = [f"{t} {n!r}" for t, names in required_names(kind).items() for n in names
+               if mujoco.mj_name2id(m, kinds[t], n) < 0]
+    if missing:
+        raise ModelFileError(f"{path}: the coupler_{kind} model needs {', '.join(missing)}, which the file lacks")
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+    driven_body = "platform_b" if kind == "single" else "shaft_b"
+    l = stated.link_length
+    gaps = []
+    for c in closures(stated, kind):
+        e = mujoco.mj_name2id(m, ob.mjOBJ_EQUALITY, c.name)
+        b = mujoco.mj_name2id(m, ob.mjOBJ_BODY, c.name)
+        b1, b2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        if m.eq_type[e] != mujoco.mjtEq.mjEQ_CONNECT or b1 != b or \
+                mujoco.mj_id2name(m, ob.mjOBJ_BODY, b2) != driven_body:
+            raise ModelFileError(f"{path}: equality {c.name!r} must be a <connect> from body {c.name!r} to "
+                                 f"{driven_body!r}")
+        anchor = m.eq_data[e, 0:3]
+        R = d.xmat[b].reshape(3, 3)
+        site = lambda n: d.site_xpos[mujoco.mj_name2id(m, ob.mjOBJ_SITE, n)]  # noqa: E731
+        end = d.site_xpos[mujoco.mj_name2id(m, ob.mjOBJ_SITE, f"{c.name}_end")]
+        aw = d.xpos[b] + R @ anchor
+        gaps.append((c.name, c.name, float(max(np.linalg.norm(d.xpos[b] - site(c.frame_a)),  # starts at its point
+                                               abs(np.linalg.norm(anchor) - l),  # stated length
+                                               np.linalg.norm(aw - site(c.frame_b)),  # lands on the driven point
+                                               np.linalg.norm(end - aw)))))  # end site on the anchor
+    raise_on_gaps(path, gaps, l, "MuJoCo")
+    check_inertias_mujoco(m, path)
+
+
+def load_checked_mjcf(kind: str, base: str | Path | None = None):
+    """Compile the coupler MJCF `base` (default: the shipped file) as it is, check it (`check_mjcf`) and return
+    (path, compiled model). A file that is not MJCF is a ModelFileError naming it."""
+    from ...engines import mujoco_engine as me
+    from ...paths import mjcf_path
+
+    _check_kind(kind)
+    path = Path(base) if base is not None else mjcf_path(f"coupler_{kind}")
+    m = me.load_model(path)
+    check_mjcf(m, path, kind)
+    return path, m
+
+
 def write_baseline(root: Path | None = None) -> list[Path]:
     """Write the shipped baseline files (CouplerParams() defaults). Used by scripts/coupler_write_models.py."""
     from ...paths import models_root
@@ -296,13 +401,17 @@ def write_baseline(root: Path | None = None) -> list[Path]:
 # ----------------------------------------------------------------------------------------------- MjSpec design edits
 def mjspec_variant(p: CouplerParams, kind: str, base: str | Path | None = None):
     """Design variant by editing the shipped MJCF through mujoco.MjSpec: platform sites, link bodies (pose, inertia,
-    geometry, end site), shaft offsets (e_y, l_b) and the <connect> anchors. Returns the edited MjSpec."""
+    geometry, end site), shaft offsets (e_y, l_b) and the <connect> anchors. The file is checked first as it is
+    (`load_checked_mjcf`: names, closures at q = 0, inertias). Returns the edited MjSpec."""
     import mujoco
 
     from ...paths import mjcf_path
 
-    _check_kind(kind)
-    spec = mujoco.MjSpec.from_file(str(base or mjcf_path(f"coupler_{kind}")))
+    path, _ = load_checked_mjcf(kind, base or mjcf_path(f"coupler_{kind}"))
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except Exception as exc:  # mujoco raises ValueError with the parser message
+        raise ModelFileError(f"MuJoCo cannot read {path}: {exc}") from exc
     pts = _mounted(p, kind)
     l = p.link_length
     it, ia = link_inertia(p, p.m_link)

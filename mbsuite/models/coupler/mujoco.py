@@ -27,27 +27,36 @@ from ... import results
 from ...engines import core
 from ...engines import mujoco_engine as me
 from ...errors import GeometryError, SceneError, SolverError
+from ...health import Figure
+from ...limits import Limit
 from ...results import SimResult
 from . import reference as ref
-from .modelfiles import PHI_B_OFFSET, _mounted, _quat_z_to, link_inertia, mjspec_variant, phi_c_offset
+from .modelfiles import PHI_B_OFFSET, _mounted, _quat_z_to, link_inertia, mjspec_variant, phi_c_offset, raise_on_gaps
 from .params import CouplerParams
 
-INPUT_KEYS = ("omega", "load_torque", "alpha_cx", "alpha_cz", "x_c", "z_c", "t_ramp")
-INPUT_DEFAULTS = {"omega": 4 * math.pi, "load_torque": 1000.0, "alpha_cx": 0.0, "alpha_cz": 0.0, "x_c": 0.0,
-                  "z_c": 0.05, "t_ramp": 0.25}
+#: the scene input of type "constant_speed": valid range, unit, meaning and the default used when a scene omits the
+#: key (the scene loader fills it in, so every output shows the value the run used)
+INPUTS: dict[str, Limit] = {
+    "omega": Limit(lo=0.0, lo_open=True, hi=1000.0, unit="rad/s", default=4 * math.pi,
+                   doc="input shaft speed after the ramp"),
+    "load_torque": Limit(lo=-1e7, hi=1e7, unit="N m", default=1000.0,
+                         doc="load torque on the output shaft, opposing its rotation"),
+    "alpha_cx": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about x"),
+    "alpha_cz": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about z"),
+    "x_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along x"),
+    "z_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along z"),
+    "t_ramp": Limit(lo=0.0, hi=1e3, unit="s", default=0.25,
+                    doc="duration of the smooth speed and load ramp from rest"),
+}
+INPUT_KEYS = tuple(INPUTS)
+INPUT_DEFAULTS = {k: lim.default for k, lim in INPUTS.items()}
 
 
 def _inputs(scene) -> dict[str, float]:
+    """The run's inputs: the scene's (checked and completed with the declared defaults by the scene loader), checked
+    again here for scenes built without it."""
     inp = {**INPUT_DEFAULTS, **{k: v for k, v in scene.input.items() if k != "type"}}
-    for k in INPUT_KEYS:
-        v = inp[k]
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise SceneError(f"coupler input {k!r} must be a finite number, got {v!r}")
-    if inp["omega"] <= 0:
-        raise SceneError(f"coupler input omega = {inp['omega']!r} rad/s must be positive")
-    if inp["t_ramp"] < 0:
-        raise SceneError(f"coupler input t_ramp = {inp['t_ramp']!r} s must be >= 0")
-    return {k: float(inp[k]) for k in INPUT_KEYS}
+    return {k: INPUTS[k].check(f"coupler input {k}", inp[k], SceneError) for k in INPUT_KEYS}
 
 
 def _id(m, kind, name: str) -> int:
@@ -102,6 +111,15 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
         m.eq_solref[e] = [p.solref_timeconst, p.solref_dampratio]
     d = mujoco.MjData(m)
     u = assemble(p, m, d, inp, 0.0)
+    # every closure of the edited model assembles at the initial (FPP) pose: link end on its driven joint point
+    sb = _id(m, mujoco.mjtObj.mjOBJ_BODY, "shaft_b")
+    gaps = []
+    for k in range(8):
+        e = _id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"link{k + 1}")
+        end = d.site_xpos[_id(m, mujoco.mjtObj.mjOBJ_SITE, f"link{k + 1}_end")]
+        gaps.append((f"link{k + 1}", f"link{k + 1}",
+                     float(np.linalg.norm(end - d.xpos[sb] - d.xmat[sb].reshape(3, 3) @ m.eq_data[e, 3:6]))))
+    raise_on_gaps("coupler_double.xml edited for this scene (MjSpec)", gaps, p.link_length, "MuJoCo")
     return m, d, {"u0": u}
 
 
@@ -226,7 +244,26 @@ def run(scene) -> SimResult:
     st = stats(tr.t, signals, sv.t_settle, inp)
     st.update(warnings=tr.warnings, solref=[p.solref_timeconst, p.solref_dampratio], steps=tr.steps,
               integrator=sv.integrator, timestep=sv.timestep)
-    return results.assemble(scene, tr.t, signals, engine="mujoco", stats=st, always=("phi_c_err",))
+    return results.assemble(scene, tr.t, signals, engine="mujoco", stats=st, always=("phi_c_err",),
+                            health=[closure_figure(st["closure_residual_max_all"], p)])
+
+
+#: bound of the MuJoCo closure residual over a whole run (start-up ramp included), relative to the link length: the
+#: shipped scenes reach 4.4e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.3e-5 m in steady
+#: rotation), so 5e-3 l (5x the largest) flags closures torn open by a too-soft solref or a bad model
+CLOSURE_BOUND_REL = 5e-3
+#: the rigid reference solves every sample's FPP to |r| <= 1e-13 R^2 (a gap ~1e-14 l): 1e-9 l flags a failed solve
+CLOSURE_BOUND_REL_REFERENCE = 1e-9
+
+
+def closure_figure(value: float, p: CouplerParams, reference: bool = False) -> Figure:
+    """The health figure `closure_residual`: the largest loop-closure gap over the run [m] against its bound
+    (CLOSURE_BOUND_REL x link length; CLOSURE_BOUND_REL_REFERENCE for the rigid reference)."""
+    rel = CLOSURE_BOUND_REL_REFERENCE if reference else CLOSURE_BOUND_REL
+    fix = ("" if reference else "lower params.solref_timeconst (stiffer closures) or lengthen input.t_ramp (a gentler "
+           "start-up)")
+    return Figure("closure_residual", float(value), rel * p.link_length, "m",
+                  f"largest SS-link closure gap over the run, bound {rel:g} x link length {p.link_length:.4g} m", fix)
 
 
 def simulated_pose(p: CouplerParams, tr: core.Trajectory) -> np.ndarray:
@@ -416,14 +453,20 @@ def run_reference(scene, p: CouplerParams, inp: dict[str, float]) -> SimResult:
     power = np.gradient(energy, t) + tl * rates[:, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         t_in = np.where(om > 0, power / np.where(om > 0, om, 1.0), tl * D1[:, 0]) + p.i_shaft_a * al
+    # closure gap of the rigid reference: |r_k| = ||l_k|^2 - l^2| at the solved poses, as a length |r_k| / (2 l)
+    gap = np.max(np.abs(ref.double_residual_batch(p, np.column_stack(
+        [phi_a - 2 * math.pi * np.round(phi_a / (2 * math.pi)), np.broadcast_to(
+            [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]], (t.size, 4))]),
+        U - np.round(phi_a / (2 * math.pi))[:, None] * ref.DOUBLE_TURN)), axis=1) / (2 * p.link_length)
     signals = {"phi_a": phi_a, "phi_c": U[:, 0], "phi_c_kin": U[:, 0], "phi_c_err": np.zeros_like(t),
-               "omega_c": rates[:, 0], "torque_in": t_in, "torque_out": tl}
+               "omega_c": rates[:, 0], "torque_in": t_in, "torque_out": tl, "closure_residual": gap}
     w = t >= max(sv.t_settle, inp["t_ramp"])
     st = {"torque_in_mean": float(np.mean(t_in[w])), "torque_in_ripple_pp": float(np.ptp(t_in[w])),
           "torque_in_ripple_quasi_static_pp": float(np.ptp(tl[w] * D1[w, 0])),
           "speed_ratio_min": float(np.min(D1[w, 0])), "speed_ratio_max": float(np.max(D1[w, 0])),
-          "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0]))}
-    return results.assemble(scene, t, signals, engine="reference", stats=st, always=("phi_c_err",))
+          "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max_all": float(gap.max())}
+    return results.assemble(scene, t, signals, engine="reference", stats=st, always=("phi_c_err",),
+                            health=[closure_figure(st["closure_residual_max_all"], p, reference=True)])
 
 
 OUTPUTS = {"phi_a": "rad", "phi_c": "rad", "phi_c_kin": "rad", "phi_c_err": "rad", "omega_c": "rad/s",

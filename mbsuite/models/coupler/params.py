@@ -9,9 +9,10 @@ link k joins A-point k to B-point k+1. Lengths are in metres; the paper's non-di
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from ...errors import ParameterError
+from ...limits import check_fields, param
 
 GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (reference B1)
 GAMMAS_PAPER = (0.11, 0.297, 0.391)  # seed l.212, l.292
@@ -38,49 +39,35 @@ class CouplerParams:
       solref_timeconst, solref_dampratio   soft-constraint parameters of the link closures (see README)
     """
 
-    gamma: float = GAMMA_17DEG
-    e_y: float = 0.1
-    R: float = 1.0
-    l_b: float = 2.0
-    phi_bc: float = 0.0
-    m_link: float = 5.0
-    link_radius: float = 0.02
-    massless_factor: float = 1e-3
-    m_shaft_b: float = 80.0
-    i_shaft_b_axial: float = 20.0
-    i_shaft_b_trans: float = 40.0
-    i_shaft_a: float = 10.0
-    i_shaft_c: float = 30.0
-    joint_friction: float = 2.0
-    joint_damping: float = 0.05
-    kv_drive: float = 2.0e5
-    solref_timeconst: float = 2.0e-3
-    solref_dampratio: float = 1.0
+    gamma: float = param(GAMMA_17DEG, lo=0.0, hi=math.pi / 4, lo_open=True, hi_open=True, unit="rad",
+                         doc="platform proportion angle (Eq 1: a positive link length only in (0, pi/4))")
+    e_y: float = param(0.1, lo=0.0, hi=1000.0, unit="m", doc="axial shift between the platforms of one coupler")
+    R: float = param(1.0, lo=0.0, hi=1000.0, lo_open=True, unit="m", doc="radius of the circle through the joints")
+    l_b: float = param(2.0, lo=0.0, hi=1000.0, lo_open=True, unit="m", doc="length of the intermediate shaft b")
+    phi_bc: float = param(0.0, lo=-math.pi, hi=math.pi, unit="rad", doc="angle between platforms BA and BC")
+    m_link: float = param(5.0, lo=0.0, hi=1e6, lo_open=True, unit="kg", doc="mass of one SS link")
+    link_radius: float = param(0.02, lo=0.0, hi=10.0, lo_open=True, unit="m", doc="capsule radius of one SS link")
+    massless_factor: float = param(1e-3, lo=0.0, hi=1.0, lo_open=True, doc="link mass scale of the massless limit")
+    m_shaft_b: float = param(80.0, lo=0.0, hi=1e7, lo_open=True, unit="kg", doc="mass of the intermediate shaft b")
+    i_shaft_b_axial: float = param(20.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of shaft b")
+    i_shaft_b_trans: float = param(40.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2",
+                                   doc="transverse inertia of shaft b about its centre")
+    i_shaft_a: float = param(10.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of input shaft a")
+    i_shaft_c: float = param(30.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of output shaft c")
+    joint_friction: float = param(2.0, lo=0.0, hi=1e6, unit="N m", doc="dry friction in every S joint and bearing")
+    joint_damping: float = param(0.05, lo=0.0, hi=1e6, unit="N m s/rad", doc="viscous damping in the S joints")
+    kv_drive: float = param(2.0e5, lo=0.0, hi=1e12, lo_open=True, unit="N m s/rad",
+                            doc="velocity-servo gain of the input drive")
+    solref_timeconst: float = param(2.0e-3, lo=0.0, hi=1.0, lo_open=True, unit="s",
+                                    doc="time constant of the soft link closures")
+    solref_dampratio: float = param(1.0, lo=0.0, hi=100.0, lo_open=True, doc="damping ratio of the link closures")
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ParameterError(f"coupler parameter {f.name} must be a finite number, got {v!r}")
-        if not 0.0 < self.gamma < math.pi / 4:
-            raise ParameterError(
-                f"coupler parameter gamma = {self.gamma!r} rad is outside (0, pi/4): Eq (1) gives link length "
-                f"l0 = 2 R sin(pi/4 - gamma) = {2 * self.R * math.sin(math.pi / 4 - self.gamma):.6g} (must be > 0 and "
-                "shorter than the platform diameter)"
-            )
-        if self.e_y < 0.0:
-            raise ParameterError(f"coupler parameter e_y = {self.e_y!r} m is negative; the axial shift must be >= 0")
-        for name in ("R", "l_b", "m_link", "link_radius", "massless_factor", "m_shaft_b", "i_shaft_b_axial",
-                     "i_shaft_b_trans", "i_shaft_a", "i_shaft_c", "kv_drive", "solref_timeconst", "solref_dampratio"):
-            if getattr(self, name) <= 0.0:
-                raise ParameterError(f"coupler parameter {name} = {getattr(self, name)!r} must be positive")
-        for name in ("joint_friction", "joint_damping"):
-            if getattr(self, name) < 0.0:
-                raise ParameterError(f"coupler parameter {name} = {getattr(self, name)!r} must be >= 0")
-        if self.massless_factor > 1.0:
-            raise ParameterError(f"coupler parameter massless_factor = {self.massless_factor!r} must be <= 1")
+        check_fields(self, "coupler parameter")
+        # cross-field checks (each message names the fields involved)
         if self.l_b <= 2.0 * self.link_radius:
-            raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for the link radius")
+            raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for link_radius = "
+                                 f"{self.link_radius!r} m (need l_b > 2 link_radius)")
 
     @property
     def l0(self) -> float:

@@ -19,7 +19,16 @@ import pinocchio as pin
 from ...engines import pinocchio_engine as pe
 from ...errors import ModelFileError, SolverError
 from ...paths import urdf_path
-from .modelfiles import PHI_B_OFFSET, Closure, _mounted, closures, closures_from_urdf, phi_c_offset, urdf_text
+from .modelfiles import (
+    PHI_B_OFFSET,
+    Closure,
+    _mounted,
+    closures,
+    closures_from_urdf,
+    phi_c_offset,
+    raise_on_gaps,
+    urdf_text,
+)
 from .params import CouplerParams
 from .reference import DOUBLE_UNKNOWNS, SINGLE_UNKNOWNS, check_physical
 
@@ -61,26 +70,45 @@ class PinCoupler:
     p: CouplerParams
     model: pin.Model
     closures: list[Closure]
+    source: str = ""  # the file the model was read from (named in the errors of the checks at load)
 
     @classmethod
     def build(cls, kind: str, p: CouplerParams | None = None, *, edit: bool = False) -> PinCoupler:
         """Shipped URDF (p None), generated URDF variant, or (edit=True) an edited copy of the shipped model."""
+        shipped = str(urdf_path(f"coupler_{kind}")) if p is None or edit else f"generated coupler_{kind} URDF"
         if p is not None and edit:
             base, _ = load_model(kind)
             model, cl = pin_variant(base, p, kind)
         else:
             model, cl = load_model(kind, p)
-        return cls(kind, p or CouplerParams(), model, cl)
+        return cls(kind, p or CouplerParams(), model, cl, shipped)
 
     def __post_init__(self) -> None:
         self.data = self.model.createData()
         self.fa = [pe.frame_id(self.model, c.frame_a) for c in self.closures]
         self.fb = [pe.frame_id(self.model, c.frame_b) for c in self.closures]
         self.lengths = np.array([c.length for c in self.closures])
+        self._check_at_load()
         self.iq = {self.model.names[j]: self.model.joints[j].idx_q for j in range(1, self.model.njoints)}
         self.iv = {self.model.names[j]: self.model.joints[j].idx_v for j in range(1, self.model.njoints)}
         self.unknowns = SINGLE_UNKNOWNS if self.kind == "single" else DOUBLE_UNKNOWNS
         self.offsets = {"phi_b": PHI_B_OFFSET, "phi_c": phi_c_offset(self.p)}
+
+    def _check_at_load(self) -> None:
+        """The closures assemble at q = 0 (the files' assembled pose): | |p_b - p_a| - l | <= CLOSURE_RTOL l for every
+        stated closure; each moving shaft has mass > 0 and a positive definite inertia. Else ModelFileError naming the
+        file, the closure and the residual."""
+        src = self.source or f"coupler_{self.kind} URDF"
+        r = self.residual(np.zeros(self.model.nq))
+        raise_on_gaps(src, [(c.name, c.frame_b, float(abs(x))) for c, x in zip(self.closures, r, strict=True)],
+                      float(np.min(self.lengths)), "Pinocchio")
+        for j in range(1, self.model.njoints):
+            I = self.model.inertias[j]
+            if self.model.names[j].startswith("phi_") and not (
+                    I.mass > 0 and np.linalg.eigvalsh(I.inertia)[0] > 0):
+                raise ModelFileError(f"{src}: the body on joint {self.model.names[j]!r} has mass {I.mass:g} kg and "
+                                     f"inertia eigenvalues {np.linalg.eigvalsh(I.inertia).tolist()}: a moving shaft "
+                                     "needs mass > 0 and a positive definite inertia")
 
     # ---- coordinates
     def q_of(self, coords: dict[str, float]) -> np.ndarray:
@@ -208,9 +236,31 @@ class PinMjcfCoupler:
         self.f1 = [self.model.getFrameId(f"anchor1_{i}") for i in range(len(self.cons))]
         self.f2 = [self.model.getFrameId(f"anchor2_{i}") for i in range(len(self.cons))]
         self.data = self.model.createData()
+        self._check_at_load()
         comp = {"single": {"b": "Composite_x_b"}, "double": {"b": "Composite_x_b", "c": "Composite_x_c"}}[self.kind]
         self.comp = {k: self.model.joints[self.model.getJointId(v)] for k, v in comp.items()}
         self.ia = self.model.joints[self.model.getJointId("phi_a")].idx_q
+
+    def _check_at_load(self) -> None:
+        """At the neutral (assembled) pose, from Pinocchio's own frames: each connect's anchor on its link lies at the
+        stated link length (`CouplerParams()`, the geometry the file states) and on the driven joint point (Pinocchio
+        also places the second anchor from the file's pose, so only these gaps show a wrong file); else
+        ModelFileError naming the file, the link and the residual."""
+        m, d = self.model, self.data
+        pin.framesForwardKinematics(m, d, pin.neutral(m))
+        stated = CouplerParams()
+        gaps = []
+        for i, c in enumerate(closures(stated, self.kind)):
+            anchor = self.cons[i].joint1_placement.translation
+            for name in (c.frame_a, c.frame_b):
+                if not m.existFrame(name):
+                    raise ModelFileError(f"{self.path}: the coupler_{self.kind} model needs site {name!r}")
+            gaps.append((c.name, c.name, float(max(
+                abs(np.linalg.norm(anchor) - c.length),
+                np.linalg.norm(d.oMf[self.f1[i]].translation - d.oMf[m.getFrameId(c.frame_b)].translation),
+                np.linalg.norm(d.oMi[self.cons[i].joint1_id].translation
+                               - d.oMf[m.getFrameId(c.frame_a)].translation)))))
+        raise_on_gaps(self.path, gaps, stated.link_length, "Pinocchio")
 
     def residual_and_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pin.computeJointJacobians(self.model, self.data, q)

@@ -148,43 +148,65 @@ def single_residual_jac(p: CouplerParams, phi_a: float, alpha_bx: float, alpha_b
     return 2.0 * np.column_stack([np.einsum("ij,ij->i", lv, dphi), lv])
 
 
-def _no_physical(p: CouplerParams, tilt: float, exc: SolverError) -> None:
+#: the admissibility rule in words, used by every error that refuses a pose (README "Physical pose")
+ADMISSIBLE = ("admissible poses keep every link's axial component positive along both shaft axes it joins "
+              "(l_k . s > 0): at l_k . s <= 0 a joint centre of one platform lies on or behind the other platform's "
+              "plane, i.e. the platform discs would interpenetrate; roughly e_y > R*alpha")
+
+
+def _no_physical(p: CouplerParams, tilt: float, exc: SolverError, inputs: str = "") -> None:
     """Re-raise a Gauss-Newton failure as GeometryError when the inclination makes the pose unphysical
     (e_y < ~1.5 R tilt: platform B would reach platform A's plane), else re-raise the SolverError."""
     if p.e_y < 1.5 * p.R * tilt:
-        raise GeometryError(f"no physical pose: e_y = {p.e_y:g} is too small for a relative inclination of {tilt:.4g} "
-                            f"rad (need e_y > ~R*alpha = {p.R * tilt:.4g}); platform B would cross platform A "
-                            f"[{exc}]") from exc
+        at = f" at {inputs}" if inputs else ""
+        raise GeometryError(f"no physical pose{at}: e_y = {p.e_y:g} m is too small for a relative inclination of "
+                            f"{tilt:.4g} rad (need e_y > ~R*alpha = {p.R * tilt:.4g} m); platform B would cross "
+                            f"platform A ({ADMISSIBLE}) [{exc}]") from exc
     raise exc
 
 
-def check_physical(p: CouplerParams, links: np.ndarray, axes: list[np.ndarray], what: str) -> None:
-    """Every link must leave the driving platform and reach the driven one from the same side: l_k . s > 0 for both
-    shaft axes s. Otherwise platform B would have crossed platform A (e_y too small for the inclination)."""
+def check_physical(p: CouplerParams, links: np.ndarray, axes: list[np.ndarray], what: str, inputs: str = "") -> None:
+    """The admissibility rule: every link must leave the driving platform and reach the driven one from the same side,
+    l_k . s > 0 for both shaft axes s. Otherwise a joint centre lies on or behind the other platform's plane: the
+    platform discs would interpenetrate (platform B crossed A; e_y too small for the inclination). The FPP equations
+    (4) still have a solution there (an independent solver converges to it); it is refused as GeometryError naming
+    the inputs, the link and its axial component."""
     for s in axes:
-        worst = float(np.min(links @ s) / p.link_length)
-        if worst <= 0.0:
+        ax = links @ s / p.link_length
+        k = int(np.argmin(ax))
+        if ax[k] <= 0.0:
+            at = f" at {inputs}" if inputs else ""
             raise GeometryError(
-                f"{what}: no physical pose - platform B would cross platform A (a link's axial component "
-                f"{worst:+.3g} l <= 0); e_y = {p.e_y:g} is too small for this misalignment (need e_y > ~R*alpha)")
+                f"{what}{at}: no physical pose - platform B would cross platform A (link {k + 1}'s axial component "
+                f"{ax[k]:+.3g} l <= 0); e_y = {p.e_y:g} m is too small for this misalignment ({ADMISSIBLE})")
+
+
+def _single_inputs(phi_a: float, alpha_bx: float, alpha_bz: float) -> str:
+    return f"phi_a = {phi_a:.6g} rad, alpha_bx = {alpha_bx:.6g} rad, alpha_bz = {alpha_bz:.6g} rad"
+
+
+def _double_inputs(inp: np.ndarray) -> str:
+    return ", ".join(f"{k} = {v:.6g} {u}" for k, v, u in zip(DOUBLE_INPUTS, inp, ("rad", "rad", "rad", "m", "m"),
+                                                                 strict=True))
 
 
 def solve_single(p: CouplerParams, phi_a: float, alpha_bx: float = 0.0, alpha_bz: float = 0.0,
                  guess: np.ndarray | None = None, *, tol: float = 1e-13) -> SinglePose:
     """Forward position problem of the single coupler (Gauss-Newton on Eq 4). Physical pose or GeometryError."""
     if p.e_y == 0.0 and (alpha_bx or alpha_bz):
-        raise GeometryError("single coupler FPP: e_y = 0 (coplanar platforms) admits no inclined physical pose; "
-                            "platform B would cross platform A")
+        raise GeometryError(f"single coupler FPP at {_single_inputs(phi_a, alpha_bx, alpha_bz)}: e_y = 0 (coplanar "
+                            f"platforms) admits no inclined physical pose; platform B would cross platform A "
+                            f"({ADMISSIBLE})")
     u0 = np.array([phi_a - math.pi / 2, 0.0, 0.0, 0.0]) if guess is None else np.asarray(guess, float)
     try:
         u, _ = gauss_newton(lambda u: single_residual(p, phi_a, alpha_bx, alpha_bz, u),
                             lambda u: single_residual_jac(p, phi_a, alpha_bx, alpha_bz, u), u0,
                             tol=tol * p.R**2, what=f"single coupler FPP at phi_a = {phi_a:.6g}")
     except SolverError as exc:
-        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc)
+        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc, _single_inputs(phi_a, alpha_bx, alpha_bz))
     a, b, _, Rb = single_points(p, phi_a, alpha_bx, alpha_bz, u)
     if p.e_y > 0.0:
-        check_physical(p, b[NEXT] - a, [EY, Rb @ EY], "single coupler FPP")
+        check_physical(p, b[NEXT] - a, [EY, Rb @ EY], "single coupler FPP", _single_inputs(phi_a, alpha_bx, alpha_bz))
     return SinglePose(phi_a, alpha_bx, alpha_bz, u)
 
 
@@ -258,7 +280,8 @@ def single_revolution(p: CouplerParams, alpha_bx: float = 0.0, alpha_bz: float =
     try:
         u = continuation(step, u0, phis, jump, "single coupler FPP")
     except SolverError as exc:
-        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc)
+        _no_physical(p, math.hypot(alpha_bx, alpha_bz), exc, f"alpha_bx = {alpha_bx:.6g} rad, alpha_bz = "
+                     f"{alpha_bz:.6g} rad over a revolution of phi_a")
     return SingleRevolution(phis, u, alpha_bx, alpha_bz)
 
 
@@ -486,11 +509,11 @@ def solve_double(p: CouplerParams, inp, guess: np.ndarray | None = None, *, tol:
         u, _ = gauss_newton(lambda u: double_residual(p, inp, u), lambda u: double_residual_jac(p, inp, u), u0,
                             tol=tol * p.R**2, what=f"double coupler FPP at phi_a = {inp[0]:.6g}")
     except SolverError as exc:
-        _no_physical(p, _double_tilt(p, inp), exc)
+        _no_physical(p, _double_tilt(p, inp), exc, _double_inputs(inp))
     if p.e_y > 0.0:
         a, ba, bc, c, _, Rb, _, Rc = double_points(p, inp, u)
-        check_physical(p, ba[NEXT] - a, [EY, Rb @ EY], "double coupler FPP (coupler A-BA)")
-        check_physical(p, c - bc[NEXT], [Rb @ EY, Rc @ EY], "double coupler FPP (coupler BC-C)")
+        check_physical(p, ba[NEXT] - a, [EY, Rb @ EY], "double coupler FPP (coupler A-BA)", _double_inputs(inp))
+        check_physical(p, c - bc[NEXT], [Rb @ EY, Rc @ EY], "double coupler FPP (coupler BC-C)", _double_inputs(inp))
     return u
 
 
@@ -535,7 +558,7 @@ def double_revolution(p: CouplerParams, alpha_cx: float = 0.0, alpha_cz: float =
     try:
         u = continuation(step, u0, phis, jump, "double coupler FPP")
     except SolverError as exc:
-        _no_physical(p, _double_tilt(p, np.r_[0.0, rest]), exc)
+        _no_physical(p, _double_tilt(p, np.r_[0.0, rest]), exc, _double_inputs(np.r_[phi_start, rest]))
     return DoubleRevolution(phis, u, rest)
 
 
@@ -640,9 +663,9 @@ def _check_physical_batch(p: CouplerParams, links: np.ndarray, axes: list[np.nda
         if bad.size:
             i = int(bad[0])
             raise GeometryError(
-                f"{what} at {_sample(i, inp, times)}: no physical pose - platform B would cross platform A (a link's "
-                f"axial component {worst[i]:+.3g} l <= 0; {bad.size} of {worst.size} samples); e_y = {p.e_y:g} is too "
-                "small for this misalignment (need e_y > ~R*alpha)")
+                f"{what} at {_sample(i, inp, times)}, {_double_inputs(inp[i])}: no physical pose - platform B would "
+                f"cross platform A (a link's axial component {worst[i]:+.3g} l <= 0; {bad.size} of {worst.size} "
+                f"samples); e_y = {p.e_y:g} m is too small for this misalignment ({ADMISSIBLE})")
 
 
 def solve_double_batch(p: CouplerParams, inp: np.ndarray, guess: np.ndarray, *, tol: float = 1e-13,
@@ -688,7 +711,7 @@ def solve_double_batch(p: CouplerParams, inp: np.ndarray, guess: np.ndarray, *, 
         res = f"residual |r|_inf = {rmax[i]:.3e}, " if fin else ""
         exc = SolverError(f"double coupler FPP: Gauss-Newton {why} at {_sample(i, inp, times)} ({res}tolerance "
                           f"{tol_abs:.1e}; {bad.size} of {rmax.size} samples)")
-        _no_physical(p, _double_tilt(p, inp[i]), exc)
+        _no_physical(p, _double_tilt(p, inp[i]), exc, _double_inputs(inp[i]))
     if p.e_y > 0.0:
         L, yb, yc, _ = _double_links_n(p, inp, u, False)
         ey = np.broadcast_to(EY, yb.shape)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...limits import Limit
 from ...registry import Effect, ModelSpec
 from .analysis import OUTPUTS, run
 from .params import IftommParams
@@ -14,7 +15,8 @@ SPEC = ModelSpec(
     summary="IFToMM benchmark gates: four-bar through singular positions (A02), over-constrained Bricard (A04)",
     params_cls=IftommParams,
     effects={"mechanism": Effect(("fourbar", "bricard"), "fourbar", "which benchmark mechanism")},
-    inputs={"initial": {"rate": "initial rate of the first (input) joint on the free motion [rad/s]"}},
+    inputs={"initial": {"rate": Limit(lo=-100.0, hi=100.0, unit="rad/s", default=0.0,
+                                      doc="initial rate of the first (input) joint on the free motion (0: at rest)")}},
     outputs=OUTPUTS,
     engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).parent / "scenes",

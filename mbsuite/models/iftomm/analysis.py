@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import SceneError
+from ...health import Figure
 from ...results import SimResult, assemble
 from ...scenes import Scene
-from .mechanisms import PinocchioMechanism, initial_velocity, mujoco_model, simulate_mujoco
+from .mechanisms import BAR, PinocchioMechanism, initial_velocity, mujoco_model, simulate_mujoco
 
 OUTPUTS = {"input_angle": "rad", "input_rate": "rad/s", "branch_angle": "rad", "energy": "J", "energy_drift": "J",
            "closure_residual": "m"}
@@ -22,7 +23,7 @@ def branch_angle(mechanism: str, q: np.ndarray) -> np.ndarray:
 def run(scene: Scene) -> SimResult:
     p = scene.build_params()
     mech = scene.effects["mechanism"]
-    rate = float(scene.input.get("rate", 6.0 if mech == "fourbar" else 0.0))
+    rate = float(scene.input.get("rate", 0.0))  # the scene loader fills in the declared default (0: at rest)
     sv = scene.solver
     if sv.engine == "mujoco":
         if sv.timestep * 2 > p.solref_timeconst + 1e-15:
@@ -31,8 +32,8 @@ def run(scene: Scene) -> SimResult:
         m = mujoco_model(mech, sv.timestep, sv.integrator, p.solref_timeconst, p.gravity)
         tr = simulate_mujoco(m, initial_velocity(m, rate), sv.duration, sv.sample_dt or sv.timestep)
     else:
+        pm = PinocchioMechanism(mech, p.gravity, p.penalty, p.penalty_omega)  # checks the file first (Pinocchio)
         m = mujoco_model(mech, 1e-3, "rk4", p.solref_timeconst, p.gravity)
-        pm = PinocchioMechanism(mech, p.gravity, p.penalty, p.penalty_omega)
         tr = pm.simulate(initial_velocity(m, rate), sv.duration, sv.sample_dt or 1e-2, method=sv.method,
                          rtol=sv.rtol, atol=sv.atol, max_step=sv.max_step)
     sig = {"input_angle": tr.q[:, 0], "input_rate": tr.v[:, 0], "branch_angle": branch_angle(mech, tr.q),
@@ -40,5 +41,39 @@ def run(scene: Scene) -> SimResult:
     stats = dict(tr.stats)
     stats.update({"energy_drift_max": float(np.max(np.abs(sig["energy_drift"]))),
                   "closure_residual_max": float(np.max(tr.closure)),
-                  "branch_angle_max": float(np.max(np.abs(sig["branch_angle"])))})
-    return assemble(scene, tr.t, sig, engine=sv.engine, stats=stats)
+                  "branch_angle_max": float(np.max(np.abs(sig["branch_angle"]))),
+                  "energy_scale": energy_scale(m, rate, p.gravity)})
+    return assemble(scene, tr.t, sig, engine=sv.engine, stats=stats, health=health(stats, sv.engine))
+
+
+#: health bounds, 5-6x the largest value measured on the shipped scenes (10 s, default solver settings):
+#: closure residual [m per m of bar]: MuJoCo 9.3e-5 (four-bar), 1.67e-4 (Bricard); Pinocchio 4.4e-16, 3.2e-7;
+#: energy drift [of `energy_scale`]: MuJoCo 6.0e-3 (0.359 J of 59.4 J; the soft closures' damping dissipates),
+#: 8.2e-4 (0.040 J of 49.1 J); Pinocchio 1.2e-7, 2.1e-6 (DOP853 rtol 1e-8)
+HEALTH_BOUNDS = {"mujoco": {"closure_residual": 1e-3, "energy_drift": 3e-2},
+                 "reference": {"closure_residual": 2e-6, "energy_drift": 1e-5}}
+
+
+def energy_scale(m, rate: float, gravity: float) -> float:
+    """The energy the motion can exchange [J]: the initial kinetic energy plus m g L for every moving bar (the most
+    potential energy a bar of length L can trade), independent of the potential's datum."""
+    import mujoco
+
+    d = mujoco.MjData(m)
+    d.qvel[:] = initial_velocity(m, rate)
+    mujoco.mj_forward(m, d)
+    bars = [b for b in range(1, m.nbody) if m.body_jntnum[b] > 0]
+    return float(d.energy[1] + sum(m.body_mass[b] for b in bars) * gravity * BAR)
+
+
+def health(stats: dict, engine: str) -> list[Figure]:
+    """`closure_residual` (largest closure gap over the run, bound relative to the bar length) and `energy_drift`
+    (largest |E(t) - E(0)| over the run relative to `energy_scale`: both benchmarks are conservative, no friction and
+    no input after t = 0)."""
+    b = HEALTH_BOUNDS[engine]
+    fix = ("lower params.solref_timeconst (stiffer closures) or solver.timestep" if engine == "mujoco" else
+           "lower solver.rtol / solver.atol")
+    return [Figure("closure_residual", stats["closure_residual_max"], b["closure_residual"] * BAR, "m",
+                   f"largest loop-closure gap over the run, bound {b['closure_residual']:g} x bar length", fix),
+            Figure("energy_drift", stats["energy_drift_max"] / stats["energy_scale"], b["energy_drift"], "",
+                   f"max |E(t) - E(0)| / energy scale {stats['energy_scale']:.4g} J (conservative benchmark)", fix)]

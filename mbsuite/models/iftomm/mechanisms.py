@@ -34,7 +34,7 @@ from scipy.integrate import solve_ivp
 from ...engines import core
 from ...engines import mujoco_engine as mje
 from ...engines import pinocchio_engine as pe
-from ...errors import SceneError, SolverError
+from ...errors import ModelFileError, SceneError, SolverError
 from ...paths import mjcf_path
 
 MECHANISMS = ("fourbar", "bricard")
@@ -60,11 +60,80 @@ class Trajectory:
     stats: dict = field(default_factory=dict)
 
 
+#: bar length of every benchmark bar [m] (the files' stated geometry)
+BAR = 1.0
+#: the stated geometry of each file: bodies and joints it must hold and its loop closures, each
+#: (connect name, body1, point on body1, body2 or "world", point on body2), points in the bodies' frames [m]
+DESIGN: dict[str, dict] = {
+    "fourbar": {"bodies": ("crank", "coupler", "rocker"), "joints": ("crank", "coupler", "rocker"),
+                # the coupler's far end C meets the rocker's tip: both bars BAR long, ground pivots BAR apart
+                "closures": (("C", "coupler", (BAR, 0.0, 0.0), "rocker", (0.0, BAR, 0.0)),)},
+    "bricard": {"bodies": ("bar1", "bar2", "bar3", "bar4", "bar5"), "joints": ("j1", "j2", "j3", "j4", "j5"),
+                # the sixth hinge (axis x through the cube corner (0, 0, 1)): two points of bar5's end on that axis
+                "closures": (("j6a", "bar5", (0.0, -BAR, 0.0), "world", (0.0, 0.0, BAR)),
+                             ("j6b", "bar5", (0.5 * BAR, -BAR, 0.0), "world", (0.5 * BAR, 0.0, BAR)))},
+}
+#: largest closure gap at the initial pose q = 0, relative to the bar length, accepted at load (files rounded to 6
+#: digits pass; a moved pivot or a changed bar length fails by orders of magnitude)
+CLOSURE_RTOL = 1e-6
+
+
+def _closure_error(path, name: str, body: str, gap: float, engine: str) -> ModelFileError:
+    return ModelFileError(f"{path}: loop closure {name!r} (body {body!r}) does not assemble at the initial pose q = 0 "
+                          f"({engine}): residual {gap:.4g} m > {CLOSURE_RTOL:g} x bar length {BAR:g} m; the file's "
+                          "pivots and bar lengths must match the stated geometry")
+
+
+def check_mujoco_model(m: mujoco.MjModel, path, mechanism: str) -> None:
+    """Checks at load of an IFToMM MJCF compiled from `path` (DESIGN): the bodies, joints and <connect>s are present
+    and join the stated bodies; each connect's anchor is the stated point and meets the stated point of its second
+    body at q = 0 (MuJoCo places the second side of a connect at compile time, so any geometry would "close"); every
+    moving body has mass > 0 and a positive definite inertia (triangle inequality). Else ModelFileError naming the
+    file, the body and the residual."""
+    des = DESIGN[mechanism]
+    ob = mujoco.mjtObj
+    missing = [f"body {n!r}" for n in des["bodies"] if mujoco.mj_name2id(m, ob.mjOBJ_BODY, n) < 0]
+    missing += [f"joint {n!r}" for n in des["joints"] if mujoco.mj_name2id(m, ob.mjOBJ_JOINT, n) < 0]
+    missing += [f"connect {c[0]!r}" for c in des["closures"] if mujoco.mj_name2id(m, ob.mjOBJ_EQUALITY, c[0]) < 0]
+    if missing:
+        raise ModelFileError(f"{path}: the IFToMM {mechanism} needs {', '.join(missing)}, which the file lacks")
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+
+    def world(body: str, pt) -> np.ndarray:
+        if body == "world":
+            return np.asarray(pt, float)
+        b = mujoco.mj_name2id(m, ob.mjOBJ_BODY, body)
+        return d.xpos[b] + d.xmat[b].reshape(3, 3) @ np.asarray(pt, float)
+
+    for name, b1, a, b2, b in des["closures"]:
+        e = mujoco.mj_name2id(m, ob.mjOBJ_EQUALITY, name)
+        id2 = 0 if b2 == "world" else mujoco.mj_name2id(m, ob.mjOBJ_BODY, b2)
+        if (m.eq_type[e] != mujoco.mjtEq.mjEQ_CONNECT or int(m.eq_obj1id[e]) != mujoco.mj_name2id(m, ob.mjOBJ_BODY, b1)
+                or int(m.eq_obj2id[e]) != id2):
+            raise ModelFileError(f"{path}: equality {name!r} must be a <connect> from body {b1!r} to {b2!r}")
+        gap = max(float(np.linalg.norm(m.eq_data[e, 0:3] - np.asarray(a))),
+                  float(np.linalg.norm(world(b1, a) - world(b2, b))))
+        if not gap <= CLOSURE_RTOL * BAR:
+            raise _closure_error(path, name, b2 if b2 != "world" else b1, gap, "MuJoCo")
+    for i in range(1, m.nbody):
+        if m.body_jntnum[i] == 0:
+            continue
+        inertia = np.sort(m.body_inertia[i])
+        if not (m.body_mass[i] > 0 and inertia[0] > 0 and inertia[0] + inertia[1] >= inertia[2] * (1 - 1e-12)):
+            raise ModelFileError(f"{path}: body {mujoco.mj_id2name(m, ob.mjOBJ_BODY, i)!r} has mass "
+                                 f"{m.body_mass[i]:g} kg and principal inertia {m.body_inertia[i].tolist()} kg m^2: a "
+                                 "moving body needs mass > 0 and a positive definite inertia (triangle inequality)")
+
+
 def mujoco_model(mechanism: str, timestep: float, integrator: str, solref_timeconst: float,
                  gravity: float) -> mujoco.MjModel:
+    """The mechanism's MJCF compiled and checked at load (`check_mujoco_model`), with the run's settings."""
     if mechanism not in MECHANISMS:
         raise SceneError(f"unknown IFToMM mechanism {mechanism!r}; valid: {list(MECHANISMS)}")
-    m = mje.load_model(mjcf_path(f"iftomm_{mechanism}"))
+    path = mjcf_path(f"iftomm_{mechanism}")
+    m = mje.load_model(path)
+    check_mujoco_model(m, path, mechanism)
     mje.set_integrator(m, integrator, timestep)
     m.eq_solref[:, 0] = solref_timeconst
     m.opt.gravity[:] = [0.0, -gravity, 0.0]
@@ -131,27 +200,34 @@ class PinocchioMechanism:
     """The MJCF read by Pinocchio with the closures of MuJoCo's compiled `connect`s (see module docstring)."""
 
     def __init__(self, mechanism: str, gravity: float, penalty: float = 1e7, omega: float = 10.0):
-        self.mj = mujoco_model(mechanism, 1e-3, "rk4", 0.004, gravity)
-        self.model = pe.load_mjcf(mjcf_path(f"iftomm_{mechanism}"))
+        if mechanism not in MECHANISMS:
+            raise SceneError(f"unknown IFToMM mechanism {mechanism!r}; valid: {list(MECHANISMS)}")
+        self.path = mjcf_path(f"iftomm_{mechanism}")
+        self.model = pe.load_mjcf(self.path)
         self.model.gravity.linear = np.array([0.0, -gravity, 0.0])
         self.data = self.model.createData()
+        # the stated closures (DESIGN) on Pinocchio's own frames, checked at the initial pose before anything else
+        self.closures = [Closure(*self._on_joint(b1, a), *self._on_joint(b2, b))
+                         for _, b1, a, b2, b in DESIGN[mechanism]["closures"]]
+        r0 = self.closure(pin.neutral(self.model)).reshape(-1, 3)
+        for (name, b1, _, b2, _), r in zip(DESIGN[mechanism]["closures"], r0, strict=True):
+            gap = float(np.linalg.norm(r))
+            if not gap <= CLOSURE_RTOL * BAR:
+                raise _closure_error(self.path, name, b2 if b2 != "world" else b1, gap, "Pinocchio")
+        self.mj = mujoco_model(mechanism, 1e-3, "rk4", 0.004, gravity)
         self.penalty, self.omega = float(penalty), float(omega)
         # the four-bar is integrated on its parallelogram branch q = (s, -s, s): a linear map, exact on that branch;
         # penalty and multiplier formulations leave the branch at the singular positions (README)
         self.branch = np.array([[1.0], [-1.0], [1.0]]) if mechanism == "fourbar" else None
-        self.closures = []
-        for e in range(self.mj.neq):
-            if self.mj.eq_type[e] != mujoco.mjtEq.mjEQ_CONNECT:
-                raise SceneError("only <connect> closures are supported")
-            b1, b2 = int(self.mj.eq_obj1id[e]), int(self.mj.eq_obj2id[e])
-            self.closures.append(Closure(self._joint_of(b1), self.mj.eq_data[e, 0:3].copy(), self._joint_of(b2),
-                                         self.mj.eq_data[e, 3:6].copy()))
 
-    def _joint_of(self, body: int) -> int:
-        if body <= 0 or self.mj.body_jntnum[body] == 0:
-            return 0  # world or the fixed root body (at the origin, identity)
-        name = mujoco.mj_id2name(self.mj, mujoco.mjtObj.mjOBJ_JOINT, int(self.mj.body_jntadr[body]))
-        return self.model.getJointId(name)
+    def _on_joint(self, body: str, point) -> tuple[int, np.ndarray]:
+        """(Pinocchio joint, the point in that joint's frame) of a point fixed in MJCF body `body` ("world": 0)."""
+        if body == "world":
+            return 0, np.asarray(point, float)
+        if not self.model.existFrame(body, pin.FrameType.BODY):
+            raise ModelFileError(f"{self.path}: Pinocchio finds no body {body!r} in the file")
+        f = self.model.frames[self.model.getFrameId(body, pin.FrameType.BODY)]
+        return int(f.parentJoint), f.placement.act(np.asarray(point, float))
 
     def _points(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pin.forwardKinematics(self.model, self.data, q)

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
-from ...errors import ParameterError
+from ...limits import check_fields, param
 
 
 @dataclass(frozen=True)
@@ -15,18 +14,12 @@ class IftommParams:
     penalty               Pinocchio reference: penalty factor p of the closure formulation [1/m^2 scale, -]
     penalty_omega         Pinocchio reference: closure-error natural frequency w [rad/s] (critically damped)"""
 
-    gravity: float = 9.81
-    solref_timeconst: float = 0.004
-    penalty: float = 1e7
-    penalty_omega: float = 10.0
+    gravity: float = param(9.81, lo=0.0, hi=1000.0, unit="m/s^2", doc="acceleration of gravity along -y")
+    solref_timeconst: float = param(0.004, lo=0.0, hi=1.0, lo_open=True, unit="s",
+                                    doc="MuJoCo soft-closure time constant (>= 2 timestep)")
+    penalty: float = param(1e7, lo=0.0, hi=1e15, lo_open=True, doc="Pinocchio reference: closure penalty factor p")
+    penalty_omega: float = param(10.0, lo=0.0, hi=1e6, lo_open=True, unit="rad/s",
+                                 doc="Pinocchio reference: closure-error natural frequency w (critically damped)")
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ParameterError(f"iftomm parameter {f.name} must be a finite number, got {v!r}")
-        if self.gravity < 0:
-            raise ParameterError(f"iftomm parameter gravity = {self.gravity!r} must be >= 0")
-        for name in ("solref_timeconst", "penalty", "penalty_omega"):
-            if getattr(self, name) <= 0:
-                raise ParameterError(f"iftomm parameter {name} = {getattr(self, name)!r} must be positive")
+        check_fields(self, "iftomm parameter")

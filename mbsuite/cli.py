@@ -16,10 +16,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from . import registry
-from .analysis.sweep import EXECUTORS, sweep_options
+from .analysis.sweep import EXECUTORS, MAX_POINTS, check_grid, parse_values, sweep_options
 from .errors import MbsuiteError
 from .limits import Limit
 from .results import Report, SimResult, format_table, to_jsonable
@@ -92,11 +90,13 @@ def _sweep_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="Dask scheduler address (tcp://HOST:PORT) for --executor dask")
     p.add_argument("--store", metavar="FILE", help="stream finished points to FILE (JSON lines) and resume from it")
+    p.add_argument("--max-points", type=int, default=None, metavar="N",
+                   help=f"size guard: most points of one sweep (default {MAX_POINTS})")
 
 
 def _sweeping(args: argparse.Namespace):
     return sweep_options(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
-                         store=getattr(args, "store", None))
+                         store=getattr(args, "store", None), max_points=getattr(args, "max_points", None))
 
 
 def _cmd_workprecision(args: argparse.Namespace) -> None:
@@ -156,26 +156,6 @@ def _cmd_hardcases(args: argparse.Namespace) -> None:
         raise MbsuiteError("hard case(s) failed: " + ", ".join(bad))
 
 
-def _parse_values(text: str) -> list:
-    """`a,b,c` or `start:stop:step` (stop included); numbers, true/false, or strings."""
-    if text.count(":") == 2 and "," not in text:
-        a, b, c = (float(x) for x in text.split(":"))
-        if c <= 0 or b < a:
-            raise MbsuiteError(f"bad range {text!r}: need start <= stop and step > 0")
-        return [float(v) for v in np.round(np.arange(a, b + 0.5 * c, c), 12)]
-    out: list = []
-    for v in text.split(","):
-        v = v.strip()
-        if v.lower() in ("true", "false"):
-            out.append(v.lower() == "true")
-            continue
-        try:
-            out.append(float(v))
-        except ValueError:
-            out.append(v)
-    return out
-
-
 def _cmd_sweep(args: argparse.Namespace) -> None:
     import itertools
 
@@ -190,9 +170,10 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
         if not sep or not dot or section not in ("input", "params", "solver", "effects"):
             raise MbsuiteError(f"--vary {spec!r}: expected SECTION.KEY=VALUES with SECTION in input, params, solver, "
                                "effects (e.g. input.frequency=1:30:0.5 or params.k_s=1e5,2e5)")
-        axes.append((section, name, _parse_values(vals)))
+        axes.append((section, name, parse_values(vals, max_points=args.max_points)))
     if not axes:
         raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")
+    check_grid([len(a[2]) for a in axes], max_points=args.max_points, what="--vary grid")
     combos = list(itertools.product(*[a[2] for a in axes]))
     points, engines = [], set()
     for combo in combos:
@@ -379,6 +360,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _fail(message: str, as_json: bool, kind: str) -> int:
     """One line on stderr (and, under --json, a JSON object on stdout); exit status 2."""
+    message = " ".join(message.split())  # messages quoting a solver's text may hold line breaks
     if as_json:
         print(json.dumps({"error": {"type": kind, "message": message}}))
     print(f"mbsuite: error: {message}", file=sys.stderr)

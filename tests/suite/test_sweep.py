@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import mujoco
@@ -16,7 +18,9 @@ import pytest
 from mbsuite import load_scene
 from mbsuite.analysis.sweep import (
     SweepStore,
+    check_grid,
     get_state,
+    parse_values,
     point_key,
     rollout_sweep,
     run_sweep,
@@ -77,7 +81,10 @@ def test_dask_localcluster_identical_to_local(tmp_path):
     local = run_sweep(scene_point, jobs, workers=2)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                                   local_directory=str(tmp_path)) as cluster:
-        via_addr = run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address)
+        store = tmp_path / "dask.jsonl"  # a store works with the cluster too: claims, results, resume
+        via_addr = run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address, store=store)
+        assert run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address,
+                         store=store) == via_addr
         with sweep_options(executor="dask", scheduler=cluster.scheduler_address):
             via_default = run_sweep(scene_point, jobs)  # how the CLI's --executor dask reaches analysis hooks
     assert via_addr == local
@@ -107,8 +114,11 @@ def test_store_streams_each_point_and_resume_skips_finished(tmp_path):
         run_sweep(_square, list(range(8)), workers=1, store=store)
     done = SweepStore(store).load()
     assert len(done) == 5  # points 0..4 were streamed before the failure
-    lines = [json.loads(x) for x in store.read_text().splitlines()]
-    assert [r["result"] for r in lines] == [0, 1, 4, 9, 16] and [r["point"] for r in lines] == [0, 1, 2, 3, 4]
+    lines = [json.loads(x)["body"] for x in store.read_text().splitlines()]
+    assert lines[0] == {"type": "header", "format": "mbsuite-sweep-store", "version": 1}
+    res = [r for r in lines if r["type"] == "result"]
+    assert [r["result"] for r in res] == [0, 1, 4, 9, 16] and [r["point"] for r in res] == [0, 1, 2, 3, 4]
+    assert [r["key"] for r in lines if r["type"] == "claim"] == [point_key(_square, x) for x in range(6)]
     # a store written for another function is not reused (the key includes the function)
     assert point_key(_square, 3) != point_key(_cube, 3)
     assert run_sweep(_cube, [0, 1, 2, 3], workers=1, store=store) == [0, 1, 8, 27]
@@ -183,3 +193,61 @@ def test_rollout_sweep_matches_python_loop_and_refuses_callbacks():
         assert np.array_equal(state[b, -1], get_state(m, d))  # same C code, same arithmetic
     with callbacks(passive=lambda m, d: None), pytest.raises(SceneError, match="without Python callbacks"):
         rollout_sweep(m, np.array(x0), ctrl)
+
+
+# ------------------------------------------------------------------------------------------------ sizes and values
+def test_parse_values_lists_and_ranges_stop_included():
+    assert parse_values("1:30:0.5") == [1.0 + 0.5 * i for i in range(59)]  # 1, 1.5, ..., 30
+    assert parse_values("0:0.3:0.1") == [0.0, 0.1, 0.2, 0.3]  # stop reached up to rounding, printed decimals
+    assert parse_values("2:2:1") == [2.0]
+    assert parse_values("1e5, 2e5,true,linear") == [1e5, 2e5, True, "linear"]
+    assert parse_values("1:3:1,10") == [1.0, 2.0, 3.0, 10.0]
+
+
+@pytest.mark.parametrize(("text", "match"), [
+    ("a:b:c", "range start 'a' is not a number"),
+    ("1:b:1", "range stop 'b' is not a number"),
+    ("1:2:0", "step 0 must be > 0"),
+    ("1:2:-0.5", "step -0.5 must be > 0"),
+    ("3:1:1", "stop 1 is below start 3"),
+    ("1:inf:1", "not finite"),
+    ("nan", "not finite"),
+    ("1,-inf", "not finite"),
+    ("1:2", "a range reads start:stop:step"),
+    ("1,,2", "empty item"),
+    ("", "empty"),
+])
+def test_parse_values_errors_name_the_text(text, match):
+    with pytest.raises(SceneError, match=match) as err:
+        parse_values(text)
+    assert repr(text) in str(err.value)
+
+
+def test_too_many_points_fail_before_anything_is_built():
+    t0 = time.perf_counter()
+    with pytest.raises(SceneError, match="1,000,000,000 points exceed the limit of 10,000"):
+        parse_values("1:1e9:1")  # what once exhausted the memory
+    with pytest.raises(SceneError, match="exceed the limit"):
+        parse_values("0:1:1e-300")  # the count overflows a float
+    with pytest.raises(SceneError, match="1,000,000 points exceed"):
+        check_grid([100, 100, 100])
+    with pytest.raises(SceneError, match="exceed the limit of 10,000"):
+        run_sweep(_cube, range(10**12), workers=1)
+    with pytest.raises(SceneError, match="more than 10,000"):
+        run_sweep(_cube, itertools.count(), workers=1)  # an endless generator is read only up to the limit
+    assert time.perf_counter() - t0 < 1.0
+    assert len(parse_values("1:20000:1", max_points=20_000)) == 20_000  # the limit can be raised
+    assert check_grid([100, 100], max_points=10_000) == 10_000
+    with sweep_options(max_points=5):
+        with pytest.raises(SceneError, match="6 points exceed the limit of 5"):
+            run_sweep(_cube, range(6), workers=1)
+    with pytest.raises(SceneError, match="max_points = 0 is invalid"):
+        run_sweep(_cube, [1], max_points=0)
+
+
+def test_scene_points_resume_from_the_store_identical(tmp_path):
+    """Real scene results (nested dicts of numpy-derived numbers) come back from the store equal to a fresh run."""
+    jobs = _jobs(2)
+    store = tmp_path / "scene.jsonl"
+    fresh = run_sweep(scene_point, jobs, workers=1, store=store)
+    assert run_sweep(scene_point, jobs, workers=1, store=store) == fresh == run_sweep(scene_point, jobs, workers=1)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...limits import Limit
 from ...registry import Effect, ModelSpec
 from .pantographs import validate_section
 from .params import CatenaryParams
@@ -36,7 +37,9 @@ SPEC = ModelSpec(
         "contact": Effect(("unilateral", "bilateral"), "unilateral",
                           "unilateral: penalty spring that only pushes; bilateral: attached (no contact loss)"),
     },
-    inputs={"passage": {"speed": "train speed (km/h); --speed overrides it"}},
+    inputs={"passage": {"speed": Limit(lo=0.0, lo_open=True, hi=1000.0, unit="km/h",
+                                       doc="train speed; --speed overrides it (below the CW wave speed: checked "
+                                           "against the parameters when the passage starts)")}},
     outputs={"contact_force": "N", "contact_force_filtered": "N", "position": "m", "head_height": "m",
              "wire_height": "m", "slack_droppers": "-", "uplift": "m"},
     engines=("reference", "mujoco"),

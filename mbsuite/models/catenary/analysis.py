@@ -15,12 +15,13 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError, SceneError
+from ...health import Figure
 from ...results import Report, SimResult, format_table, write_csv
 from ...results import assemble as assemble_result
 from .fe import CatenaryFE, assemble
 from .pantographs import Pantograph
 from .pantographs import build as build_pantograph
-from .params import CatenaryParams
+from .params import MAX_ELEMENT_STEPS, CatenaryParams
 from .sim import CoupledResult, CoupledSimulation
 from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
 
@@ -63,6 +64,39 @@ def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
     return info
 
 
+def passage_size(p: CatenaryParams, speed_ms: float, dt: float) -> tuple[int, int]:
+    """(FE elements, time steps) of a passage, computed from the parameters without building anything: each wire
+    has at least ceil(length / element_length) elements (key points only add some), the pantograph moves
+    x_end - x_start at speed_ms in steps of dt."""
+    per_wire = math.ceil(p.length / p.element_length)
+    steps = math.ceil((p.x_end - p.x_start) / (speed_ms * dt) - 1e-9)
+    return 2 * per_wire, steps
+
+
+def check_size(p: CatenaryParams, speed_ms: float, dt: float, max_steps: float | None = None) -> None:
+    """Refuse a passage whose elements x steps exceed `p.max_element_steps` (or whose steps exceed `max_steps`,
+    the scene's solver.max_steps) with a `SceneError` naming the settings, before anything is allocated."""
+    elements, steps = passage_size(p, speed_ms, dt)
+    what = (f"a passage of {p.x_end - p.x_start:g} m at {3.6 * speed_ms:g} km/h with dt = {dt:g} s is {steps:,} "
+            f"steps; element_length = {p.element_length:g} m gives about {elements:,} elements")
+    if elements * steps > p.max_element_steps:
+        raise SceneError(f"{what}: {float(elements) * steps:.3g} element-steps exceed params.max_element_steps = "
+                         f"{p.max_element_steps:.3g}; enlarge element_length or timestep, or raise "
+                         "max_element_steps if you mean it")
+    if max_steps is not None and steps > max_steps:
+        raise SceneError(f"{what}: exceeds solver.max_steps = {max_steps:.3g}; enlarge the timestep or raise "
+                         "solver.max_steps (CLI: --max-steps) if you mean it")
+
+
+def health(run: CatenaryRun) -> list[Figure]:
+    """Health figures of a passage: the train speed against the contact wire's wave speed (bound: the near-critical
+    ratio, above which the model's own results depend on mesh and step; see `speed_regime`)."""
+    return [Figure("speed_ratio", float(run.regime["speed_ratio"]), NEAR_CRITICAL_RATIO, "",
+                   "train speed / contact wire wave speed sqrt(T/rho)",
+                   f"lower input.speed below {3.6 * NEAR_CRITICAL_RATIO * run.regime['cw_wave_speed_ms']:.1f} km/h "
+                   "or raise cw_tension; a near-critical passage needs its own mesh and step convergence study")]
+
+
 @dataclass
 class CatenaryRun:
     """A coupled run with its EN 50318 statistics."""
@@ -88,17 +122,20 @@ class CatenaryRun:
 def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = "slack",
              pantograph: str | Pantograph = "reference2mass", contact: str = "unilateral",
              progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
-             engine: str = "reference", pantograph_section: dict[str, Any] | None = None) -> CatenaryRun:
+             engine: str = "reference", pantograph_section: dict[str, Any] | None = None,
+             max_steps: float | None = None) -> CatenaryRun:
     """Build, run and analyse one pantograph passage (the EN 50318 procedure). `pantograph` is a name
     (the scene's `pantograph` effect, built on the engine path `engine` with the `[pantograph]` section
-    `pantograph_section`; see `pantographs.build`) or an object of the pantograph protocol. The speed is checked before
-    anything is built or integrated."""
+    `pantograph_section`; see `pantographs.build`) or an object of the pantograph protocol. The speed and the size of
+    the job (`check_size`: elements x steps against `p.max_element_steps`, steps against `max_steps`) are checked
+    before anything is built or integrated."""
     if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
         raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ParameterError(f"time step must be positive, got {dt!r}")
     V = speed_kmh / 3.6
     regime = speed_regime(p, V)
+    check_size(p, V, dt, max_steps)
     t0, c0 = time.perf_counter(), time.process_time()
     fe = fe if fe is not None else assemble(p)
     if isinstance(pantograph, str):
@@ -132,8 +169,8 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     if eng_warn:
         warn.append(f"MuJoCo warnings in the pantograph model: {eng_warn}")
     # the EN 50318 ranges apply to the reference scene only: 2-mass pantograph, specification's parameters
-    is_reference = name == "reference2mass" and dataclasses.replace(p, element_length=1.0) == CatenaryParams(
-        element_length=1.0)
+    is_reference = name == "reference2mass" and dataclasses.replace(
+        p, element_length=1.0, max_element_steps=MAX_ELEMENT_STEPS) == CatenaryParams(element_length=1.0)
     return CatenaryRun(params=p, speed_kmh=float(speed_kmh), dt=float(dt), dropper_law=dropper_law,
                        pantograph=name, result=res, stats=stats, filtered=ff, regime=regime, timing=timing,
                        ranges=check_ranges(stats, speed_kmh) if is_reference else None, warnings=warn,
@@ -157,7 +194,8 @@ def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides)
         p = dataclasses.replace(p, **overrides)
     return simulate(p, scene_speed(scene, speed_kmh), scene.solver.timestep, dropper_law=scene.effects["droppers"],
                     pantograph=scene.effects["pantograph"], contact=scene.effects["contact"], progress=progress,
-                    engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"))
+                    engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"),
+                    max_steps=scene.solver.max_steps)
 
 
 def to_simresult(run: CatenaryRun, scene) -> SimResult:
@@ -170,7 +208,8 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
                "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
     stats = {**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
              "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings)}
-    res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats)
+    res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats,
+                          health=health(run))
     if "uplift" in scene.outputs:
         unit = scene.spec.outputs["uplift"]
         for j, xs in enumerate(r.support_x):

@@ -10,6 +10,11 @@ import math
 from dataclasses import dataclass, field
 
 from ...errors import ParameterError
+from ...limits import check_fields, param
+
+#: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
+#: dt 2e-4 s, 250 km/h: 7.3e7; the finest convergence level, 0.125 m at 5e-5 s: 1.2e9)
+MAX_ELEMENT_STEPS = 5e9
 
 #: EN 50318 reference dropper positions from the span's first support (m), catenary.md "Model data"
 EN50318_DROPPERS = (5.0, 10.5, 17.0, 23.5, 30.0, 36.5, 43.0, 49.5, 55.0)
@@ -20,62 +25,53 @@ class CatenaryParams:
     """Catenary (2-D, vertical plane), 2-mass reference pantograph, contact and analysis settings (catenary.md)."""
 
     # --- catenary geometry and wires -------------------------------------------------------------------------------
-    n_spans: int = 10  #: number of spans (-)
-    span_length: float = 60.0  #: span length (m)
-    cw_mass: float = 1.35  #: contact wire mass per length (kg/m)
-    cw_tension: float = 20000.0  #: contact wire tension (N)
-    cw_EI: float = 195.0  #: contact wire bending stiffness (N m^2)
-    mw_mass: float = 1.07  #: messenger wire mass per length (kg/m)
-    mw_tension: float = 16000.0  #: messenger wire tension (N)
-    mw_EI: float = 131.7  #: messenger wire bending stiffness (N m^2)
-    dropper_positions: list[float] = field(default_factory=lambda: list(EN50318_DROPPERS))  #: from support (m)
-    k_dropper: float = 1.0e5  #: dropper axial stiffness (N/m), massless
-    k_steady_arm: float = 300.0  #: steady arm: CW to ground at each support (N/m)
-    k_messenger_support: float = 5.0e4  #: messenger support: MW to ground at each support (N/m)
-    zeta: float = 0.005  #: Rayleigh damping ratio matched at f_damp1 and f_damp2 (-)
-    f_damp1: float = 1.0  #: first Rayleigh matching frequency (Hz)
-    f_damp2: float = 20.0  #: second Rayleigh matching frequency (Hz)
-    g: float = 9.81  #: gravitational acceleration for the static state (m/s^2)
-    element_length: float = 0.25  #: target FE element length (m); key points (supports, droppers) are always nodes
+    n_spans: int = param(10, lo=1, hi=1000, kind=int, unit="-", doc="number of spans")
+    span_length: float = param(60.0, lo=0.0, lo_open=True, hi=1000.0, unit="m", doc="span length")
+    cw_mass: float = param(1.35, lo=0.0, lo_open=True, hi=100.0, unit="kg/m", doc="contact wire mass per length")
+    cw_tension: float = param(20000.0, lo=0.0, lo_open=True, hi=1e6, unit="N", doc="contact wire tension")
+    cw_EI: float = param(195.0, lo=0.0, hi=1e6, unit="N m^2", doc="contact wire bending stiffness")
+    mw_mass: float = param(1.07, lo=0.0, lo_open=True, hi=100.0, unit="kg/m", doc="messenger wire mass per length")
+    mw_tension: float = param(16000.0, lo=0.0, lo_open=True, hi=1e6, unit="N", doc="messenger wire tension")
+    mw_EI: float = param(131.7, lo=0.0, hi=1e6, unit="N m^2", doc="messenger wire bending stiffness")
+    #: dropper positions from the span's first support (m); checked below (inside the span, increasing)
+    dropper_positions: list[float] = field(default_factory=lambda: list(EN50318_DROPPERS))
+    k_dropper: float = param(1.0e5, lo=0.0, lo_open=True, hi=1e10, unit="N/m", doc="dropper axial stiffness "
+                                                                                       "(massless)")
+    k_steady_arm: float = param(300.0, lo=0.0, hi=1e10, unit="N/m", doc="steady arm: CW to ground at each support")
+    k_messenger_support: float = param(5.0e4, lo=0.0, hi=1e10, unit="N/m",
+                                       doc="messenger support: MW to ground at each support")
+    zeta: float = param(0.005, lo=0.0, hi=1.0, unit="-", doc="Rayleigh damping ratio at f_damp1 and f_damp2")
+    f_damp1: float = param(1.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz", doc="first Rayleigh matching frequency")
+    f_damp2: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz", doc="second Rayleigh matching frequency")
+    g: float = param(9.81, lo=0.0, hi=100.0, unit="m/s^2", doc="gravitational acceleration for the static state")
+    element_length: float = param(0.25, lo=0.0, lo_open=True, hi=1000.0, unit="m",
+                                  doc="target FE element length; key points (supports, droppers) are always nodes")
     # --- reference pantograph (two lumped masses on a fixed base) ----------------------------------------------------
-    m1: float = 7.2  #: head mass (kg)
-    k1: float = 4200.0  #: head suspension stiffness, head to frame (N/m)
-    c1: float = 10.0  #: head suspension damping (N s/m)
-    m2: float = 15.0  #: frame mass (kg)
-    k2: float = 50.0  #: frame stiffness to the base, referenced to the undisturbed CW level (N/m)
-    c2: float = 90.0  #: frame damping to the base (N s/m)
-    F0: float = 120.0  #: static uplift force on the frame mass (N)
+    m1: float = param(7.2, lo=0.0, lo_open=True, hi=1e4, unit="kg", doc="head mass")
+    k1: float = param(4200.0, lo=0.0, lo_open=True, hi=1e9, unit="N/m", doc="head suspension stiffness")
+    c1: float = param(10.0, lo=0.0, hi=1e7, unit="N s/m", doc="head suspension damping")
+    m2: float = param(15.0, lo=0.0, lo_open=True, hi=1e4, unit="kg", doc="frame mass")
+    k2: float = param(50.0, lo=0.0, hi=1e9, unit="N/m",
+                      doc="frame stiffness to the base, referenced to the undisturbed CW level")
+    c2: float = param(90.0, lo=0.0, hi=1e7, unit="N s/m", doc="frame damping to the base")
+    F0: float = param(120.0, lo=-1e5, hi=1e5, unit="N", doc="static uplift force on the frame mass (<= 0: the head "
+                                                                "leaves the wire)")
     # --- contact and run ------------------------------------------------------------------------------------------
-    k_contact: float = 5.0e4  #: penalty contact stiffness (N/m)
-    x_start: float = 0.0  #: pantograph start position (m)
-    x_end: float = 420.0  #: pantograph end position (m)
+    k_contact: float = param(5.0e4, lo=0.0, lo_open=True, hi=1e10, unit="N/m", doc="penalty contact stiffness")
+    x_start: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="pantograph start position")
+    x_end: float = param(420.0, lo=0.0, hi=1e6, unit="m", doc="pantograph end position")
     # --- analysis (EN 50318 statistics) -------------------------------------------------------------------------
-    window_start: float = 240.0  #: start of the statistics window (m)
-    window_end: float = 360.0  #: end of the statistics window (m)
-    filter_cutoff: float = 20.0  #: low-pass cut-off of the contact force (Hz)
-    filter_order: int = 4  #: Butterworth order (applied forwards and backwards)
+    window_start: float = param(240.0, lo=0.0, hi=1e6, unit="m", doc="start of the statistics window")
+    window_end: float = param(360.0, lo=0.0, hi=1e6, unit="m", doc="end of the statistics window")
+    filter_cutoff: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz",
+                                 doc="low-pass cut-off of the contact force")
+    filter_order: int = param(4, lo=1, hi=10, kind=int, unit="-", doc="Butterworth order (forwards and backwards)")
+    # --- size guard -------------------------------------------------------------------------------------------
+    max_element_steps: float = param(MAX_ELEMENT_STEPS, lo=1.0, hi=1e15, unit="-",
+                                     doc="size guard: FE elements x time steps a passage may take")
 
     def __post_init__(self) -> None:
-        positive = ("span_length", "cw_mass", "cw_tension", "mw_mass", "mw_tension", "k_dropper", "f_damp1",
-                    "f_damp2", "element_length", "m1", "k1", "m2", "k_contact", "filter_cutoff")
-        non_negative = ("cw_EI", "mw_EI", "k_steady_arm", "k_messenger_support", "zeta", "g", "c1", "c2", "k2")
-        finite = ("F0", "x_start", "x_end", "window_start", "window_end")
-        for name in positive + non_negative + finite:
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ParameterError(f"catenary parameter {name} must be a finite number, got {v!r}")
-        for name in positive:
-            if getattr(self, name) <= 0:
-                what = "tension" if "tension" in name else "value"
-                raise ParameterError(
-                    f"catenary parameter {name} must be > 0 (a positive {what}), got {getattr(self, name)!r}")
-        for name in non_negative:
-            if getattr(self, name) < 0:
-                raise ParameterError(f"catenary parameter {name} must be >= 0, got {getattr(self, name)!r}")
-        for name in ("n_spans", "filter_order"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ParameterError(f"catenary parameter {name} must be a positive integer, got {v!r}")
+        check_fields(self, "catenary parameter")
         if not self.f_damp2 > self.f_damp1:
             raise ParameterError(f"f_damp2 ({self.f_damp2}) must be above f_damp1 ({self.f_damp1})")
         dp = self.dropper_positions

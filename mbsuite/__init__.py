@@ -9,6 +9,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
+from . import native  # noqa: E402  (mbsuite.native.load(): register the engine plugins with MuJoCo)
 from .errors import (  # noqa: E402
     GeometryError,
     MbsuiteError,
@@ -52,6 +53,7 @@ __all__ = [
     "model_file",
     "model_files",
     "models",
+    "native",
     "run",
     "scene_from_dict",
 ]

@@ -1,0 +1,95 @@
+"""The documentation's code is live: every ```python block of the README and of each model README runs (blocks of one
+file in order, sharing a namespace, from a directory that is not the repository root); every TOML scene block is a
+valid scene or scene fragment; every `mbsuite ...` command line in the docs is accepted by the command-line parser.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import shlex
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import mbsuite
+from mbsuite.cli import build_parser
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "mbsuite" / "models").glob("*/README.md")),
+        *sorted((ROOT / "docs").glob("*.md"))]
+FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.S | re.M)
+PLACEHOLDER = re.compile(r"[A-Z]{2,}|\[|\.\.\.|\||<")
+
+
+def _blocks(path: Path, lang: str) -> list[str]:
+    return [body for kind, body in FENCE.findall(path.read_text()) if kind == lang]
+
+
+def _ids(paths: list[Path]) -> list[str]:
+    return [str(p.relative_to(ROOT)) for p in paths]
+
+
+WITH_PYTHON = [p for p in DOCS if _blocks(p, "python")]
+
+
+@pytest.mark.parametrize("path", WITH_PYTHON, ids=_ids(WITH_PYTHON))
+def test_python_blocks_run_outside_the_checkout(path, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {"__name__": "__doc_example__"}
+    for i, code in enumerate(_blocks(path, "python")):
+        with contextlib.redirect_stdout(io.StringIO()):
+            exec(compile(code, f"{path.name}[python block {i}]", "exec"), namespace)  # noqa: S102
+
+
+def test_there_are_python_examples():
+    assert sum(len(_blocks(p, "python")) for p in DOCS) >= 2
+
+
+def _toml_blocks() -> list[tuple[Path, str]]:
+    return [(p, b) for p in DOCS for b in _blocks(p, "toml")]
+
+
+@pytest.mark.parametrize(("path", "block"), _toml_blocks(), ids=[str(p.relative_to(ROOT)) for p, _ in _toml_blocks()])
+def test_toml_blocks_are_valid_scenes_or_fragments(path, block):
+    data = tomllib.loads(block)
+    if "model" in data:
+        mbsuite.scene_from_dict(data)
+        return
+    # a fragment: it belongs to the model whose README holds it (the top-level README's fragments to the pantograph)
+    model = path.parent.name if path.parent.parent.name == "models" else "pantograph"
+    base = mbsuite.load_scene(model).to_dict()
+    for key, val in data.items():
+        if isinstance(val, dict) and isinstance(base.get(key), dict):
+            base[key].update(val)
+        else:
+            base[key] = val
+    mbsuite.scene_from_dict(base)
+
+
+def _command_lines() -> list[tuple[Path, str]]:
+    out = []
+    for p in DOCS:
+        for kind, body in FENCE.findall(p.read_text()):
+            if kind not in ("", "bash", "sh", "console"):
+                continue
+            for line in body.splitlines():
+                cmd = line.split("#")[0].strip()
+                if cmd.startswith("mbsuite ") and not PLACEHOLDER.search(cmd.replace("--", "")):
+                    out.append((p, cmd))
+    return out
+
+
+COMMANDS = _command_lines()
+
+
+@pytest.mark.parametrize(("path", "cmd"), COMMANDS, ids=[c for _, c in COMMANDS])
+def test_command_lines_parse(path, cmd):
+    args = build_parser().parse_args(shlex.split(cmd)[1:])
+    assert callable(args.func)
+
+
+def test_there_are_command_examples():
+    assert len(COMMANDS) >= 5

@@ -1,4 +1,7 @@
-"""The coupler's suite declarations (`SPEC.cases`): hard cases, work-precision study, random input."""
+"""The coupler's suite declarations (`SPEC.cases`): the hard cases' strict error checks and random input.
+
+Every hard case runs once, in `tests/suite/test_hardcases.py` (`pytest tests/suite/test_hardcases.py -k coupler`);
+the work-precision study runs in `test_workprecision.py`."""
 
 from __future__ import annotations
 
@@ -7,15 +10,14 @@ import zlib
 import numpy as np
 import pytest
 
-import mbsuite
 from mbsuite import hardcases
-from mbsuite.analysis.workprecision import Study
+from mbsuite.errors import SceneError, SolverError
+from mbsuite.hardcases import Checker
 from mbsuite.models.coupler import SPEC
+from mbsuite.models.coupler.cases import _raises_exactly
 from mbsuite.scenes import load_scene
 
 CASES = SPEC.suite()
-
-PARAMS = [pytest.param(c, id=c.name, marks=([pytest.mark.slow] if c.slow else [])) for c in CASES.HARD_CASES]
 
 
 def test_spec_points_at_this_module():
@@ -28,10 +30,22 @@ def test_spec_points_at_this_module():
         assert c.hard and c.scene and c.asserts and not c.expected_failure, c.name
 
 
-@pytest.mark.parametrize("case", PARAMS)
-def test_hard_case(case):
-    out = hardcases.run_case(case)
-    assert out.passed, out.text()
+def test_strict_error_check_fails_on_any_other_outcome():
+    """`_raises_exactly` passes only on the named type with every phrase: a result, another type or a missing phrase
+    is a failed check (so a case expecting an error cannot pass by returning)."""
+    def boom(exc, msg):
+        def f():
+            raise exc(msg)
+        return f
+
+    outcomes = [(boom(SolverError, "torque_in out of range; use implicitfast"), True),
+                (boom(SolverError, "torque_in out of range"), False),  # a phrase missing
+                (boom(SceneError, "torque_in out of range; use implicitfast"), False),  # another type
+                (lambda: 1.0, False)]  # no error: a result
+    for fn, want in outcomes:
+        ck = Checker()
+        _raises_exactly(ck, "x", fn, SolverError, ("torque_in", "use implicitfast"))
+        assert [c.ok for c in ck.checks] == [want]
 
 
 def test_timestep_cases_assert_what_happens():
@@ -55,25 +69,4 @@ def test_random_input_is_admissible_and_reproducible():
         for k in ("omega", "load_torque"):
             assert 0.5 <= new.input[k] / sc.input[k] <= 1.5
         assert new.input["z_c"] / sc.input["z_c"] == pytest.approx(1.0, abs=0.2)
-    sc = load_scene("coupler/double_inclined")
-    res = mbsuite.run(sc.replace(**CASES.random_input(sc, np.random.default_rng(1)),
-                                 solver={"duration": 0.6, "t_settle": 0.3}))
-    assert res.stats["warnings"] == {} and all(np.all(np.isfinite(v)) for v in res.signals.values())
-
-
-def test_workprecision_study_quick():
-    """The study's errors fall as the settings tighten (FPP tolerance; MuJoCo timestep)."""
-    st = CASES.workprecision_study(load_scene("coupler/double_lateral"), quick=True)
-    assert isinstance(st, Study)
-    ref, info = st.reference()
-    assert "least_squares" in info["reference"]
-    rows = {}
-    for s in st.settings():
-        res = s.run()
-        rows[(s.engine, s.method, s.setting)] = (st.state_error(res, ref), *st.physics_error(res, ref))
-    loose, tight = rows[("fpp", "gauss-newton", "tol 0.0001, 37 steps")], rows[("fpp", "gauss-newton",
-                                                                               "tol 1e-08, 37 steps")]
-    assert tight[1] < 1e-3 * loose[1]
-    assert tight[2]["closure_residual"] <= 1e-8  # the Gauss-Newton tolerance bounds the residual
-    a, b = rows[("mujoco", "implicitfast", 1e-3)], rows[("mujoco", "implicitfast", 5e-4)]
-    assert b[0] < a[0]
+    # running the scenes under these inputs is tests/suite/test_menagerie.py's job (every shipped scene, 1 s)

@@ -72,8 +72,8 @@ def test_admissibility_boundary(e_y):
 
 
 # -------------------------------------------------------------------------------------------------------- c5
-@pytest.mark.parametrize("l_b, c5_ref", [(2.0, 1.37364e-3), (4.0, 3.59042e-4)])
-def test_c5_extremum_converged_against_brute_force(l_b, c5_ref):
+@pytest.mark.parametrize("l_b", [2.0, 4.0])
+def test_c5_extremum_converged_against_brute_force(l_b):
     p = CouplerParams(l_b=l_b, phi_bc=math.pi / 2)
     c = analysis.double_c5(p, 0.1, n=61)
     # brute force: 4096 samples over [0, 2 pi) (no closing sample) by the batched FPP, a different solver path
@@ -93,7 +93,6 @@ def test_c5_extremum_converged_against_brute_force(l_b, c5_ref):
     # and the brute maximum refined by the parabola through its 3 best samples (measured 9e-12, 2e-12 relative)
     x = 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
     assert c["c5"] == pytest.approx(y1 - 0.25 * (y0 - y2) * x, rel=1e-9)
-    assert c["c5"] == pytest.approx(c5_ref, rel=5e-6)  # the converged values at 5 digits
     assert c["mean"] == pytest.approx(mean, abs=1e-13)  # trapezoid-free periodic mean
     assert (c["c5"] - c["c5_sampled"]) / c["c5"] > 5e-3  # 61 samples alone under-read by 0.53-0.55 %
     assert analysis.double_c5(p, 0.1, n=31)["c5"] == pytest.approx(c["c5"], rel=1e-9)  # independent of the grid
@@ -104,7 +103,9 @@ def test_periodic_mean_counts_the_closing_sample_once():
     assert analysis.periodic_mean(1.0 + np.cos(x)) == pytest.approx(1.0, abs=1e-15)  # closed-grid mean: 1.142857
 
 
-def test_criteria_table_names_its_double_geometry(capsys):
+def test_regression_criteria_table_double_c5(capsys):
+    """The double-coupler table names its geometry; its c5 is the README's converged value (regression: validated
+    against a 4096-sample brute force in test_c5_extremum_converged_against_brute_force)."""
     rep = analysis.criteria_report(gammas=(0.297,), eys=(0.1,), alphas=(0.07,), zcs=(0.1,), lbs=(2.0,),
                                    phibcs=(math.pi / 2,), n=121)
     assert "gamma = 0.29671 rad (17 deg), e_y = 0.1, R = 1" in rep.table
@@ -219,9 +220,10 @@ def test_health_figures_on_both_engines():
     mj = mbsuite.run(sc)
     (fig,) = mj.health
     l = sc.build_params().link_length
-    # the closure gap over the run is the start-up ramp's peak (9.45e-4 m measured), bound 5e-3 l
+    # the figure is the closure gap over the whole run, start-up ramp included (its peak: 9.45e-4 m measured, 34x the
+    # settled 2.77e-5 m), bound 5e-3 l
     assert fig.name == "closure_residual" and fig.bound == pytest.approx(5e-3 * l)
-    assert fig.value == pytest.approx(mj.stats["closure_residual_max_all"]) and 5e-4 < fig.value < 2e-3
+    assert fig.value == np.max(mj["closure_residual"]) and fig.value > 10 * mj.stats["closure_residual_max"]
     rf = mbsuite.run(sc, engine="reference")
     assert rf.health[0].value < 1e-12  # rigid FPP: |r| <= 1e-13 R^2
     from mbsuite.health import judge

@@ -1,8 +1,8 @@
-"""MuJoCo double-coupler dynamics against the kinematics; shipped scenes; effects; bad input."""
+"""MuJoCo double-coupler dynamics against the kinematics, the power balance, the virtual-work link forces and the
+rigid-shaft reference; effects; bad input. (Stepping every shipped scene without NaN or warning is
+tests/suite/test_menagerie.py's job; here each shipped scene carries a physical invariant.)"""
 
 from __future__ import annotations
-
-import math
 
 import mujoco
 import numpy as np
@@ -17,19 +17,26 @@ from mbsuite.scenes import load_scene
 
 
 @pytest.mark.parametrize("name", sorted(SPEC.scene_files()))
-def test_shipped_scenes_step_one_second_without_warnings(name):
+def test_shipped_scenes_power_balance(name):
+    """Power balance over the settled revolution (0.5-1 s at 2 rev/s): T_in w_a = T_load w_c + losses, with w_c = w_a
+    on average. Without friction the only losses are the S joints' viscous damping and the closures' damping: mean
+    T_in = T_load, measured |error| <= 7.0e-6 T_load (bound 7x). With friction the output bearing dissipates exactly
+    joint_friction x w_c, so T_in - T_load >= joint_friction; the S joints add 4.3 % of it (measured 2.087 N m for
+    2 N m; bound 10 %, 2.5x)."""
     sc = load_scene(f"coupler/{name}").replace(solver={"duration": 1.0})
     res = mbsuite.run(sc)
-    assert res.stats["warnings"] == {}
-    assert res.t[-1] == pytest.approx(1.0)
-    # output follows the kinematic solution; closures stay closed (bounds justified in README)
-    assert res.stats["phi_c_err_max"] < 5e-4
-    assert res.stats["closure_residual_max"] < 2e-4 * SPEC.params_cls().R
+    load, excess = sc.input["load_torque"], res.stats["torque_in_mean"] - sc.input["load_torque"]
+    if sc.effects["friction"]:
+        f = sc.build_params().joint_friction
+        assert f <= excess <= 1.1 * f
+    else:
+        assert abs(excess) <= 5e-5 * load
 
 
 def test_lateral_offset_agreement_and_torque_balance():
-    """Baseline scene: phi_c(t) within 1e-4 rad of the FPP, closure residual < 1e-4 R, mean input torque = load
-    (energy balance over whole revolutions), and the homokinetic phi_bc = 0 coupler has a small ripple."""
+    """Baseline scene, 2 s: phi_c(t) within 1e-4 rad of the FPP (measured 3.5e-5), closure residual < 1e-4 R
+    (3.75e-5), mean input torque = load (power balance over 3 whole revolutions), and the homokinetic phi_bc = 0
+    coupler has a small ripple (0.70 %: the links' own inertia)."""
     sc = load_scene("coupler/double_lateral")
     r = mbsuite.run(sc)
     s = r.stats
@@ -37,12 +44,13 @@ def test_lateral_offset_agreement_and_torque_balance():
     assert s["phi_c_kin_fluctuation_pp"] < 1e-12  # kinematically homokinetic
     assert s["phi_c_err_max"] < 1e-4
     assert s["closure_residual_max"] < 1e-4
-    assert s["torque_in_mean"] == pytest.approx(1000.0, rel=1e-3)
+    assert s["torque_in_mean"] == pytest.approx(1000.0, rel=5e-5)  # power balance, 3 revolutions: 6.4e-6 measured
     assert s["torque_in_ripple_rel"] < 0.02
 
 
 def test_massless_limit_forces_match_quasi_static():
-    """Massless-link limit, no gravity: the mean link forces equal the virtual-work link forces within 2 %."""
+    """Massless-link limit, no gravity: the mean link forces equal the virtual-work link forces (+-284.7 N) within 2 %
+    (measured 0.74 %: the links' 5 % mass and the soft closures)."""
     sc = load_scene("coupler/double_massless")
     r = mbsuite.run(sc)
     p = sc.build_params()
@@ -55,7 +63,8 @@ def test_massless_limit_forces_match_quasi_static():
                                          ("double_inclined", {"gravity": False})])
 def test_torque_ripple_matches_rigid_reference(name, extra):
     """Light links (5 % mass), no gravity: the MuJoCo input torque follows the rigid-shaft power balance
-    T_in w_a = d/dt(E_b + I_c w_c^2/2) + T_load w_c within 5 % of its ripple + 0.2 N m (the 5 % link inertia left)."""
+    T_in w_a = d/dt(E_b + I_c w_c^2/2) + T_load w_c within 5 % of its ripple + 0.2 N m (the 5 % link inertia left;
+    measured 0.70 of 2.42 N m allowed (phi_bc = pi/2), 0.099 of 0.39 (lateral), 0.030 of 0.23 (inclined))."""
     sc = load_scene(f"coupler/{name}").replace(effects={"link_inertia": "massless", **extra},
                                                params={"massless_factor": 0.05, "solref_timeconst": 1e-3},
                                                solver={"duration": 1.5})
@@ -65,7 +74,7 @@ def test_torque_ripple_matches_rigid_reference(name, extra):
     t_ref = np.interp(rm["phi_a"][w], rr["phi_a"], rr["torque_in"])
     ripple = np.ptp(t_ref)
     assert np.max(np.abs(rm["torque_in"][w] - t_ref)) < 0.05 * ripple + 0.2
-    assert np.mean(rm["torque_in"][w]) == pytest.approx(np.mean(t_ref), abs=0.1)
+    assert np.mean(rm["torque_in"][w]) == pytest.approx(np.mean(t_ref), abs=0.03)  # measured <= 7.7e-3 N m
     if name == "double_phibc90":  # inertial ripple of the output shaft dominates the quasi-static one
         assert ripple > 5 * rr.stats["torque_in_ripple_quasi_static_pp"]
 
@@ -85,13 +94,6 @@ def test_effects_switch_model_content():
     assert "y_c" in names and "phi_c" in names and "x_c" not in names and "alpha_cx" not in names
 
 
-def test_friction_costs_input_torque():
-    base = load_scene("coupler/double_lateral").replace(solver={"duration": 1.0})
-    r0 = mbsuite.run(base)
-    r1 = mbsuite.run(base.replace(effects={"friction": True}))
-    assert r1.stats["torque_in_mean"] > r0.stats["torque_in_mean"] + 0.5
-
-
 def test_bad_scene_input():
     sc = load_scene("coupler/double_lateral")
     with pytest.raises(SceneError, match="omega"):
@@ -102,6 +104,5 @@ def test_bad_scene_input():
         sc.replace(effects={"gravity": "yes"})
     with pytest.raises(ParameterError, match="e_y"):
         sc.replace(params={"e_y": -0.1})
-    with pytest.raises(mbsuite.GeometryError):  # shaft b would have to tilt more than e_y allows
+    with pytest.raises(mbsuite.GeometryError, match="no physical pose"):  # shaft b would tilt more than e_y allows
         mbsuite.run(sc.replace(input={"z_c": 0.4}, solver={"duration": 0.01, "t_settle": 0.0}))
-    assert math.isfinite(sc.build_params().link_length)

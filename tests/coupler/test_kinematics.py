@@ -1,4 +1,7 @@
-"""Hand-derived kinematics of the 4-link coupler against the paper (seed 001) and closed forms."""
+"""Hand-derived kinematics of the 4-link coupler against the paper (Maniowski & Czauderna) and closed forms.
+
+The e_y -> 0 limit (rank, condition number and singular values against their closed forms, the coplanar free
+motions, the singularity warnings) is asserted once, by the hard case `coupler_ey_to_zero`."""
 
 from __future__ import annotations
 
@@ -26,47 +29,22 @@ def test_eq1_link_length_is_the_chord_of_the_assembled_points():
 
 
 def test_eq15_reproduced_with_documented_layout():
-    """Eq (15) (seed l.245) to 1e-4: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y)."""
+    """Eq (15) (l.245) digit for digit: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y). Every entry
+    rounded to the paper's 4 decimals is the printed one (the largest gap, 4.76e-5, is 0.88295 printed as 0.8829)."""
     J = ref.single_jacobian(CouplerParams(e_y=0.0))
-    assert np.max(np.abs(ref.paper_eq15_layout(J) - ref.EQ15)) <= 1e-4
+    assert np.array_equal(np.round(ref.paper_eq15_layout(J), 4), ref.EQ15)
     # with gamma = 0.297 exactly the moment entry is 0.8831, not 0.8829 (reference B1): the paper used 17 deg
     J297 = ref.single_jacobian(CouplerParams(gamma=0.297, e_y=0.0))
     assert np.max(np.abs(ref.paper_eq15_layout(J297) - ref.EQ15)) > 1e-4
 
 
-def test_rank_three_at_coplanar_pose_and_free_axial_translation():
-    p = CouplerParams(e_y=0.0)
-    with pytest.warns(analysis.SingularityWarning):
-        rep = analysis.jacobian_report(p)
-    d = rep.data
-    assert d["rank"] == 3 and math.isinf(d["cond"])
-    np.testing.assert_allclose(d["singular_values"][:3], [2 * math.cos(math.pi / 4 - G), math.sqrt(2), math.sqrt(2)],
-                               atol=1e-12)
-    trans = [s for s in d["principal_screws"] if math.isinf(s["pitch"])]
-    assert len(trans) == 1 and abs(abs(trans[0]["axis"][1]) - 1) < 1e-12  # S3: translation along the shaft (y)
-    rots = [s for s in d["principal_screws"] if math.isfinite(s["pitch"])]
-    axes = sorted(int(np.argmax(np.abs(s["axis"]))) for s in rots)
-    assert axes == [0, 2] and all(abs(s["pitch"]) < 1e-12 for s in rots)  # Table 2, e_y = 0: S1 about x, S2 about z
-
-
-@pytest.mark.parametrize("ey", [1e-13, 1e-11])
-def test_near_coplanar_rank_drop_detected(ey):
-    with pytest.warns(analysis.SingularityWarning):
-        rep = analysis.jacobian_report(CouplerParams(e_y=ey))
-    assert rep.data["rank"] == 3
-
-
 @pytest.mark.parametrize("ey", [0.05, 0.1])
-def test_condition_number_closed_form_and_paper(ey):
-    """chi = R cos(2 gamma)/e_y (derived in README) - not Table 2's 87 / 85."""
-    p = CouplerParams(e_y=ey)
-    J = ref.single_jacobian(p)
-    s = np.linalg.svd(J, compute_uv=False)
-    l = math.hypot(2 * math.sin(math.pi / 4 - G), ey)
-    assert s[-1] == pytest.approx(2 * ey / l, rel=1e-12)
-    assert s[0] / s[-1] == pytest.approx(math.cos(2 * G) / ey, rel=1e-10)
-    assert abs(s[0] / s[-1] - analysis.TABLE2[ey][3]) > 50  # the paper's value is not reproducible (reference B2)
-    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-10)
+def test_condition_number_not_table2(ey):
+    """Table 2's chi = 87 / 85 is not reproducible with the geometry that reproduces Eq (15) and Table 2's axes (README:
+    chi = R^2 cos(2 gamma)/e_y = 16.58 / 8.29, from the SVD; a near-constant chi while e_y doubles is impossible).
+    A documented disagreement with the paper, asserted as one."""
+    s = np.linalg.svd(ref.single_jacobian(CouplerParams(e_y=ey)), compute_uv=False)
+    assert abs(s[0] / s[-1] - analysis.TABLE2[ey][3]) > 50
 
 
 @pytest.mark.parametrize("R", [1.0, 1.5, 2.0, 3.0])
@@ -74,11 +52,10 @@ def test_condition_number_closed_form_scales_with_R_squared(R):
     """J mixes force and moment rows: chi = R^2 cos(2 gamma)/e_y (length units matter); below R ~ 0.85 a translational
     singular value dominates and there is no closed form (clear error, not a wrong number)."""
     p = CouplerParams(R=R, e_y=0.1)
-    s = np.linalg.svd(ref.single_jacobian(p), compute_uv=False)
-    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-10)
-    assert ref.cond_asymptotic(p) == pytest.approx(R**2 * math.cos(2 * G) / 0.1, rel=1e-12)
-    from mbsuite.errors import ParameterError
-
+    s = np.linalg.svd(ref.single_jacobian(p), compute_uv=False)  # the numerical side: the SVD of J
+    # the derived closed form against the SVD, and cond_asymptotic against the SVD (measured <= 2.5e-15; bound 40x)
+    assert s[0] / s[-1] == pytest.approx(R**2 * math.cos(2 * G) / 0.1, rel=1e-13)
+    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-13)
     with pytest.raises(ParameterError, match="too small"):
         ref.cond_asymptotic(CouplerParams(R=0.5, e_y=0.1))
 
@@ -91,8 +68,12 @@ def test_table2_axes_are_the_zero_pitch_screws(ey):
     zp = analysis.zero_pitch_pair(an.principal_screws)
     y1, y2, h_paper, _ = analysis.TABLE2[ey]
     assert abs(abs(zp[0].axis[0]) - 1) < 1e-12 and abs(abs(zp[1].axis[2]) - 1) < 1e-12
-    assert zp[0].point[1] == pytest.approx(y1, abs=1.5e-4)  # Table 2 prints 4 decimals
-    assert zp[1].point[1] == pytest.approx(y2, abs=1.5e-4)
+    # Table 2 prints 4 decimals (rounding 5e-5). e_y = 0.05: ours 0.07202 / -0.02202, within the rounding. e_y = 0.1:
+    # ours 0.14404 / -0.04404 against 0.1439 / -0.0439, 1.36e-4 apart - beyond the rounding and not explained by
+    # gamma = 0.297 (0.14410) nor by links kept at l0 (0.14404); the paper's printed value is asserted with that gap.
+    tol = 5e-5 if ey == 0.05 else 1.5e-4
+    assert zp[0].point[1] == pytest.approx(y1, abs=tol)
+    assert zp[1].point[1] == pytest.approx(y2, abs=tol)
     # principal screws: axes at +-45 deg through (0, e_y/2, 0), pitches +-d/2 with d = distance of Table 2's axes
     d = zp[0].point[1] - zp[1].point[1]
     pit = sorted(s.pitch for s in an.principal_screws)
@@ -122,14 +103,19 @@ def test_single_fpp_full_revolution_continuation_largest_misalignment():
 def test_c1_quadratic_in_alpha_period_pi_independent_of_ey():
     p = CouplerParams(e_y=0.1)
     c = [analysis.single_criteria(p, a, 121) for a in (0.02, 0.04)]
-    assert c[1]["c1"] / c[0]["c1"] == pytest.approx(4.0, rel=0.02)
+    # parabolic in alpha (l.292): ratio 4 (1 + O(alpha^2)), measured 4.0008; bound 5x the deviation
+    assert c[1]["c1"] / c[0]["c1"] == pytest.approx(4.0, rel=1e-3)
     d = c[1]["rev"].phi_a[:-1] - c[1]["rev"].u[:-1, 0]
     spec = np.abs(np.fft.rfft(d - d.mean()))
     assert int(np.argmax(spec)) == 2  # two oscillations per revolution (not one, as l.275 says)
     c3 = analysis.single_criteria(CouplerParams(e_y=0.3), 0.04, 121)
-    assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-3)
-    assert c[1]["c2"] > 1.9 * c[0]["c2"]  # c2 grows with alpha
-    assert c[1]["c4"] > 5 * c[1]["c3"]  # beta2 (out of plane) dominates beta1
+    assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-9)  # "virtually not influenced by e_y" (l.292): measured 0
+    # c2 "proportional to" alpha (l.280, l.294): measured ratio 1.9655 for doubling alpha (1.7 % below 2); bound 3x
+    assert c[1]["c2"] / c[0]["c2"] == pytest.approx(2.0, rel=0.05)
+    # "c4 achieves 10 times greater values than c3" (l.296, read off Fig 9): measured 9.12 and 9.21. The paper's beta
+    # angles are defined in its Fig 3c, which is not in the text (ours: README), so a 15 % reading tolerance.
+    for ci in c:
+        assert ci["c4"] / ci["c3"] == pytest.approx(10.0, rel=0.15)
 
 
 def test_c1_improves_with_slimmer_platform():
@@ -140,10 +126,14 @@ def test_c1_improves_with_slimmer_platform():
 def test_double_homokinetic_at_phibc_0_not_at_pi_2():
     c0 = analysis.double_c5(CouplerParams(), 0.08, n=37)
     c90 = analysis.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=37)
+    # phi_bc = 0: full homokineticity (l.327) although the intermediate shaft fluctuates (measured 1.7e-16 vs 5.0e-4)
     assert c0["c5"] < 1e-12 < 1e-4 < c0["c1_intermediate"]
-    assert c90["c5"] > 1e-4
-    # with an inclined output shaft the phi_bc = 0 double coupler is no longer exactly homokinetic
-    assert analysis.double_c5(CouplerParams(), 0.0, alpha_cx=0.03, n=37)["c5"] > 1e-6
+    # phi_bc = pi/2: the two couplers' fluctuations add, c5 = 2 c1 of shaft b (measured ratio 1.0154; bound 3x)
+    assert c90["c5"] == pytest.approx(2 * c90["c1_intermediate"], rel=0.05)
+    # inclined output shaft: shaft b barely tilts, coupler 2 takes the whole angle, so c5 is the single coupler's c1 at
+    # alpha = 0.03 (a different FPP, 4 unknowns): measured 2.2 % below it; bound 4.5x
+    ci = analysis.double_c5(CouplerParams(), 0.0, alpha_cx=0.03, n=37)
+    assert ci["c5"] == pytest.approx(analysis.single_criteria(CouplerParams(), 0.03, 121)["c1"], rel=0.1)
 
 
 def test_double_fpp_revolution_phibc_90_no_jump():
@@ -181,12 +171,10 @@ def test_bad_input_errors():
         CouplerParams(l_b=0.0)
     with pytest.raises(ParameterError, match="unknown"):
         geometry_params(gama=0.3)
-    # e_y smaller than ~R alpha: platform B would cross A -> GeometryError naming the cause, never a pose
-    with pytest.raises(GeometryError, match="cross"):
-        ref.solve_single(CouplerParams(e_y=0.02), 0.0, 0.05, 0.0)
-    with pytest.raises(GeometryError, match="cross"):
-        ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01, 0.0)
-    with pytest.raises((GeometryError, SolverError)):
+    # e_y smaller than ~R alpha (no physical pose): the hard case coupler_ey_below_R_alpha and, at the boundary,
+    # tests/coupler/test_checks.py::test_admissibility_boundary
+    # e_y = 0.03 with alpha = 0.05: the inclination ramp reaches the boundary at alpha_bx = 0.03125 rad
+    with pytest.raises(GeometryError, match=r"alpha_bx = 0\.03125 rad.*link 1's axial component -0\.00518 l <= 0"):
         ref.single_revolution(CouplerParams(e_y=0.03), 0.05, 0.0, n=31)
     # Gauss-Newton non-convergence reported with the residual
     with pytest.raises(SolverError, match=r"residual \|r\|_inf = [0-9.e+-]+"):
@@ -198,12 +186,6 @@ def test_jacobian_report_no_warning_when_regular():
         warnings.simplefilter("error")
         rep = analysis.jacobian_report(CouplerParams(e_y=0.1), 0.4, 0.03, 0.01)
     assert rep.data["rank"] == 4
-
-
-def test_huge_condition_number_warns():
-    with pytest.warns(analysis.SingularityWarning, match="nearly singular"):
-        rep = analysis.jacobian_report(CouplerParams(e_y=1e-8))
-    assert rep.data["rank"] == 4 and rep.data["cond"] > 1e7
 
 
 def test_inclination_about_z_equals_about_x_up_to_phase():

@@ -78,7 +78,7 @@ def test_variant_kinematics_pinocchio_matches_reference():
     q = pc.q_of({"phi_a": 1.1, "alpha_bx": 0.08, "alpha_bz": 0.05,
                  **dict(zip(("phi_b", "x_b", "y_b", "z_b"), sp.u, strict=True))})
     assert np.max(np.abs(pc.residual(q))) < 1e-12
-    assert np.max(np.abs(pc.mechanism_jacobian(q) - ref.single_jacobian(p, sp))) < 1e-10
+    assert np.max(np.abs(pc.mechanism_jacobian(q) - ref.single_jacobian(p, sp))) < 1e-14  # measured 2.2e-16
 
 
 def test_urdf_states_every_closure_by_named_frames():

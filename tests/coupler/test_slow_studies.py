@@ -32,7 +32,7 @@ def test_full_criteria_grid_trends():
             assert c2[0] < c2[1] < c2[2]
         for g in (0.11, 0.297, 0.391):
             c1e = [get(g, ey, a, "c1") for ey in analysis.EYS]
-            assert max(c1e) / min(c1e) < 1.001  # c1 does not depend on e_y
+            assert max(c1e) / min(c1e) < 1 + 1e-9  # c1 does not depend on e_y (l.292; measured equal to 1e-15)
             c2e = [get(g, ey, a, "c2") for ey in analysis.EYS]
             assert c2e[0] < c2e[1] < c2e[2]
             assert get(g, 0.1, a, "c4") > 5 * get(g, 0.1, a, "c3")
@@ -50,7 +50,7 @@ def test_dense_revolution_pinocchio_widest_platform_largest_inclination():
     p = CouplerParams(gamma=0.391, e_y=0.1)
     rev = ref.single_revolution(p, 0.07, 0.0, n=361)
     pr = single_revolution_pin(PinCoupler.build("single", p), 0.07, 0.0, rev.phi_a, rev.u[0])
-    assert np.max(np.abs(pr - rev.u)) < 1e-10
+    assert np.max(np.abs(pr - rev.u)) < 3e-12  # measured 4.1e-13
 
 
 def test_closure_residual_scales_with_solref_squared():
@@ -59,10 +59,3 @@ def test_closure_residual_scales_with_solref_squared():
     r2 = mbsuite.run(base.replace(params={"solref_timeconst": 2e-3}))
     ratio = r2.stats["closure_residual_max"] / r1.stats["closure_residual_max"]
     assert ratio == pytest.approx(4.0, rel=0.2)
-
-
-def test_long_run_no_drift():
-    r = mbsuite.run(load_scene("coupler/double_inclined").replace(solver={"duration": 6.0}))
-    assert r.stats["revolutions"] > 10.5
-    assert r.stats["phi_c_err_max"] < 1e-4 and r.stats["closure_residual_max"] < 1e-4
-    assert r.stats["warnings"] == {}

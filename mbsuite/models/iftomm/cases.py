@@ -30,16 +30,21 @@ def _iftomm_fourbar(ck: Checker) -> None:
                    method="DOP853", rtol=1e-12, atol=1e-12, t_eval=ref.t)
     ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
     turns = (mj["input_angle"][-1] - mj["input_angle"][0]) / (2 * math.pi)
+    turns_an = (an.y[0][-1] - an.y[0][0]) / (2 * math.pi)
     ck.ge("crank turns in 10 s (2 singular positions per turn)", turns, 10)
+    # measured 0.020 turn of 11.9 (MuJoCo's soft closures lose 0.36 J and the crank falls behind); bound 5x
+    ck.le("MuJoCo crank turns in 10 s vs the closed form", abs(turns - turns_an), 0.1)
+    # measured 7.5e-9 rad (DOP853 rtol 1e-10); bound 6.7x
     ck.le("Pinocchio (branch-reduced) vs closed form, crank angle (rad)",
-          np.max(np.abs(ref["input_angle"] + math.pi / 2 - an.y[0])), 1e-6)
+          np.max(np.abs(ref["input_angle"] + math.pi / 2 - an.y[0])), 5e-8)
     ck.le("MuJoCo stays on the parallelogram branch: max |coupler angle| (rad)", mj.stats["branch_angle_max"], 0.01)
     ck.le("MuJoCo closure residual (m)", mj.stats["closure_residual_max"], 2e-4)
     # measured 0.36 J of 30 J kinetic energy: the soft closure (solref 4 ms, damping ratio 1) dissipates
     ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.5)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-6)
-    ck.le("MuJoCo vs Pinocchio crank angle over the first 2 s (rad)",
-          np.max(np.abs(mj["input_angle"] - ref["input_angle"])[mj.t <= 2.0]), 0.05)
+    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 3e-7)  # measured 4.8e-8 J; bound 6x
+    # against the closed form (= Pinocchio to 7.5e-9 rad): measured 7.39e-3 rad over the first 2 s; bound 4x
+    ck.le("MuJoCo vs closed form, crank angle over the first 2 s (rad)",
+          np.max(np.abs(mj["input_angle"] + math.pi / 2 - an.y[0])[mj.t <= 2.0]), 0.03)
     ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
 
 
@@ -55,11 +60,12 @@ def _iftomm_bricard(ck: Checker) -> None:
     ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
     ck.ge("it moves: range of joint 1 (rad)", np.ptp(ref["input_angle"]), 0.5)
     ck.le("Pinocchio closure residual (m)", ref.stats["closure_residual_max"], 1e-6)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 1e-3)
+    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 5e-4)  # measured 1.03e-4 J; bound 5x
     ck.le("MuJoCo closure residual with redundant rows (m)", mj.stats["closure_residual_max"], 5e-4)
     ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.1)
     ck.le("MuJoCo vs Pinocchio joint 1 over 10 s (rad)", np.max(np.abs(mj["input_angle"] - ref["input_angle"])), 0.15)
-    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.stats["branch_angle_max"], 1e-5)
+    # measured 3.8e-7 rad (the penalty formulation's closure error, 3.2e-7 m); bound 5x
+    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.stats["branch_angle_max"], 2e-6)
     ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
 
 
@@ -141,18 +147,19 @@ HARD_CASES: tuple[HardCase, ...] = (
              "A02: all bars collinear twice per turn; the closure Jacobian loses rank and the parallelogram may "
              "switch to the anti-parallelogram branch",
              "iftomm/fourbar, 10 s, MuJoCo and Pinocchio",
-             ">= 10 turns; stays on branch (|coupler angle| <= 0.01 rad); closure <= 2e-4 m; energy drift <= 0.5 J "
-             "(MuJoCo) / 1e-6 J (Pinocchio); Pinocchio = closed form to 1e-6 rad", _iftomm_fourbar),
+             ">= 10 turns, within 0.1 turn of the closed form; stays on branch (|coupler angle| <= 0.01 rad); "
+             "closure <= 2e-4 m; energy drift <= 0.5 J (MuJoCo) / 3e-7 J (Pinocchio); Pinocchio = closed form to 5e-8 "
+             "rad; MuJoCo = closed form to 0.03 rad over the first 2 s", _iftomm_fourbar),
     HardCase("iftomm_bricard_overconstrained", "iftomm",
              "A04: over-constrained loop (Gruebler 0 DOF, real 1 DOF): redundant closure rows",
              "iftomm/bricard, 10 s, MuJoCo and Pinocchio",
              "rank 4 of 6 rows detected; closure <= 5e-4 m (MuJoCo) / 1e-6 m (Pinocchio); energy drift <= 0.1 / "
-             "1e-3 J; paths agree within 0.15 rad", _iftomm_bricard),
+             "5e-4 J; paths agree within 0.15 rad; symmetric motion q1 + q3 <= 2e-6 rad", _iftomm_bricard),
     HardCase("iftomm_drift_100s", "iftomm",
              "100 s of soft closures through singular positions and redundant rows",
              "iftomm fourbar and bricard, MuJoCo RK4 1 ms, 100 s",
              "closure <= 5e-4 m without growth; energy never gained; four-bar stays on its branch",
-             _iftomm_drift_100s),
+             _iftomm_drift_100s, slow=True),
 )
 
 

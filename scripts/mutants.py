@@ -1,0 +1,152 @@
+"""Seeded defects: does the default test suite catch realistic physics mistakes?
+
+Each mutation below is one plausible error in the physics code — a sign flipped in an equation of motion, an operating
+point shifted, a regularisation band widened, a loss term dropped, a bound scaled by 1 %, an event one step late, a
+Jacobian row swapped... It is applied, one at a time, to a scratch copy of the repository (the tracked files), and the
+default suite (`pytest -m "not slow"`) runs against it with `-x`, the mutated model's own tests first. A mutation is
+caught when a test fails; the report names the first failing test. Every mutation must be caught.
+
+    python scripts/mutants.py                  # all mutations (tens of minutes on 2 cores)
+    python scripts/mutants.py --list           # the mutations, without running
+    python scripts/mutants.py --only NAME ...  # some of them
+    python scripts/mutants.py --json out/mutants.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Mutation:
+    """Replace the one occurrence of `old` in `path` by `new`; `tests` run first (then the whole default suite)."""
+
+    name: str
+    path: str
+    old: str
+    new: str
+    doc: str
+    tests: str
+
+
+MUTATIONS: tuple[Mutation, ...] = (
+    # --- coupler: kinematics -----------------------------------------------------------------------------------------
+    Mutation("coupler_jacobian_row_swapped", "mbsuite/models/coupler/reference.py",
+             "    return np.hstack([lh, np.cross(links_to - o, lh)])",
+             "    J = np.hstack([lh, np.cross(links_to - o, lh)])\n    return J[[1, 0, *range(2, len(J))]]",
+             "two rows of the mechanism Jacobian swapped (links mislabelled)", "tests/coupler"),
+    Mutation("coupler_jacobian_moment_sign", "mbsuite/models/coupler/reference.py",
+             "    return np.hstack([lh, np.cross(links_to - o, lh)])",
+             "    return np.hstack([lh, np.cross(lh, links_to - o)])",
+             "the moment part of the Jacobian with the cross product reversed (sign flipped)", "tests/coupler"),
+    Mutation("coupler_cond_R_not_squared", "mbsuite/models/coupler/reference.py",
+             "    s_moment = 2 * p.R * math.cos(math.pi / 4 - p.gamma) * l0 / l",
+             "    s_moment = 2 * math.cos(math.pi / 4 - p.gamma) * l0 / l",
+             "the closed-form condition number missing a factor R", "tests/coupler"),
+)
+
+
+def _scratch_copy(dest: Path) -> None:
+    files = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+    for f in files:
+        src = ROOT / f
+        if src.is_file():
+            (dest / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / f)
+
+
+def _apply(root: Path, m: Mutation) -> str:
+    path = root / m.path
+    text = path.read_text()
+    n = text.count(m.old)
+    if n != 1:
+        raise SystemExit(f"mutation {m.name}: the text to replace occurs {n} times in {m.path} (must be once); the "
+                         "code has moved on: update the mutation")
+    path.write_text(text.replace(m.old, m.new))
+    return text
+
+
+def _suite(root: Path, first: str, python: str, timeout: float) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(root), "MPLBACKEND": "Agg",
+           "MBSUITE_NATIVE_DIR": str(root / ".native-cache")}
+    return subprocess.run([python, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-m", "not slow", first,
+                           "tests"], cwd=root, env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def run_one(root: Path, m: Mutation, python: str, timeout: float) -> dict:
+    """Apply `m` in `root`, run the default suite (`m.tests` first, stop at the first failure), restore."""
+    original = _apply(root, m)
+    t0 = time.perf_counter()
+    try:
+        proc = _suite(root, m.tests, python, timeout)
+        out = proc.stdout + proc.stderr
+        failed = re.findall(r"^(?:FAILED|ERROR) (\S+)", out, re.M)
+        caught = proc.returncode != 0
+        by = failed[0] if failed else (out.strip().splitlines() or ["?"])[-1]
+    except subprocess.TimeoutExpired:
+        caught, by = True, f"timeout after {timeout:.0f} s (the suite hung: counted as caught, look at it)"
+    finally:
+        (root / m.path).write_text(original)
+    return {"name": m.name, "caught": caught, "by": by if caught else "",
+            "seconds": round(time.perf_counter() - t0, 1), "doc": m.doc}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="*", help="run only these mutations")
+    ap.add_argument("--list", action="store_true", help="list the mutations and exit")
+    ap.add_argument("--json", metavar="PATH", help="write the outcomes as JSON")
+    ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mutation (default 1800)")
+    ap.add_argument("--no-baseline", action="store_true",
+                    help="skip the control run of the unmutated copy (it must pass for the results to mean anything)")
+    args = ap.parse_args(argv)
+    chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
+    unknown = sorted(set(args.only or ()) - {m.name for m in MUTATIONS})
+    if unknown:
+        print(f"unknown mutation(s): {unknown}", file=sys.stderr)
+        return 2
+    if args.list:
+        for m in chosen:
+            print(f"{m.name:38s} {m.doc}")
+        return 0
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="mbsuite-mutants-") as tmp:
+        root = Path(tmp)
+        _scratch_copy(root)
+        for m in chosen:  # every mutation must apply to the code as it is
+            _apply(root, m)
+            (root / m.path).write_text((ROOT / m.path).read_text())
+        if not args.no_baseline:
+            base = _suite(root, "tests", sys.executable, args.timeout)
+            if base.returncode != 0:
+                tail = (base.stdout + base.stderr).strip().splitlines()[-5:]
+                print("the unmutated copy fails its own suite; fix that first:\n" + "\n".join(tail), file=sys.stderr)
+                return 2
+            print("control: the unmutated copy passes the default suite", flush=True)
+        for i, m in enumerate(chosen, 1):
+            r = run_one(root, m, sys.executable, args.timeout)
+            rows.append(r)
+            print(f"[{i}/{len(chosen)}] {m.name}: {'caught by ' + r['by'] if r['caught'] else 'NOT CAUGHT'} "
+                  f"({r['seconds']} s)", flush=True)
+    missed = [r["name"] for r in rows if not r["caught"]]
+    print(f"\n{len(rows) - len(missed)}/{len(rows)} mutations caught" + (f"; missed: {missed}" if missed else ""))
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps({"mutations": [asdict(m) for m in chosen], "outcomes": rows}, indent=2))
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

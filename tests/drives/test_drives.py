@@ -259,11 +259,17 @@ def test_bad_input():
 @pytest.mark.parametrize("name,value", [
     ("K_ctrl", 0.0), ("K_ctrl", -1.0), ("Omega_ctrl", -132.0), ("Omega_ctrl", 0.0), ("spring_max", 0.0),
     ("spring_max", -2.0), ("max_tk", 0.0), ("min_vel", -1.0), ("max_vel", -1.0), ("tau_0", -10.0), ("tau_0", 0.0),
-    ("tau_slope", 0.05), ("twist_tol", -0.1), ("min_motor_vel", -1.0), ("Kp", float("nan")),
+    ("tau_slope", 0.05), ("twist_tol", -0.1), ("min_motor_vel", -1.0),
 ])
 def test_bad_parameter_values_named(name, value):
     with pytest.raises(ParameterError, match=name):
         load_scene("drives/susd_100w_design").replace(params={name: value})
+
+
+def test_non_finite_parameter_named_by_the_scene_loader():
+    # the scene loader refuses a non-finite number before the parameters are built (SceneError naming it)
+    with pytest.raises(SceneError, match="Kp"):
+        load_scene("drives/susd_100w_design").replace(params={"Kp": float("nan")})
 
 
 def test_bad_parameter_combinations():
@@ -350,3 +356,50 @@ def test_velocity_band_scheme_compares():
     i = [int(np.argmin(np.abs(band.t - tt))) for tt in (0.5, 1.0, 1.5)]
     err = np.max(np.abs(band.w[:, i] - ref["w"][:, j]))
     assert 1e-4 < err < 2e-2  # worse than the event-exact path (6e-5), bounded by the band
+
+
+def test_storage_time_nearest_sample_over_grid():
+    """PWM storage time t_k = duty x t_l in samples: the integer nearest to duty x t_l x fs in exact rational
+    arithmetic (decimal strings as fractions; ties up), over a grid of duty x t_l x fs, through the controller."""
+    from fractions import Fraction
+
+    from mbsuite.models.drives.friction import time_to_samples
+
+    q = w = np.zeros(3)
+    n_trap = 0
+    for fs in ("500", "1000", "10000"):
+        for tl in ("0.05", "0.1", "0.15", "0.2", "0.25", "0.3", "0.35", "0.4", "0.5", "0.7"):
+            for i in range(1, 100):
+                duty = f"0.{i:02d}"
+                exact = Fraction(duty) * Fraction(tl) * Fraction(fs)
+                oracle = math.floor(exact + Fraction(1, 2))
+                ctrl = C.StepUpController(kind="pwm", fs=float(fs), t_l=float(tl), duty=float(duty))
+                ctrl(0, 0.0, q, w)
+                ctrl(1, 1.0 / float(fs), q, w)
+                assert ctrl.tk_samples == oracle, (duty, tl, fs)
+                n_trap += int(float(duty) * float(tl) * float(fs)) != oracle
+    assert n_trap > 100  # the grid exercises the truncation trap (int() would be wrong in these cases)
+    # the case that was wrong: 0.35 x 0.2 x 500 = 34.99999999999999 in binary
+    assert int(0.35 * 0.2 * 500) == 34 and time_to_samples(0.35 * 0.2, 500.0) == 35
+    # truncation where the thesis means it (delays, computed waits), and bad input
+    assert time_to_samples(0.0045, 1000.0, "floor") == 4 and time_to_samples(0.0045, 1000.0) == 5
+    with pytest.raises(ParameterError, match="storage"):
+        time_to_samples(-0.1, 500.0, what="storage time")
+    with pytest.raises(ParameterError, match="rounding"):
+        time_to_samples(0.1, 500.0, "up")
+
+
+def test_parameter_and_input_limits_declared():
+    """Every drives parameter declares its valid range; a value outside it names the field, value and range; the
+    reference input is range-checked by the scene loader."""
+    from mbsuite.limits import limit_of, undeclared
+    from mbsuite.models.drives.params import PARAM_SETS, DriveParams
+
+    assert undeclared(DriveParams) == []
+    for name in PARAM_SETS:  # every shipped parameter set lies inside the declared ranges
+        DriveParams().resolved(name)
+    with pytest.raises(ParameterError, match=r"duty = 1.0 is invalid; valid: \(0, 1\)"):
+        DriveParams(duty=1.0)
+    assert limit_of(DriveParams, "tau_slope").hi == 0.0
+    with pytest.raises(SceneError, match="input.value"):
+        load_scene("drives/step_up_pwm").replace(input={"value": 1e9})

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...limits import Limit
 from ...registry import Effect, ModelSpec
 from .model import SIGNALS, run
 from .params import PARAM_SETS, DriveParams
@@ -19,8 +20,10 @@ SPEC = ModelSpec(
     summary="switched-mode mechanical drives (step-up, step-up/step-down) with exact clutches; CoupledClutches",
     params_cls=DriveParams,
     effects={
-        "mechanism": Effect(("step_up", "step_up_down", "coupled_clutches"), "step_up",
-                            "which rotor system: Fig 3.3, Fig 3.4 or Modelica's CoupledClutches"),
+        "mechanism": Effect(("step_up", "step_up_down", "coupled_clutches", "msl_friction", "msl_one_way_clutch",
+                             "msl_one_way_clutch_disengaged", "msl_simple_gear_shift"), "step_up",
+                            "which rotor system: Fig 3.3, Fig 3.4, or a Modelica Rotational example (CoupledClutches, "
+                            "Friction, OneWayClutch, OneWayClutchDisengaged, SimpleGearShift)"),
         "param_set": Effect(tuple(PARAM_SETS), "table_4_2",
                             "parameter set (Table 4.2, 100 W design/prototype, App. J)"),
         "controller": Effect(("none", "pwm", "resonant", "motor_resonant", "energy_packet"), "pwm",
@@ -37,8 +40,10 @@ SPEC = ModelSpec(
         "added_motor_inertia": Effect((True, False), False, "add J_add to the motor (L959, L1987)"),
     },
     inputs={
-        "reference": {"value": "constant speed reference (rad/s)",
-                      "profile": "[[t, r], ...] piecewise-linear reference (rad/s)"},
+        # `value` has no fixed default: without it (and without a profile) the parameter set's `ref` is the reference
+        "reference": {"value": Limit(lo=-1e5, hi=1e5, unit="rad/s",
+                                     doc="constant speed reference (default: the parameter set's ref)"),
+                      "profile": "[[t, r], ...] piecewise-linear reference (rad/s; t increasing, checked by the run)"},
         "none": {},
     },
     outputs=SIGNALS,

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError
-from .friction import delay_samples
+from .friction import delay_samples, time_to_samples
 
 STEP_UP_CONTROLLERS = ("pwm", "resonant", "motor_resonant")
 SUSD_CONTROLLERS = ("energy_packet",)
@@ -98,14 +98,14 @@ class StepUpController:
         self.c_on = 0
         if self.max_tk is None:
             self.max_tk = 0.5 * self.t_l
-        self.tlcount = int(round(self.t_l * self.fs))
-        self.tncount = int(round(self.t_n * self.fs))
+        self.tlcount = time_to_samples(self.t_l, self.fs, "nearest", "cycle time t_l")
+        self.tncount = time_to_samples(self.t_n, self.fs, "nearest", "dead time t_n")
 
     def _loiter(self, q: np.ndarray, w: np.ndarray) -> int:
         if not self.clutch_matching:
             return -1
         td = clutch_loiter(self.Omega, q[0] - q[1], w[0], w[2]) - self.delay_comp
-        return int(td * self.fs)
+        return time_to_samples(max(td, 0.0), self.fs, "floor", "clutch loiter time")
 
     def __call__(self, k: int, t: float, q: np.ndarray, w: np.ndarray) -> dict[str, int] | None:
         if k == 0:
@@ -122,7 +122,9 @@ class StepUpController:
             self.e_prev = e
         else:
             tk = self.duty * self.t_l
-        tkcount = int(tk * self.fs)
+        # storage time: a duration (nearest sample); a negative PI output (printed PI, no anti-windup) is no storage
+        tkcount = time_to_samples(max(tk, 0.0), self.fs, "nearest", "storage time t_k")
+        self.tk_samples = tkcount
         twist = q[0] - q[1]
         out: dict[str, int] = {}
         if self.kind == "pwm":
@@ -269,7 +271,7 @@ class EnergyPacketController:
             # integer can truncate either way under a ~1e-6 difference in state: one sample later or earlier)
             self.log.append({"t": t, "event": "cycle", "eps": self.eps, "dir": self.E_dir, "root": ok,
                              "wait_samples": te * self.fs})
-            self.count = max(0, int(te * self.fs) - self.cd)
+            self.count = max(0, time_to_samples(te, self.fs, "floor", "extraction wait") - self.cd)
             self.i = 0
             self.state = 2
         if self.state == 2:  # WAIT_ENERGY_EXTRACTION
@@ -295,7 +297,8 @@ class EnergyPacketController:
                 # predict the state at the actual release (after the clutch delay) with the source's speed
                 th_rel = ths + ws * self.clutch_delay
                 tt, ok = match_time(self.Omega, th_rel, ws, tgt, -push)
-                self.count = max(0, int((tt + self.clutch_delay) * self.fs) - self.cd)
+                self.count = max(0, time_to_samples(tt + self.clutch_delay, self.fs, "floor", "transfer wait")
+                                 - self.cd)
                 self.i = 0
                 self.state = 4
                 self.log.append({"t": t, "event": "extracted", "theta": ths, "root": ok,

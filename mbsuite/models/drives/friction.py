@@ -59,28 +59,42 @@ class Part:
 
 @dataclass
 class Friction:
-    """A Coulomb friction element between rotor `a` and rotor `b` (-1 = ground). Breakaway = `peak` x sliding torque."""
+    """A Coulomb friction element between rotor `a` and rotor `b` (-1 = ground). Breakaway = `peak` x sliding torque.
+
+    `g` (optional, one coefficient per rotor) replaces a/b by a general relative speed w_rel = g . w, on which the
+    element acts with the generalised torque -g tau_e (virtual work); a/b is the row g = e_b - e_a. It is what an
+    element behind an ideal gear or planetary sees (Modelica `IdealPlanetary`: a massless ring eliminated).
+    `one_way_hold` (N m, optional) makes it Modelica's `OneWayClutch` (a freewheel in parallel with a clutch): it
+    slides only forward (w_rel > 0, torque = level), locks whenever w_rel reaches 0 and holds any torque toward
+    w_rel < 0; it releases forward when the holding torque exceeds `peak` x level, or `one_way_hold`
+    (= eps0 mu0 cgeo fn_max, Modelica's tau0_max_low) while disengaged (level 0)."""
 
     name: str
     a: int
     b: int
     parts: list[Part]
     peak: float = 1.0
+    g: tuple[float, ...] | None = None
+    one_way_hold: float | None = None
 
 
 @dataclass
 class Spring:
-    """Linear torsion spring K (N m/rad) between rotor a and rotor b (-1 = ground): tau_a = -K (q_a - q_b)."""
+    """Linear torsion spring K (N m/rad) between rotor a and rotor b (-1 = ground): tau_a = -K (q_a - q_b), with an
+    optional parallel damper D (N m s/rad; Modelica `SpringDamper`): tau_a -= D (w_a - w_b); its loss is the energy
+    term `damper_<name>`."""
 
     name: str
     a: int
     b: int
     K: float
+    D: float = 0.0
 
 
 @dataclass
 class Source:
-    """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w (a DC motor: c0 = Kt Vs / R, c1 = -Kt Ke / R).
+    """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w + c2 * w^2 (a DC motor: c0 = Kt Vs / R,
+    c1 = -Kt Ke / R; Modelica `QuadraticSpeedDependentTorque`: c2 = tau_nominal / w_nominal^2).
     `shape` (None = 1) is best a signal of `mbsuite.engines.signals`, as `Part.schedule`."""
 
     label: str
@@ -88,6 +102,7 @@ class Source:
     c0: float
     c1: float = 0.0
     shape: Callable[[float], float] | None = None
+    c2: float = 0.0
 
 
 @dataclass
@@ -113,12 +128,33 @@ class RotorSystem:
         for s in self.springs:
             if not (np.isfinite(s.K) and s.K > 0):
                 raise ParameterError(f"spring rate of '{s.name}' must be positive, got {s.K!r} N m/rad")
+        for s in self.springs:
+            if not (np.isfinite(s.D) and s.D >= 0):
+                raise ParameterError(f"damping of '{s.name}' must be >= 0, got {s.D!r} N m s/rad")
+        for s in self.sources:
+            if not all(np.isfinite(x) for x in (s.c0, s.c1, s.c2)):
+                raise ParameterError(f"torque source '{s.label}': c0, c1, c2 must be finite, got {s}")
+        rows = []
         for f in self.frictions:
             if f.peak < 1.0:
                 raise ParameterError(f"breakaway factor of '{f.name}' must be >= 1, got {f.peak!r}")
+            if f.one_way_hold is not None and not (np.isfinite(f.one_way_hold) and f.one_way_hold > 0):
+                raise ParameterError(f"one-way hold torque of '{f.name}' must be > 0, got {f.one_way_hold!r} N m")
+            if f.g is None:
+                row = np.zeros(self.n)
+                row[f.a] -= 1.0
+                if f.b >= 0:
+                    row[f.b] += 1.0
+            else:
+                row = np.asarray(f.g, float)
+                if row.shape != (self.n,) or not np.all(np.isfinite(row)) or not np.any(row):
+                    raise ParameterError(f"relative-speed row g of '{f.name}' must be {self.n} finite numbers, not "
+                                         f"all zero, got {f.g!r}")
+            rows.append(row)
             for p in f.parts:
                 if not (np.isfinite(p.level) and p.level >= 0):
                     raise ParameterError(f"friction torque '{p.label}' of '{f.name}' must be >= 0, got {p.level!r} N m")
+        self.rows = np.array(rows).reshape(len(self.frictions), self.n)
 
     @property
     def n(self) -> int:
@@ -144,17 +180,25 @@ class RotorSystem:
         return np.asarray(out, float)
 
     def w_rel(self, w: np.ndarray) -> np.ndarray:
-        return np.array([(w[f.b] if f.b >= 0 else 0.0) - w[f.a] for f in self.frictions])
+        return np.array([((w[f.b] if f.b >= 0 else 0.0) - w[f.a]) if f.g is None else float(self.rows[e] @ w)
+                         for e, f in enumerate(self.frictions)])
 
     def G(self, idx: Sequence[int]) -> np.ndarray:
         """Constraint rows (d/dt w_rel) of the friction elements `idx`."""
-        G = np.zeros((len(idx), self.n))
-        for r, e in enumerate(idx):
-            f = self.frictions[e]
-            G[r, f.a] -= 1.0
-            if f.b >= 0:
-                G[r, f.b] += 1.0
-        return G
+        return self.rows[list(idx)].reshape(len(idx), self.n)
+
+    def apply(self, f: np.ndarray, e: int, tau: float) -> None:
+        """Add element e's torque tau_e to the rotor torques f (+tau on a, -tau on b; -g tau for a general row)."""
+        fr = self.frictions[e]
+        if fr.g is None:
+            f[fr.a] += tau
+            if fr.b >= 0:
+                f[fr.b] -= tau
+        else:
+            f -= self.rows[e] * tau
+
+    def dampers(self) -> list[Spring]:
+        return [s for s in self.springs if s.D > 0]
 
     def stored_energy(self, q: np.ndarray, w: np.ndarray) -> tuple[float, float]:
         ke = 0.5 * float(np.sum(self.J * w**2))
@@ -170,10 +214,18 @@ class RotorSystem:
         p_src = 0.0
         for s in self.sources:
             tau = s.c0 * (s.shape(t) if s.shape is not None else 1.0) + s.c1 * w[s.body]
+            if s.c2:
+                tau += s.c2 * w[s.body] * w[s.body]
             f[s.body] += tau
             p_src += tau * w[s.body]
         for s in self.springs:
             d = q[s.a] - (q[s.b] if s.b >= 0 else 0.0)
+            if s.D:
+                d_w = w[s.a] - (w[s.b] if s.b >= 0 else 0.0)
+                f[s.a] -= s.K * d + s.D * d_w
+                if s.b >= 0:
+                    f[s.b] += s.K * d + s.D * d_w
+                continue
             f[s.a] -= s.K * d
             if s.b >= 0:
                 f[s.b] += s.K * d
@@ -188,16 +240,36 @@ class Controller(Protocol):
     def __call__(self, k: int, t: float, q: np.ndarray, w: np.ndarray) -> dict[str, int] | None: ...
 
 
-def delay_samples(delay: float, fs: float) -> int:
-    """Actuation delay in controller samples, as the thesis' shift registers: `count = (int)(delay*sample_rate)`
-    (App. C L2569-2575), i.e. truncation - but of the product rounded to 9 decimals, so that a delay that is a whole
-    number of samples in decimal (0.3 ms at 10 kHz: 0.0003*10000 = 2.9999999999999996 in binary) gives that number
-    (3), not one less. The one conversion used by the command queue, the controllers and `drive.build_controller`."""
-    if not (math.isfinite(delay) and delay >= 0.0):
-        raise ParameterError(f"actuation delay must be a finite number >= 0 s, got {delay!r}")
+def time_to_samples(duration: float, fs: float, rounding: str = "nearest", what: str = "duration") -> int:
+    """A time in controller samples - the one conversion of every controller of both paths (the MuJoCo path's C
+    stepper converts no time: it reads the command states the same Python controllers set).
+
+    `rounding = "nearest"` for a **duration the thesis means as a whole number of samples** (storage time t_k =
+    duty x t_l, cycle t_l, dead time t_n): the sample nearest to duration x fs, ties up. The thesis' code computes
+    these counts as `(int)(tk*sample_rate)` in single precision, where 0.35 x 0.2 x 500 is exactly 35.0; in double
+    precision the product is 34.99999999999999 and a plain int() would lose a sample.
+    `rounding = "floor"` where the thesis **means truncation**: the actuation delays of its shift registers (App. C,
+    `count = (int)(delay*sample_rate)`) and the waits computed from the state (clutch loiter Eq 2.1, extraction and
+    transfer waits of App. F: the last sample not after the computed instant).
+    Both round the product to 9 decimals first, so a time that is a whole number of samples in decimal stays one
+    (0.3 ms at 10 kHz: 0.0003 x 10000 = 2.9999999999999996 in binary gives 3)."""
+    if not (math.isfinite(duration) and duration >= 0.0):
+        raise ParameterError(f"{what} must be a finite number >= 0 s, got {duration!r}")
     if not (math.isfinite(fs) and fs > 0.0):
         raise ParameterError(f"controller sample rate must be positive, got {fs!r}")
-    return int(math.floor(round(delay * fs, 9)))
+    x = round(duration * fs, 9)
+    if rounding == "nearest":
+        return int(math.floor(x + 0.5))
+    if rounding == "floor":
+        return int(math.floor(x))
+    raise ParameterError(f"rounding must be 'nearest' or 'floor', got {rounding!r}")
+
+
+def delay_samples(delay: float, fs: float) -> int:
+    """Actuation delay in controller samples, as the thesis' shift registers: `count = (int)(delay*sample_rate)`
+    (App. C L2569-2575): truncation (`time_to_samples(delay, fs, "floor")`). The one conversion used by the command
+    queue, the controllers and `drive.build_controller`."""
+    return time_to_samples(delay, fs, "floor", "actuation delay")
 
 
 class CommandQueue:
@@ -304,7 +376,9 @@ class ReferenceSimulator:
         # a level below this is "free" (a schedule crossing zero leaves round-off like 20*cos(pi/2) = 1e-15)
         self.free_tol = np.array([1e-12 * max(1.0, sum(p.level for p in f.parts)) for f in sys.frictions])
         self.events: list[dict[str, Any]] = []
-        self.ne_tot = 1 + self.n + len(self.part_owner)
+        self.dampers = sys.dampers()
+        self.one_way = np.array([f.one_way_hold is not None for f in sys.frictions], bool)
+        self.ne_tot = 1 + self.n + len(self.part_owner) + len(self.dampers)
         self._cfg_cache: dict[tuple, _Config] = {}
         self.stats: dict[str, Any] = {"nfev": 0, "steps": 0, "restarts": 0, "reset_energy": 0.0, "events": 0}
         y = np.concatenate([np.asarray(q0, float), np.asarray(w0, float), np.zeros(self.ne_tot)])
@@ -322,6 +396,8 @@ class ReferenceSimulator:
         self._same_instant = 0
         self._last_event_t = -1.0
         self.solver: DOP853 | None = None  # the solver of the current smooth piece (None between pieces)
+        self._f_known: list[tuple[float, np.ndarray]] = []  # (t, right-hand side) at the solver step's ends
+        self._graze: dict[int, float] | None = None
         self._cfg: _Config | None = None  # the piece's projection and sliding elements (modes fixed on a piece)
         self._slid: list[tuple[int, int]] = []
         self._evs: list = []
@@ -344,7 +420,7 @@ class ReferenceSimulator:
         stuck elements, rebuilt if they changed)."""
         stuck = [e for e in range(self.ne) if self.modes[e] == STUCK]
         _, el = self.levels(t)
-        caps = self.peaks[stuck] * el[stuck] if stuck else np.zeros(0)
+        caps = np.array([self.capacity(e, el) for e in stuck]) if stuck else np.zeros(0)
         key = tuple(stuck)
         c = self._cfg_cache.get(key)
         if c is None or (len(stuck) > 1 and not np.allclose(c.caps, caps)):
@@ -358,11 +434,7 @@ class ReferenceSimulator:
         f, _ = self.sys.free_torque(t, q, w)
         for e in range(self.ne):
             if self.modes[e] in (FWD, BWD):
-                fr = self.sys.frictions[e]
-                tau = self.modes[e] * el[e]
-                f[fr.a] += tau
-                if fr.b >= 0:
-                    f[fr.b] -= tau
+                self.sys.apply(f, e, self.modes[e] * el[e])
         return f
 
     def _rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -378,11 +450,8 @@ class ReferenceSimulator:
         dE[:] = 0.0
         for e, d in slid:
             fr = sys.frictions[e]
-            tau = d * el[e]
-            f[fr.a] += tau
-            if fr.b >= 0:
-                f[fr.b] -= tau
-            wr = abs((w[fr.b] if fr.b >= 0 else 0.0) - w[fr.a])
+            sys.apply(f, e, d * el[e])
+            wr = abs(((w[fr.b] if fr.b >= 0 else 0.0) - w[fr.a]) if fr.g is None else float(sys.rows[e] @ w))
             for i, pe in enumerate(self.part_owner):
                 if pe == e:
                     dE[1 + n + i] = lv[i] * wr
@@ -390,11 +459,17 @@ class ReferenceSimulator:
         dy[n:2 * n] = cfg.Pa @ f
         dE[0] = p_src
         dE[1:1 + n] = sys.B * w * w
+        k0 = 1 + n + len(self.part_owner)
+        for i, s in enumerate(self.dampers):
+            d_w = w[s.a] - (w[s.b] if s.b >= 0 else 0.0)
+            dE[k0 + i] = s.D * d_w * d_w
         return dy
 
     def _slip(self, fr: Friction, t: float, y: np.ndarray) -> float:
         """Event function of a sliding element: its slip w_b - w_a (a lock when it reaches 0)."""
         n = self.n
+        if fr.g is not None:
+            return float(np.asarray(fr.g, float) @ y[n:2 * n])
         return (y[n + fr.b] if fr.b >= 0 else 0.0) - y[n + fr.a]
 
     def _margin(self, r: int, e: int, t: float, y: np.ndarray) -> float:
@@ -402,7 +477,21 @@ class ReferenceSimulator:
         n = self.n
         el = self.levels(t)[1]
         lam = self._cfg.L[r] @ self.forces(t, y[:n], y[n:2 * n], el)
+        if self.one_way[e]:  # a freewheel holds any torque toward w_rel < 0
+            return self.capacity(e, el) - lam
         return self.peaks[e] * el[e] - abs(lam)
+
+    def capacity(self, e: int, el: np.ndarray) -> float:
+        """Breakaway torque of element e at element levels el (a one-way clutch: peak x level while engaged, its
+        hold torque while disengaged; Modelica `OneWayClutch.tau0_max`)."""
+        if self.one_way[e] and el[e] <= self.free_tol[e]:
+            return float(self.sys.frictions[e].one_way_hold)
+        return float(self.peaks[e] * el[e])
+
+    def _engaging(self, e: int, t: float, y: np.ndarray) -> float:
+        """Event function of a free element: its level above the free tolerance (engagement by a rising schedule,
+        e.g. a ramp from zero; Modelica's `free = fn <= 0` relation)."""
+        return float(self.levels(t)[1][e] - 2.0 * self.free_tol[e])  # 2x: at the located root it is engaged
 
     def _event_functions(self) -> list:
         """Event functions g(t, y) of the current piece, the crossing direction that fires them and their tags: a
@@ -410,6 +499,8 @@ class ReferenceSimulator:
         (break)."""
         funcs = [(partial(self._slip, self.sys.frictions[e]), -d, ("lock", e)) for e, d in self._slid]
         funcs += [(partial(self._margin, r, e), -1, ("break", e)) for r, e in enumerate(self._cfg.stuck)]
+        funcs += [(partial(self._engaging, e), 1, ("engage", e)) for e in range(self.ne)
+                  if self.modes[e] == FREE and any(p.schedule is not None for p in self.sys.frictions[e].parts)]
         return funcs
 
     # ---- mode changes ---------------------------------------------------------------------------------------------
@@ -424,7 +515,14 @@ class ReferenceSimulator:
         old = modes.copy()
         must_break: set[int] = set()
         for e in range(ne):
-            if el[e] <= self.free_tol[e]:
+            if self.one_way[e]:  # Modelica OneWayClutch: stuck = locked or w_rel <= 0; slides forward only
+                if modes[e] == FREE:
+                    modes[e] = FWD if wr[e] > self.v_tol else STUCK
+                elif modes[e] == FWD and (e in lock_try or wr[e] <= self.v_tol):
+                    modes[e] = STUCK
+                elif modes[e] == STUCK and e in force_break:
+                    must_break.add(e)
+            elif el[e] <= self.free_tol[e]:
                 modes[e] = FREE
             elif modes[e] == FREE:
                 modes[e] = STUCK if abs(wr[e]) <= self.v_tol else int(np.sign(wr[e]))
@@ -438,7 +536,8 @@ class ReferenceSimulator:
                 break
             f = self.forces(t, y[:n], cfg.Pw @ w, el)
             lam = cfg.lam(f)
-            ratio = np.abs(lam) / (self.peaks[cfg.stuck] * el[cfg.stuck])
+            ratio = np.array([(max(lam[r], 0.0) if self.one_way[e] else abs(lam[r])) / self.capacity(e, el)
+                              for r, e in enumerate(cfg.stuck)])
             for r, e in enumerate(cfg.stuck):
                 if e in must_break:
                     ratio[r] = max(ratio[r], 1.0 + 1e-6)
@@ -489,6 +588,7 @@ class ReferenceSimulator:
         self._evs = self._event_functions()
         self.solver = DOP853(self._rhs, self.t, self.y, self.t_end, rtol=self.rtol, atol=self.atol,
                              max_step=self.max_step)
+        self._f_known, self._graze = [], None
         self.stats["restarts"] += 1
         self._g_old = [g(self.t, self.y) for g, _, _ in self._evs]
 
@@ -523,7 +623,10 @@ class ReferenceSimulator:
         solver = self.solver
         t_hard, kind = self._next_hard_time()
         if solver.t < t_hard and solver.status == "running":
+            self._f_known = [(solver.t, solver.f)]  # the right-hand side at the step's start (`_grazing_step`)
             msg = solver.step()
+            self._f_known.append((solver.t, solver.f))
+            self._graze = None  # grazing locks of this solver step: found at its first scan
             if solver.status == "failed":
                 raise SolverError(f"reference integrator failed at t = {solver.t:.6g} s: {msg}")
             self.stats["steps"] += 1
@@ -560,9 +663,52 @@ class ReferenceSimulator:
         for i, (g, d, tag) in enumerate(self._evs):
             a0, a1 = self._g_old[i], g_new[i]
             if (d < 0 and a0 > 0 and a1 <= 0) or (d > 0 and a0 < 0 and a1 >= 0):
-                te = _root(lambda tt, g=g, yf=yfun: g(tt, yf(tt)), t_lo, t_new)
+                def gf(tt: float, g=g, yf=yfun) -> float:
+                    return g(tt, yf(tt))
+
+                te = _root(gf, t_lo, t_new)
+                if tag[0] == "engage":  # a schedule jumping up: the first instant at which the element is engaged
+                    for _ in range(8):
+                        if te >= t_new or gf(te) >= 0.0:
+                            break
+                        te = min(t_new, float(np.nextafter(te, np.inf)))
                 fired.append((te, tag))
+            elif tag[0] == "lock" and t_new > t_lo and -d * a0 > self.v_tol:
+                if self._graze is None:
+                    self._graze = self._grazing_step(yfun)
+                te = self._graze.get(tag[1])
+                if te is not None and t_lo < te <= t_new:
+                    fired.append((te, tag))
         return fired
+
+    def _grazing_step(self, yfun) -> dict[int, float]:
+        """Grazing locks inside the current solver step: a slip that touches zero and turns back (e.g. a freewheel
+        whose input torque reverses just as the speeds meet) changes no sign at the step's ends, but its rate turns
+        from closing to opening inside it (the rates at the ends are the solver's own right-hand sides: free). Then
+        the minimum is located; if the slip there is <= 0, the lock is the slip's first zero before it. Returns
+        {element: lock time}."""
+        out: dict[int, float] = {}
+        if len(self._f_known) != 2 or self.solver is None or self.solver.t_old is None:
+            return out
+        (t0, f0), (t1, f1) = self._f_known
+        n = self.n
+        for e, d in self._slid:
+            row, sgn = self.sys.rows[e], d
+            if not (sgn * float(row @ f0[n:2 * n]) < 0.0 < sgn * float(row @ f1[n:2 * n])):
+                continue
+
+            def rate(tt: float, row=row, sgn=sgn) -> float:
+                return sgn * float(row @ self._rhs(tt, yfun(tt))[n:2 * n])
+
+            def slip(tt: float, row=row, sgn=sgn) -> float:
+                return sgn * float(row @ yfun(tt)[n:2 * n])
+
+            if slip(t0) <= self.v_tol:  # at the start of a slip
+                continue
+            tm = _root(rate, t0, t1)
+            if slip(tm) <= 0.0:
+                out[e] = _root(slip, t0, tm)
+        return out
 
     def _on_event(self, fired: list, yfun) -> None:
         """Go to the earliest event, resolve the modes there (all events within 1e-13 s of it together)."""
@@ -619,7 +765,8 @@ class ReferenceSimulator:
         """The sampled result of the steps made so far (the whole run after `advance(t_end)`)."""
         n, m = self.n, self._i_out
         Y = self._out_y[:m]
-        e_names = ["source"] + [f"viscous_{nm}" for nm in self.sys.names] + self.labels
+        e_names = (["source"] + [f"viscous_{nm}" for nm in self.sys.names] + self.labels
+                   + [f"damper_{s.name}" for s in self.dampers])
         energy = {nm: Y[:, 2 * n + i] for i, nm in enumerate(e_names)}
         energy["lock_impact"] = self._out_reset[:m]
         return RefResult(t=self.t_samples[:m], q=Y[:, :n].T, w=Y[:, n:2 * n].T, modes=self._out_m[:, :m],
@@ -669,6 +816,9 @@ def simulate_velocity_band(
     evaluated jointly rather than clutch by clutch)."""
     from scipy.integrate import solve_ivp
 
+    if sys.dampers() or any(f.g is not None or f.one_way_hold is not None for f in sys.frictions):
+        raise ParameterError("the velocity-band scheme takes two-rotor friction elements without one-way logic and "
+                             "springs without dampers (the thesis' systems); use simulate_reference")
     n, ne = sys.n, len(sys.frictions)
     part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
     peaks = np.array([f.peak for f in sys.frictions])

@@ -8,19 +8,24 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
+from ...health import Figure
 from ...paths import mjcf_path
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from . import coupled_clutches as cc
-from . import drive
+from . import drive, msl
 from .friction import RefResult, simulate_reference
 
 SIGNALS = {
     "w_motor": "rad/s", "w_spring": "rad/s", "w_load": "rad/s",
     "theta_motor": "rad", "theta_spring": "rad", "theta_load": "rad", "extension": "rad",
     "w1": "rad/s", "w2": "rad/s", "w3": "rad/s", "w4": "rad/s",
+    "J1.w": "rad/s", "J2.w": "rad/s", "J3.w": "rad/s", "J4.w": "rad/s",  # CoupledClutches on the reference's names
     "E_in": "J", "E_out": "J", "E_loss": "J", "u_brake": "1", "u_clutch": "1", "u_clutch_a": "1", "u_clutch_b": "1",
+    **msl.SIGNAL_UNITS,
 }
+#: energy_residual bound of the MSL scenes (|input - output - losses - stored change| / input)
+ENERGY_BOUND = {"reference": 1e-6, "mujoco": 1e-5}
 
 
 def reference_signal(inp: dict[str, Any], default: float):
@@ -38,6 +43,18 @@ def simulate_scene(scene: Scene) -> tuple[RefResult, Any, Any]:
     eff = dict(scene.effects)
     mech = eff["mechanism"]
     sv = scene.solver
+    if mech in msl.EXAMPLES:
+        ex = msl.example(mech)
+        if sv.engine == "reference":
+            res = simulate_reference(ex.system, ex.q0, ex.w0, sv.duration, sample_dt=sv.sample_dt or 5e-4,
+                                     rtol=sv.rtol, atol=sv.atol)
+        else:
+            from .mujoco_path import MujocoRotorSim
+
+            sim = MujocoRotorSim(ex.system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep,
+                                 integrator=sv.integrator)
+            res = sim.run(ex.q0, ex.w0, sv.duration, sample_dt=sv.sample_dt or 5e-4)
+        return res, None, ex.system
     if mech == "coupled_clutches":
         system = cc.build_system()
         if sv.engine == "reference":
@@ -79,9 +96,12 @@ def run(scene: Scene) -> SimResult:
     res, ctrl, system = simulate_scene(scene)
     mech = scene.effects["mechanism"]
     sig: dict[str, np.ndarray] = {}
-    if mech == "coupled_clutches":
+    if mech in msl.EXAMPLES:
+        sig.update(msl.signals_of(msl.example(mech), res))
+    elif mech == "coupled_clutches":
         for i in range(4):
             sig[f"w{i + 1}"] = res.w[i]
+            sig[f"J{i + 1}.w"] = res.w[i]
     else:
         for i, nm in enumerate(("motor", "spring", "load")):
             sig[f"w_{nm}"] = res.w[i]
@@ -105,7 +125,19 @@ def run(scene: Scene) -> SimResult:
         stats["cycles"] = cs
     # the scene's outputs in its order (an output of the other mechanisms is not computed, so not kept)
     ordered = {k: sig[k] for k in scene.outputs if k in sig}
-    return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats)
+    health = []
+    if mech in msl.EXAMPLES or mech == "coupled_clutches":  # the Modelica examples: mode changes, final values
+        stats["mode_changes"] = [{"t": e["t"], "component": e["element"], "from": e["from"], "to": e["to"]}
+                                 for e in res.events]
+        stats["final"] = {k: float(v[-1]) for k, v in sig.items() if k in msl.SIGNAL_UNITS or "." in k}
+    if mech in msl.EXAMPLES:
+        eng = scene.solver.engine
+        health.append(Figure(
+            "energy_residual", abs(bal.residual) / max(abs(bal.input), 1e-300), ENERGY_BOUND[eng], "1",
+            "energy balance |input - output - losses - change of stored energy| / input over the run",
+            "tighten solver.rtol/atol (reference) or reduce solver.timestep (mujoco)"))
+    return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats,
+                    health=health)
 
 
 def coupled_clutches_table(engines=("reference", "mujoco"), timestep: float = 1e-4) -> dict[str, Any]:

@@ -6,8 +6,13 @@ Conventions of the MJCF files (`mjcf/coupled_clutches.xml`, `mjcf/drive_step_up.
 * friction element X: actuator `fric_X` (on the joint for a ground element, on the fixed tendon `rel_X` = q_b - q_a
   for a clutch) carries the sliding torque while the element slips; the joint equality `lock_X` (inactive in the file)
   is switched on with `d.eq_active` while it is stuck - a real lock, not `frictionloss` (which creeps);
-* spring between two rotors: fixed tendon `spring_X` with stiffness; spring to ground: joint stiffness;
-* torque source L: actuator `src_L` with gain c0 (ctrl = shape(t)) and affine velocity bias c1.
+* spring between two rotors: fixed tendon `spring_X` with stiffness (and damping D); spring to ground: joint
+  stiffness (and D added to the joint damping);
+* torque source L: actuator `src_L` with gain c0 (ctrl = shape(t)) and affine velocity bias c1; a quadratic source
+  (c2 != 0) has gain 1 and ctrl = c0 shape + c2 w^2 at the speed predicted at mid-step, held over the step;
+* a general element (a row g over the rotors, `Friction.g`: behind an ideal planetary or gear): fixed tendon `rel_X`
+  with the coefficients g (set at run time), actuator `fric_X` on it, and a *tendon* equality `lock_X` on it (its
+  force acts as -g tau_e).
 
 The step loop is mbsuite's native core (`mbsuite.engines.core.Stepper`) with the drives' state machine as its native
 stepper (`native/drives.c`, packed by `native_stepper.py`): per step, at the core's forward of the current state,
@@ -90,15 +95,35 @@ class MujocoRotorSim:
         for s in sys.springs:
             if s.b < 0:
                 m.jnt_stiffness[self.jnt[s.a]] = s.K
+                m.dof_damping[self.dof[s.a]] += s.D
             else:
-                m.tendon_stiffness[idx(mujoco.mjtObj.mjOBJ_TENDON, f"spring_{s.name}")] = s.K
+                k = idx(mujoco.mjtObj.mjOBJ_TENDON, f"spring_{s.name}")
+                m.tendon_stiffness[k] = s.K
+                m.tendon_damping[k] = s.D
         self.eq = [idx(mujoco.mjtObj.mjOBJ_EQUALITY, f"lock_{f.name}") for f in sys.frictions]
         self.act = [idx(mujoco.mjtObj.mjOBJ_ACTUATOR, f"fric_{f.name}") for f in sys.frictions]
+        # general elements: the tendon rel_X takes the row g as its coefficients; their locks are tendon equalities
+        self.general = any(f.g is not None for f in sys.frictions)
+        for e, f in enumerate(sys.frictions):
+            if f.g is None:
+                continue
+            k = idx(mujoco.mjtObj.mjOBJ_TENDON, f"rel_{f.name}")
+            if m.eq_type[self.eq[e]] != mujoco.mjtEq.mjEQ_TENDON or m.eq_obj1id[self.eq[e]] != k:
+                raise ModelFileError(f"{mjcf}: lock_{f.name} must be a tendon equality on rel_{f.name}")
+            coef = np.zeros(sys.n)
+            for w in range(m.tendon_adr[k], m.tendon_adr[k] + m.tendon_num[k]):
+                i = self.jnt.index(int(m.wrap_objid[w]))
+                m.wrap_prm[w] = sys.rows[e, i]
+                coef[i] = sys.rows[e, i]
+            if not np.array_equal(coef, sys.rows[e]):
+                raise ModelFileError(f"{mjcf}: tendon rel_{f.name} does not span the rotors of its row {sys.rows[e]}")
+        # lock force -> element torque: a joint equality acts +lambda on rotor a; a tendon equality g lambda
+        self.eq_sign = [-1.0 if m.eq_type[k] == mujoco.mjtEq.mjEQ_TENDON else 1.0 for k in self.eq]
         # actuator sign: joint actuator acts +ctrl on rotor a; tendon (q_b - q_a) acts -ctrl on a
         self.act_sign = [1.0 if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT else -1.0 for a in self.act]
         self.src = [idx(mujoco.mjtObj.mjOBJ_ACTUATOR, f"src_{s.label}") for s in sys.sources]
         for s, a in zip(sys.sources, self.src, strict=True):
-            m.actuator_gainprm[a, 0] = s.c0
+            m.actuator_gainprm[a, 0] = s.c0 if s.c2 == 0.0 else 1.0
             m.actuator_biasprm[a, :3] = (0.0, 0.0, s.c1)
         # a few coaxial rotors are one constraint island: island discovery only costs (5 % per step measured; the
         # results agree to round-off, 1e-11 rad/s)
@@ -181,7 +206,9 @@ class RotorRun:
                           for f in sys.frictions for pt in f.parts]
         self.shapes = [None if s.shape is None else signal_for(s.shape, grid, f"shape of torque source '{s.label}'")
                        for s in sys.sources]
-        self.e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + self.labels
+        self.dampers = sys.dampers()
+        self.e_names = (["source"] + [f"viscous_{nm}" for nm in sys.names] + self.labels
+                        + [f"damper_{s.name}" for s in self.dampers])
         self.nrec = 2 * n + len(sys.frictions) + len(self.commands) + len(self.e_names) + 1
         mujoco.mj_resetData(m, d)
         for i in range(n):

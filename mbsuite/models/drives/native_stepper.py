@@ -47,6 +47,9 @@ class _Drives(ctypes.Structure):
         ("rec", _P), ("ncmd", ctypes.c_int),
         ("ev", _P), ("ev_cap", ctypes.c_long), ("ev_n", ctypes.c_long),
         ("err_index", ctypes.c_int), ("err_time", ctypes.c_double), ("err_value", ctypes.c_double),
+        ("general", ctypes.c_int), ("grow", _P), ("eqsign", _P), ("oneway", _P), ("hold", _P),
+        ("ndamp", ctypes.c_int), ("da", _P), ("db", _P), ("dD", _P), ("c2", _P), ("sheld", _P),
+        ("gmat", _P), ("gidx", _P),
     ]
 
 
@@ -115,8 +118,15 @@ class NativeRotorRun:
             "nchange": np.zeros(ne, _LONG),
             "lam": np.zeros(ne), "gprev": np.full(ne, np.nan), "gnow": np.full(ne, np.nan), "wr": np.zeros(ne),
             "lv": np.zeros(len(parts)), "el": np.zeros(ne), "lvm": np.zeros(len(parts)), "elm": np.zeros(ne),
-            "wa": np.zeros(n), "qa": np.zeros(n), "wtmp": np.zeros(2 * n + 2), "acc": np.zeros(1 + n + len(parts)),
+            "wa": np.zeros(n), "qa": np.zeros(n), "wtmp": np.zeros(2 * n + 2),
+            "acc": np.zeros(1 + n + len(parts) + len(run.dampers)),
             "ctrl0": np.zeros(max(m.nu, 1)),
+            "grow": np.ascontiguousarray(sys.rows, f64).reshape(-1), "eqsign": np.array(sim.eq_sign, f64),
+            "oneway": np.array([f.one_way_hold is not None for f in fr], i32),
+            "hold": np.array([f.one_way_hold or 0.0 for f in fr], f64),
+            "da": np.array([s_.a for s_ in run.dampers], i32), "db": np.array([s_.b for s_ in run.dampers], i32),
+            "dD": np.array([s_.D for s_ in run.dampers], f64), "c2": np.array([s_.c2 for s_ in sys.sources], f64),
+            "sheld": np.zeros(len(sys.sources)), "gmat": np.zeros(ne * (ne + 1) + ne), "gidx": np.zeros(2 * ne, i32),
         }
         b["sig"] = np.array(specs or [0.0, 0.0], f64)
         self.rec = np.zeros(run.nrec)
@@ -140,6 +150,7 @@ class NativeRotorRun:
         s.rec, s.ncmd = self.rec.ctypes.data, len(run.commands)
         s.ev, s.ev_cap, s.ev_n = self.ev.ctypes.data, self.ev_cap, 0
         s.err_index, s.err_time, s.err_value = 0, 0.0, 0.0
+        s.general, s.ndamp = int(sim.general), len(run.dampers)
         self.struct = s
         lib = library()
         self.hook = core.NativeHook(fn=lib.mbs_drives_hook, ud=ctypes.addressof(s), record=self.rec,

@@ -8,11 +8,11 @@ PhD thesis, University of Hull, 1997) and of Modelica's CoupledClutches.
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 from typing import Any
 
 from ...errors import ParameterError
+from ...limits import param
 
 # ---- parameter sets -------------------------------------------------------------------------------------------------
 # Step-up prototype, Table 4.2 (L1155-1176). J_l printed 6.76e-5 is a typo: load disk A is 6.76e-4 (L1090); the clutch
@@ -68,84 +68,83 @@ PARAM_SETS: dict[str, dict[str, float]] = {
 }
 
 
+BIG = 1e6  # generous upper ends: far above any drive of this kind, low enough to catch unit slips (mm for m, ...)
+
+
+def _p(lo: float | None, hi: float | None, unit: str, doc: str, *, lo_open: bool = False,
+       hi_open: bool = False) -> Any:
+    """A scene override (default None: the parameter set's value) with its valid range."""
+    return param(None, lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, unit=unit, doc=doc)
+
+
 @dataclass(frozen=True)
 class DriveParams:
-    """Scene overrides; None = value of the parameter set. Units SI (kg m^2, N m, N m s/rad, N m/rad, s, Hz, rad/s)."""
+    """Scene overrides; None = value of the parameter set. Units SI (kg m^2, N m, N m s/rad, N m/rad, s, Hz, rad/s).
+    Every field declares its valid range (`mbsuite.limits.param`); a set value outside it is a ParameterError naming
+    the field, the value and the range."""
 
     # motor (Eq 4.1: tau = K_t (V_s - K_e w) / R, or tau = tau_0 + tau_slope w)
-    K_t: float | None = None
-    K_e: float | None = None
-    R: float | None = None
-    V_s: float | None = None
-    tau_0: float | None = None
-    tau_slope: float | None = None
-    J_m: float | None = None
-    J_add: float | None = None  # added motor inertia (L959: 1.42e-3; L1987: 1.6e-3)
-    C_m: float | None = None
-    B_m: float | None = None
+    K_t: float | None = _p(0.0, 100.0, "N m/A", "motor torque constant (Eq 4.1)", lo_open=True)
+    K_e: float | None = _p(0.0, 100.0, "V s/rad", "motor back-emf constant (Eq 4.1)")
+    R: float | None = _p(0.0, 1e3, "ohm", "armature resistance (Eq 4.1)", lo_open=True)
+    V_s: float | None = _p(-1e4, 1e4, "V", "supply voltage (Eq 4.1)")
+    tau_0: float | None = _p(0.0, 1e4, "N m", "stall torque of the straight-line motor (App. J)", lo_open=True)
+    tau_slope: float | None = _p(-1e3, 0.0, "N m s/rad", "torque-speed slope of the straight-line motor (<= 0: a "
+                                 "torque rising with speed runs away)")
+    J_m: float | None = _p(0.0, 1e3, "kg m^2", "motor inertia", lo_open=True)
+    J_add: float | None = _p(0.0, 1e3, "kg m^2", "added motor inertia (L959: 1.42e-3; L1987: 1.6e-3)")
+    C_m: float | None = _p(0.0, 1e3, "N m", "motor bearing Coulomb torque")
+    B_m: float | None = _p(0.0, 1e3, "N m s/rad", "motor bearing viscous coefficient")
     # spring system and load
-    K: float | None = None
-    J_s: float | None = None
-    C_s: float | None = None
-    B_s: float | None = None
-    J_l: float | None = None
-    C_l: float | None = None
-    B_l: float | None = None
-    tau_l: float | None = None
+    K: float | None = _p(0.0, BIG, "N m/rad", "torsion spring rate", lo_open=True)
+    J_s: float | None = _p(0.0, 1e3, "kg m^2", "spring-system inertia", lo_open=True)
+    C_s: float | None = _p(0.0, 1e3, "N m", "spring bearing Coulomb torque")
+    B_s: float | None = _p(0.0, 1e3, "N m s/rad", "spring viscous coefficient")
+    J_l: float | None = _p(0.0, 1e3, "kg m^2", "load inertia", lo_open=True)
+    C_l: float | None = _p(0.0, 1e3, "N m", "load bearing Coulomb torque")
+    B_l: float | None = _p(0.0, 1e3, "N m s/rad", "load bearing viscous coefficient")
+    tau_l: float | None = _p(0.0, 1e4, "N m", "Coulomb load torque (useful output)")
     # clutches / brake (rated dynamic torques) and actuation delays
-    tau_b: float | None = None
-    tau_c: float | None = None
-    tau_c1: float | None = None
-    tau_c2: float | None = None
-    peak: float | None = None  # breakaway / sliding torque ratio (thesis: 1)
-    d_on: float | None = None
-    d_off: float | None = None
+    tau_b: float | None = _p(0.0, 1e4, "N m", "brake sliding torque (step-up)")
+    tau_c: float | None = _p(0.0, 1e4, "N m", "clutch sliding torque (step-up)")
+    tau_c1: float | None = _p(0.0, 1e4, "N m", "input clutch sliding torque (step-up/step-down)")
+    tau_c2: float | None = _p(0.0, 1e4, "N m", "output clutch sliding torque (step-up/step-down)")
+    peak: float | None = _p(1.0, 100.0, "1", "breakaway / sliding torque ratio (thesis: 1)")
+    d_on: float | None = _p(0.0, 1.0, "s", "engagement delay (quantised to controller samples)")
+    d_off: float | None = _p(0.0, 1.0, "s", "release delay (quantised to controller samples)")
     # controller
-    fs: float | None = None
-    t_l: float | None = None
-    duty: float | None = None
-    t_n: float | None = None
-    twist_tol: float | None = None
-    min_vel: float | None = None
-    max_vel: float | None = None
-    Kp: float | None = None
-    Ki: float | None = None
-    ref: float | None = None
-    max_tk: float | None = None
-    min_motor_vel: float | None = None
-    min_load_vel: float | None = None
-    K_ctrl: float | None = None
-    Omega_ctrl: float | None = None
-    spring_max: float | None = None
+    fs: float | None = _p(0.0, BIG, "Hz", "controller sample rate", lo_open=True)
+    t_l: float | None = _p(0.0, 100.0, "s", "PWM cycle time", lo_open=True)
+    duty: float | None = _p(0.0, 1.0, "1", "PWM duty (storage time t_k = duty t_l)", lo_open=True, hi_open=True)
+    t_n: float | None = _p(0.0, 100.0, "s", "resonant controller's dead time")
+    twist_tol: float | None = _p(0.0, 100.0, "rad", "transfer ends below this spring twist (must exceed the "
+                                 "friction-held twist (C_s + C_l)/K)")
+    min_vel: float | None = _p(0.0, 1e5, "rad/s", "motor-resonant: restart speed")
+    max_vel: float | None = _p(0.0, 1e5, "rad/s", "motor-resonant: switch speed")
+    Kp: float | None = _p(0.0, BIG, "", "PI proportional gain (step-up: s per rad/s; energy packet: J per (rad/s)^2)")
+    Ki: float | None = _p(0.0, BIG, "", "PI integral gain")
+    ref: float | None = _p(-1e5, 1e5, "rad/s", "speed reference when the scene's input gives none")
+    max_tk: float | None = _p(0.0, 100.0, "s", "upper clamp of the storage time t_k (default t_l / 2)", lo_open=True)
+    min_motor_vel: float | None = _p(0.0, 1e5, "rad/s", "energy packet: least motor speed to extract from")
+    min_load_vel: float | None = _p(0.0, 1e5, "rad/s", "energy packet: least load speed to regenerate from")
+    K_ctrl: float | None = _p(0.0, BIG, "N m/rad", "spring rate the controller assumes", lo_open=True)
+    Omega_ctrl: float | None = _p(0.0, BIG, "rad/s", "free frequency the controller assumes", lo_open=True)
+    spring_max: float | None = _p(0.0, 1e3, "rad", "largest spring twist of a packet", lo_open=True)
 
     def __post_init__(self) -> None:
-        positive = ("J_m", "J_s", "J_l", "K", "R", "K_t", "fs", "t_l", "K_ctrl", "Omega_ctrl", "spring_max", "max_tk",
-                    "tau_0")
-        nonneg = ("J_add", "C_m", "B_m", "C_s", "B_s", "C_l", "B_l", "tau_l", "tau_b", "tau_c", "tau_c1", "tau_c2",
-                  "d_on", "d_off", "K_e", "t_n", "twist_tol", "Kp", "Ki", "min_motor_vel", "min_load_vel", "min_vel",
-                  "max_vel")
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             if v is None:
                 continue
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ParameterError(f"parameter {f.name} must be a finite number, got {v!r}")
-            if f.name in positive and v <= 0:
-                raise ParameterError(f"parameter {f.name} must be positive, got {v!r}")
-            if f.name in nonneg and v < 0:
-                raise ParameterError(f"parameter {f.name} must be >= 0, got {v!r}")
-        if self.tau_slope is not None and self.tau_slope > 0:
-            raise ParameterError(f"parameter tau_slope (motor torque-speed slope) must be <= 0, got {self.tau_slope!r}"
-                                 " (a torque rising with speed runs away)")
-        if self.duty is not None and not 0 < self.duty < 1:
-            raise ParameterError(f"parameter duty must be in (0, 1), got {self.duty!r}")
-        if self.peak is not None and self.peak < 1:
-            raise ParameterError(f"parameter peak (breakaway/sliding) must be >= 1, got {self.peak!r}")
+            lim = f.metadata["limit"]
+            v2 = lim.check(f"drives parameter {f.name}", v)
+            if v2 is not v:
+                object.__setattr__(self, f.name, v2)
         if self.min_vel is not None and self.max_vel is not None and self.min_vel > self.max_vel:
             raise ParameterError(f"parameter min_vel = {self.min_vel!r} must not exceed max_vel = {self.max_vel!r}")
 
     def resolved(self, param_set: str) -> dict[str, Any]:
-        """The parameter set with the overrides applied, validated as a whole (ranges as in `__post_init__`, and
+        """The parameter set with the overrides applied, validated as a whole (the declared ranges, and
         min_vel <= max_vel). Combinations that depend on the mechanism and effects (delay vs PWM cycle / free
         oscillation period, twist_tol vs the friction-held twist) are checked by `drive.build_controller`."""
         if param_set not in PARAM_SETS:

@@ -72,7 +72,14 @@ class RotorStepper:
         self.lvm: list[float] = []
         self.wa = [0.0] * self.n
         self.qa = [0.0] * self.n
-        self.acc = [0.0] * (1 + self.n + len(self.parts))
+        self.general = sim.general
+        self.grow = [[float(x) for x in r] for r in sys.rows]
+        self.eq_sign = list(sim.eq_sign)
+        self.oneway = [f.one_way_hold is not None for f in sys.frictions]
+        self.hold = [f.one_way_hold or 0.0 for f in sys.frictions]
+        self.dampers = run.dampers
+        self.sheld = [0.0] * len(sys.sources)
+        self.acc = [0.0] * (1 + self.n + len(self.parts) + len(self.dampers))
         self.first = True
         self.reset_energy = 0.0
         self.lock_trials = 0
@@ -118,7 +125,24 @@ class RotorStepper:
 
     def slips(self) -> None:
         for e, f in enumerate(self.fr):
-            self.wr[e] = (self.w(f.b) if f.b >= 0 else 0.0) - self.w(f.a)
+            if self.general:
+                v = 0.0
+                for i in range(self.n):
+                    v += self.grow[e][i] * self.w(i)
+                self.wr[e] = v
+            else:
+                self.wr[e] = (self.w(f.b) if f.b >= 0 else 0.0) - self.w(f.a)
+
+    def capacity(self, e: int, el: list[float]) -> float:
+        """Breakaway torque of element e at levels el (a disengaged one-way clutch: its hold torque)."""
+        if self.oneway[e] and el[e] <= self.free_tol[e]:
+            return self.hold[e]
+        return self.peak[e] * el[e]
+
+    def overload(self, e: int, el: list[float]) -> float:
+        """Lock force over breakaway (> 1: it breaks); a one-way clutch holds any negative force."""
+        lam = (self.lam[e] if self.lam[e] > 0.0 else 0.0) if self.oneway[e] else abs(self.lam[e])
+        return lam / self.capacity(e, el)
 
     def lock_forces(self) -> None:
         """Force of each element's lock from the last forward: first row of its equality, 0 if inactive."""
@@ -131,7 +155,7 @@ class RotorStepper:
                 continue
             e = eq2el.get(int(d.efc_id[r]), -1)
             if e >= 0 and not seen[e]:
-                self.lam[e] = float(d.efc_force[r])
+                self.lam[e] = self.eq_sign[e] * float(d.efc_force[r])
                 seen[e] = True
 
     def engage(self) -> float:
@@ -139,6 +163,23 @@ class RotorStepper:
         takes its momentum-weighted mean speed, 0 if held to the ground), offsets of newly engaged locks, equality
         activation. Returns the kinetic energy removed (C: engage)."""
         m, d, n = self.m, self.d, self.n
+        if self.general:
+            dke = self.project()
+            for e, f in enumerate(self.fr):
+                on = self.modes[e] == STUCK
+                k = self.eq[e]
+                if on and not d.eq_active[k]:
+                    if m.eq_type[k] == mujoco.mjtEq.mjEQ_TENDON:
+                        off = 0.0
+                        for i in range(n):
+                            off += self.grow[e][i] * self.q(i)
+                        m.eq_data[k, 1] = 0.0
+                    else:
+                        off = self.q(f.a) - (self.q(f.b) if f.b >= 0 else 0.0)
+                        m.eq_data[k, 1] = 1.0 if f.b >= 0 else 0.0
+                    m.eq_data[k, 0] = off
+                d.eq_active[k] = on
+            return 0.5 * dke
         parent = list(range(n + 1))  # node n = ground
         find = partial(_find, parent)
         for e, f in enumerate(self.fr):
@@ -179,15 +220,80 @@ class RotorStepper:
             d.eq_active[k] = on
         return 0.5 * dke
 
-    def set_ctrl(self, t: float, el: list[float]) -> None:
-        """Sliding torques of the elements at levels el, sources at time t."""
+    def project(self) -> float:
+        """General systems: the plastic impact as the M-orthogonal projection onto the stuck constraints,
+        w -= M^-1 G^T (G M^-1 G^T)^-1 G w, Gaussian elimination with partial pivoting (C: project)."""
+        n, ne, d = self.n, self.ne, self.d
+        rows = [e for e in range(ne) if self.modes[e] == STUCK]
+        k = len(rows)
+        if not k:
+            return 0.0
+        Sm = [[0.0] * (k + 1) for _ in range(k)]
+        dmax = 0.0
+        for r in range(k):
+            gr = self.grow[rows[r]]
+            for c in range(k):
+                gc = self.grow[rows[c]]
+                v = 0.0
+                for i in range(n):
+                    v += gr[i] * gc[i] / self.J[i]
+                Sm[r][c] = v
+            b = 0.0
+            for i in range(n):
+                b += gr[i] * self.w(i)
+            Sm[r][k] = b
+            if Sm[r][r] > dmax:
+                dmax = Sm[r][r]
+        piv = [-1] * k
+        used = 0
+        for c in range(k):
+            best, bv = -1, 1e-12 * dmax
+            for r in range(used, k):
+                if abs(Sm[r][c]) > bv:
+                    bv, best = abs(Sm[r][c]), r
+            if best < 0:
+                continue
+            if best != used:
+                Sm[used], Sm[best] = Sm[best], Sm[used]
+            for r in range(k):
+                if r == used:
+                    continue
+                f = Sm[r][c] / Sm[used][c]
+                if f == 0.0:
+                    continue
+                for j in range(c, k + 1):
+                    Sm[r][j] -= f * Sm[used][j]
+            piv[c] = used
+            used += 1
+        lam = [Sm[piv[c]][k] / Sm[piv[c]][c] if piv[c] >= 0 else 0.0 for c in range(k)]
+        dke = 0.0
+        for i in range(n):
+            w = self.w(i)
+            dw = 0.0
+            for c in range(k):
+                dw += self.grow[rows[c]][i] * lam[c]
+            wn = w - dw / self.J[i]
+            dke += self.J[i] * (w * w - wn * wn)
+            d.qvel[self.dof[i]] = wn
+        return dke
+
+    def set_ctrl(self, t: float, el: list[float], mid: bool = False) -> None:
+        """Sliding torques of the elements at levels el, sources at time t; a quadratic source's torque at the
+        speed now, or predicted at mid-step (`mid`, held over the step)."""
         d = self.d
         for e in range(self.ne):
             md = self.modes[e]
             tau = md * el[e] if md in (FWD, BWD) else 0.0
             d.ctrl[self.act[e]] = self.act_sign[e] * tau
         for s, a in enumerate(self.src):
-            d.ctrl[a] = self.shape(s, t)
+            v = self.shape(s, t)
+            so = self.run.sys.sources[s]
+            if so.c2 != 0.0:
+                dof = self.dof[so.body]
+                w = float(d.qvel[dof]) + (0.5 * self.run.dt * float(d.qacc[dof]) if mid else 0.0)
+                v = so.c0 * v + so.c2 * w * w  # the actuator's gain is 1
+                self.sheld[s] = v
+            d.ctrl[a] = v
 
     def event_function(self, el: list[float], stuck_too: bool) -> list[float]:
         """Slip in the sliding direction, breakaway - |lock force| when stuck (if `stuck_too`), else NaN."""
@@ -197,7 +303,7 @@ class RotorStepper:
             if md in (FWD, BWD):
                 g.append(md * self.wr[e])
             elif md == STUCK and stuck_too:
-                g.append(self.peak[e] * el[e] - abs(self.lam[e]))
+                g.append(self.capacity(e, el) - (self.lam[e] if self.oneway[e] else abs(self.lam[e])))
             else:
                 g.append(math.nan)
         return g
@@ -241,7 +347,22 @@ class RotorStepper:
         trial = []
         for e in range(ne):
             md, wr = self.modes[e], self.wr[e]
-            if el[e] <= self.free_tol[e]:
+            if self.oneway[e]:  # Modelica OneWayClutch: stuck = locked or w_rel <= 0; slides forward only
+                if md == FREE:
+                    if wr > ZERO_SLIP:
+                        self.modes[e] = FWD
+                        self.armed[e] = True
+                    else:
+                        trial.append(e)
+                elif md == FWD:
+                    if wr > 0.0:
+                        self.armed[e] = True
+                    elif self.armed[e]:
+                        trial.append(e)
+                elif md == STUCK and not self.first and self.lam[e] > self.capacity(e, el):
+                    self.modes[e] = FWD
+                    self.armed[e] = False
+            elif el[e] <= self.free_tol[e]:
                 self.modes[e] = FREE
             elif md == FREE:
                 if abs(wr) < ZERO_SLIP:
@@ -273,7 +394,7 @@ class RotorStepper:
         lvm, elm = self.levels(t + 0.5 * dt) if self.run.timevar else (lv, el)
         self.lvm = lvm
         ctrl0 = d.ctrl.copy()
-        self.set_ctrl(t + 0.5 * dt, elm)
+        self.set_ctrl(t + 0.5 * dt, elm, True)
         if not np.array_equal(ctrl0, d.ctrl):  # the forward of this state and locks, redone from the control on
             mujoco.mj_forwardSkip(self.m, d, mujoco.mjtStage.mjSTAGE_VEL, 0)
             mujoco.mj_checkAcc(self.m, d)
@@ -294,7 +415,7 @@ class RotorStepper:
             for e in range(self.ne):
                 if self.modes[e] != STUCK:
                     continue
-                ratio = abs(self.lam[e]) / (self.peak[e] * el[e])
+                ratio = self.overload(e, el)
                 if worst < 0 or ratio > wratio:
                     worst, wratio = e, ratio
             if worst < 0 or wratio <= 1.0:
@@ -311,7 +432,8 @@ class RotorStepper:
         for s, so in enumerate(self.run.sys.sources):
             i = so.body
             w0, w1 = self.wa[i], self.w(i)
-            src += so.c0 * self.shape(s, tm) * (self.q(i) - self.qa[i]) + so.c1 * 0.5 * (w0 * w0 + w1 * w1) * dt
+            held = self.sheld[s] if so.c2 != 0.0 else so.c0 * self.shape(s, tm)
+            src += held * (self.q(i) - self.qa[i]) + so.c1 * 0.5 * (w0 * w0 + w1 * w1) * dt
         self.acc[0] += src
         for i in range(n):
             w0, w1 = self.wa[i], self.w(i)
@@ -322,9 +444,19 @@ class RotorStepper:
             if md not in (FWD, BWD):
                 continue
             f = self.fr[e]
-            dqa = self.q(f.a) - self.qa[f.a]
-            dqr = ((self.q(f.b) - self.qa[f.b]) if f.b >= 0 else 0.0) - dqa
+            if self.general:
+                dqr = 0.0
+                for i in range(n):
+                    dqr += self.grow[e][i] * (self.q(i) - self.qa[i])
+            else:
+                dqa = self.q(f.a) - self.qa[f.a]
+                dqr = ((self.q(f.b) - self.qa[f.b]) if f.b >= 0 else 0.0) - dqa
             self.acc[1 + n + p] += md * self.lvm[p] * dqr
+        for j, sp in enumerate(self.dampers):
+            a, b = sp.a, sp.b
+            r0 = (self.wa[b] if b >= 0 else 0.0) - self.wa[a]
+            r1 = (self.w(b) if b >= 0 else 0.0) - self.w(a)
+            self.acc[1 + n + len(self.parts) + j] += sp.D * 0.5 * (r0 * r0 + r1 * r1) * dt
 
     def _forward(self) -> None:
         m, d = self.m, self.d

@@ -25,6 +25,13 @@
  * At MBS_STAGE_POST_STEP: the work of the step: sources c0 shape(t + dt/2) dq + c1 (w0^2 + w1^2)/2 dt, viscous
  * B (w0^2 + w1^2)/2 dt, each sliding part mode x level x relative displacement (exact for the held torques).
  *
+ * General elements (`general`: a relative speed g . w over the rotors, e.g. behind an ideal planetary; locked by a
+ * tendon equality on the fixed tendon g . q, whose force acts as -g tau_e: eqsign -1), one-way clutches (Modelica
+ * OneWayClutch: slide forward only, lock at zero slip, hold any torque toward negative slip, release when the lock
+ * force exceeds peak x level, or `hold` while disengaged), dampers between rotors (their loss after the parts'
+ * terms) and quadratic speed-dependent sources (c2 w^2, held over the step at the speed predicted at mid-step) are
+ * no-ops for systems without them.
+ *
  * The model's eq_data of a lock is written when the lock engages (each run owns its model). Nothing here is global:
  * two runs in two threads never mix. */
 #include <math.h>
@@ -113,6 +120,23 @@ typedef struct {
   int err_index;
   double err_time;
   double err_value;
+  /* general relative-speed rows (ne x n; used when general), lock force sign per element (+1 joint equality, -1
+   * tendon equality), one-way flags and hold torques (ne) */
+  int general;
+  const double* grow;
+  const double* eqsign;
+  const int* oneway;
+  const double* hold;
+  /* dampers (ndamp): rotors a, b (-1 = ground), coefficient; quadratic sources: c2 (nsrc), held torque (nsrc) */
+  int ndamp;
+  const int* da;
+  const int* db;
+  const double* dD;
+  const double* c2;
+  double* sheld;
+  /* work space of the general plastic impact: ne (ne + 1) + ne doubles, 2 ne ints */
+  double* gmat;
+  int* gidx;
 } mbs_drives;
 
 static int fail(mbs_drives* S, int code, int index, double t, double value) {
@@ -157,8 +181,26 @@ static int source_shape(mbs_drives* S, int s, double t, double* out) {
 
 static void slips(const mjData* d, mbs_drives* S) {
   for (int e = 0; e < S->ne; e++) {
-    S->wr[e] = (S->eb[e] >= 0 ? w_of(d, S, S->eb[e]) : 0.0) - w_of(d, S, S->ea[e]);
+    if (S->general) {
+      double v = 0.0;
+      for (int i = 0; i < S->n; i++) v += S->grow[e * S->n + i] * w_of(d, S, i);
+      S->wr[e] = v;
+    } else {
+      S->wr[e] = (S->eb[e] >= 0 ? w_of(d, S, S->eb[e]) : 0.0) - w_of(d, S, S->ea[e]);
+    }
   }
+}
+
+/* breakaway torque of element e at levels el (a disengaged one-way clutch: its hold torque) */
+static inline double capacity(const mbs_drives* S, int e, const double* el) {
+  if (S->oneway[e] && el[e] <= S->free_tol[e]) return S->hold[e];
+  return S->peak[e] * el[e];
+}
+
+/* how far a lock force is past the breakaway torque (> 1: it breaks); a one-way clutch holds any negative force */
+static inline double overload(const mbs_drives* S, int e, const double* el) {
+  double lam = S->oneway[e] ? (S->lam[e] > 0.0 ? S->lam[e] : 0.0) : fabs(S->lam[e]);
+  return lam / capacity(S, e, el);
 }
 
 /* lock forces of the friction elements from the last forward (first row of each equality; 0 where inactive) */
@@ -173,7 +215,7 @@ static int lock_forces(const mjData* d, mbs_drives* S, double t) {
     int id = d->efc_id[r];
     int e = id >= 0 && id < S->neq ? S->eq2el[id] : -1;
     if (e >= 0 && !seen[e]) {
-      S->lam[e] = d->efc_force[r];
+      S->lam[e] = S->eqsign[e] * d->efc_force[r];
       seen[e] = 1;
       if (!isfinite(S->lam[e])) return fail(S, DRV_ERR_NONFINITE, e, t, S->lam[e]);
     }
@@ -189,9 +231,96 @@ static int find(int* parent, int i) {
 /* Switch the locks to the stuck set: plastic impact (the speeds of each rigid group of rotors joined by stuck
  * elements become its momentum-weighted mean, 0 for a group held to the ground), lock offsets of newly engaged
  * locks, equality activation. Returns the kinetic energy removed. */
+/* general systems: the plastic impact is the M-orthogonal projection of the speeds onto the stuck elements'
+ * constraints, w -= M^-1 G^T (G M^-1 G^T)^-1 G w (M = diag J), by Gaussian elimination with partial pivoting;
+ * a dependent constraint (pivot below 1e-12 of the largest diagonal) carries no impulse. */
+static double project(mjData* d, mbs_drives* S) {
+  const int n = S->n, ne = S->ne;
+  int* rows = S->gidx; /* the stuck elements (ne) */
+  int k = 0;
+  for (int e = 0; e < ne; e++) {
+    if (S->modes[e] == DRV_STUCK) rows[k++] = e;
+  }
+  double dke = 0.0;
+  if (!k) return 0.0;
+  double* Sm = S->gmat;      /* k x (k + 1): [G M^-1 G^T | G w] */
+  double* lam = S->gmat + (size_t)ne * (ne + 1);
+  double dmax = 0.0;
+  for (int r = 0; r < k; r++) {
+    const double* gr = S->grow + rows[r] * n;
+    for (int c = 0; c < k; c++) {
+      const double* gc = S->grow + rows[c] * n;
+      double v = 0.0;
+      for (int i = 0; i < n; i++) v += gr[i] * gc[i] / S->J[i];
+      Sm[r * (k + 1) + c] = v;
+    }
+    double b = 0.0;
+    for (int i = 0; i < n; i++) b += gr[i] * w_of(d, S, i);
+    Sm[r * (k + 1) + k] = b;
+    if (Sm[r * (k + 1) + r] > dmax) dmax = Sm[r * (k + 1) + r];
+  }
+  int* piv = S->gidx + ne; /* column -> pivot row, or -1 (ne) */
+  for (int c = 0; c < k; c++) piv[c] = -1;
+  int used = 0;
+  for (int c = 0; c < k; c++) {
+    int best = -1;
+    double bv = 1e-12 * dmax;
+    for (int r = used; r < k; r++) {
+      if (fabs(Sm[r * (k + 1) + c]) > bv) {
+        bv = fabs(Sm[r * (k + 1) + c]);
+        best = r;
+      }
+    }
+    if (best < 0) continue;
+    if (best != used) {
+      for (int j = 0; j <= k; j++) {
+        double tmp = Sm[used * (k + 1) + j];
+        Sm[used * (k + 1) + j] = Sm[best * (k + 1) + j];
+        Sm[best * (k + 1) + j] = tmp;
+      }
+    }
+    for (int r = 0; r < k; r++) {
+      if (r == used) continue;
+      double f = Sm[r * (k + 1) + c] / Sm[used * (k + 1) + c];
+      if (f == 0.0) continue;
+      for (int j = c; j <= k; j++) Sm[r * (k + 1) + j] -= f * Sm[used * (k + 1) + j];
+    }
+    piv[c] = used++;
+  }
+  for (int c = 0; c < k; c++) lam[c] = piv[c] >= 0 ? Sm[piv[c] * (k + 1) + k] / Sm[piv[c] * (k + 1) + c] : 0.0;
+  for (int i = 0; i < n; i++) {
+    double w = w_of(d, S, i), dw = 0.0;
+    for (int c = 0; c < k; c++) dw += S->grow[rows[c] * n + i] * lam[c];
+    double wn = w - dw / S->J[i];
+    dke += S->J[i] * (w * w - wn * wn);
+    d->qvel[S->dof[i]] = wn;
+  }
+  return dke;
+}
+
 static double engage(const mjModel* mc, mjData* d, mbs_drives* S) {
   mjModel* m = (mjModel*)mc; /* the lock offsets live in the run's own model */
   const int n = S->n;
+  if (S->general) {
+    double dke = project(d, S);
+    for (int e = 0; e < S->ne; e++) {
+      int on = S->modes[e] == DRV_STUCK;
+      int k = S->eq[e];
+      if (on && !d->eq_active[k]) {
+        double off = 0.0;
+        if (m->eq_type[k] == mjEQ_TENDON) {
+          for (int i = 0; i < n; i++) off += S->grow[e * n + i] * q_of(d, S, i);
+          m->eq_data[k * mjNEQDATA + 1] = 0.0;
+        } else {
+          off = q_of(d, S, S->ea[e]) - (S->eb[e] >= 0 ? q_of(d, S, S->eb[e]) : 0.0);
+          m->eq_data[k * mjNEQDATA + 1] = S->eb[e] >= 0 ? 1.0 : 0.0;
+        }
+        m->eq_data[k * mjNEQDATA + 0] = off;
+      }
+      d->eq_active[k] = (mjtByte)on;
+    }
+    return 0.5 * dke;
+  }
   int* parent = S->scratch;         /* n + 1 nodes, n = ground */
   int* size = S->scratch + n + 1;   /* rotors per group */
   double* sJ = S->wtmp;             /* n + 1 */
@@ -243,8 +372,9 @@ static double engage(const mjModel* mc, mjData* d, mbs_drives* S) {
   return 0.5 * dke;
 }
 
-/* sliding torques of the elements at levels el, sources at time t */
-static int set_ctrl(mjData* d, mbs_drives* S, double t, const double* el) {
+/* sliding torques of the elements at levels el, sources at time t; a quadratic source's torque at the speed now
+ * (mid = 0) or predicted at mid-step from the last forward's acceleration (mid = 1; held over the step) */
+static int set_ctrl(mjData* d, mbs_drives* S, double t, const double* el, int mid) {
   for (int e = 0; e < S->ne; e++) {
     double tau = sliding(S->modes[e]) ? S->modes[e] * el[e] : 0.0;
     d->ctrl[S->act[e]] = S->act_sign[e] * tau;
@@ -253,6 +383,12 @@ static int set_ctrl(mjData* d, mbs_drives* S, double t, const double* el) {
     double v;
     int r = source_shape(S, s, t, &v);
     if (r) return r;
+    if (S->c2[s] != 0.0) {
+      int dof = S->dof[S->sbody[s]];
+      double w = d->qvel[dof] + (mid ? 0.5 * S->dt * d->qacc[dof] : 0.0);
+      v = S->c0[s] * v + S->c2[s] * w * w; /* the actuator's gain is 1 */
+      S->sheld[s] = v;
+    }
     d->ctrl[S->sact[s]] = v;
   }
   return 0;
@@ -288,7 +424,7 @@ static void event_function(mbs_drives* S, double* g, int stuck_too) {
     if (sliding(md)) {
       g[e] = md * S->wr[e];
     } else if (md == DRV_STUCK && stuck_too) {
-      g[e] = S->peak[e] * S->el[e] - fabs(S->lam[e]);
+      g[e] = capacity(S, e, S->el) - (S->oneway[e] ? S->lam[e] : fabs(S->lam[e]));
     } else {
       g[e] = NAN;
     }
@@ -302,7 +438,7 @@ static void fill_record(const mjData* d, mbs_drives* S) {
   for (int i = 0; i < n; i++) r[n + i] = w_of(d, S, i);
   for (int e = 0; e < ne; e++) r[2 * n + e] = S->modes[e];
   for (int c = 0; c < S->ncmd; c++) r[2 * n + ne + c] = S->u[c];
-  const int na = 1 + n + S->npart;
+  const int na = 1 + n + S->npart + S->ndamp;
   for (int i = 0; i < na; i++) r[2 * n + ne + S->ncmd + i] = S->acc[i];
   r[2 * n + ne + S->ncmd + na] = S->reset_energy;
 }
@@ -328,7 +464,25 @@ static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
   for (int e = 0; e < ne; e++) {
     int md = S->modes[e];
     double wr = S->wr[e];
-    if (S->el[e] <= S->free_tol[e]) {
+    if (S->oneway[e]) { /* Modelica OneWayClutch: stuck = locked or w_rel <= 0; slides forward only */
+      if (md == DRV_FREE) {
+        if (wr > DRV_ZERO_SLIP) {
+          S->modes[e] = DRV_FWD;
+          S->armed[e] = 1;
+        } else {
+          trial[ntrial++] = e;
+        }
+      } else if (md == DRV_FWD) {
+        if (wr > 0.0) {
+          S->armed[e] = 1;
+        } else if (S->armed[e]) {
+          trial[ntrial++] = e;
+        }
+      } else if (md == DRV_STUCK && !S->first && S->lam[e] > capacity(S, e, S->el)) {
+        S->modes[e] = DRV_FWD;
+        S->armed[e] = 0;
+      }
+    } else if (S->el[e] <= S->free_tol[e]) {
       S->modes[e] = DRV_FREE;
     } else if (md == DRV_FREE) {
       if (fabs(wr) < DRV_ZERO_SLIP) {
@@ -357,7 +511,7 @@ static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
     int settled = 0;
     for (int it = 0; it < 2 * ne + 2 && !settled; it++) {
       S->reset_energy += engage(m, d, S);
-      if ((r = set_ctrl(d, S, t, S->el))) return r;
+      if ((r = set_ctrl(d, S, t, S->el, 0))) return r;
       mj_forward(m, d);
       if ((r = lock_forces(d, S, t))) return r;
       S->lock_trials++;
@@ -365,7 +519,7 @@ static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
       double wratio = 0.0;
       for (int e = 0; e < ne; e++) {
         if (S->modes[e] != DRV_STUCK) continue;
-        double ratio = fabs(S->lam[e]) / (S->peak[e] * S->el[e]);
+        double ratio = overload(S, e, S->el);
         if (worst < 0 || ratio > wratio) {
           worst = e;
           wratio = ratio;
@@ -396,7 +550,7 @@ static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
     memcpy(S->elm, S->el, sizeof(double) * (size_t)ne);
   }
   memcpy(S->ctrl0, d->ctrl, sizeof(double) * (size_t)m->nu);
-  if ((r = set_ctrl(d, S, t + 0.5 * dt, S->elm))) return r;
+  if ((r = set_ctrl(d, S, t + 0.5 * dt, S->elm, 1))) return r;
   int same = 1;
   for (int i = 0; i < m->nu && same; i++) same = d->ctrl[i] == S->ctrl0[i];
   if (!same) {
@@ -424,7 +578,8 @@ static int work(mjData* d, mbs_drives* S, long k) {
     int r = source_shape(S, s, tm, &sh);
     if (r) return r;
     double w0 = S->wa[i], w1 = w_of(d, S, i);
-    src += S->c0[s] * sh * (q_of(d, S, i) - S->qa[i]) + S->c1[s] * 0.5 * (w0 * w0 + w1 * w1) * dt;
+    double held = S->c2[s] != 0.0 ? S->sheld[s] : S->c0[s] * sh; /* the torque held over the step (but c1 w) */
+    src += held * (q_of(d, S, i) - S->qa[i]) + S->c1[s] * 0.5 * (w0 * w0 + w1 * w1) * dt;
   }
   acc[0] += src;
   for (int i = 0; i < n; i++) {
@@ -435,10 +590,22 @@ static int work(mjData* d, mbs_drives* S, long k) {
     int e = S->owner[p];
     int md = S->modes[e];
     if (!sliding(md)) continue;
-    int a = S->ea[e], b = S->eb[e];
-    double dqa = q_of(d, S, a) - S->qa[a];
-    double dqr = (b >= 0 ? q_of(d, S, b) - S->qa[b] : 0.0) - dqa;
+    double dqr;
+    if (S->general) {
+      dqr = 0.0;
+      for (int i = 0; i < n; i++) dqr += S->grow[e * n + i] * (q_of(d, S, i) - S->qa[i]);
+    } else {
+      int a = S->ea[e], b = S->eb[e];
+      double dqa = q_of(d, S, a) - S->qa[a];
+      dqr = (b >= 0 ? q_of(d, S, b) - S->qa[b] : 0.0) - dqa;
+    }
     acc[1 + n + p] += md * S->lvm[p] * dqr;
+  }
+  for (int j = 0; j < S->ndamp; j++) {
+    int a = S->da[j], b = S->db[j];
+    double r0 = (b >= 0 ? S->wa[b] : 0.0) - S->wa[a];
+    double r1 = (b >= 0 ? w_of(d, S, b) : 0.0) - w_of(d, S, a);
+    acc[1 + n + S->npart + j] += S->dD[j] * 0.5 * (r0 * r0 + r1 * r1) * dt;
   }
   return 0;
 }

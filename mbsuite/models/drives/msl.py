@@ -1,0 +1,296 @@
+"""Four `Modelica.Mechanics.Rotational.Examples` (Modelica Standard Library 4.1.0) as drives rotor systems.
+
+Components (reusable parts of the drives package, equations of `Modelica/Mechanics/Rotational/Components/*.mo`):
+* `clutch` (`Components.Clutch`): sliding torque mu0 cgeo fn_max f_normalized(t), breakaway peak x that, modes of
+  `Interfaces.PartialFriction` (the drives' friction element);
+* `brake` (`Components.Brake`): the same between a shaft and the support, on w_relfric = w (the flange speed);
+* `one_way_clutch` (`Components.OneWayClutch`): freewheel in parallel with a clutch; its own 3-state logic (stuck =
+  locked or w_rel <= 0; startForward when the holding torque sa > tau0_max; tau0_max = peak2 tau0 engaged,
+  tau0_max_low = eps0 mu0 cgeo fn_max disengaged, eps0 = 1e-4, peak2 = max(peak, 1 + eps0));
+* `planetary_rows` (`Components.IdealPlanetary`): (1 + ratio) w_carrier = w_sun + ratio w_ring with a massless
+  ring: the ring speed as a row over the rotors, so elements on the ring act through it (virtual work);
+* `ideal_gear_row` (`Components.IdealGear`): w_a = ratio w_b, flange b as a row over the rotors;
+* torque sources from `mbsuite.engines.signals` (Step, Sine, Pulse, Ramp) and `quadratic_speed_torque`
+  (`Sources.QuadraticSpeedDependentTorque`, TorqueDirection = true: tau = tau_nominal (w/w_nominal)^2);
+* spring-damper: `friction.Spring` with `D` (`Components.SpringDamper`: tau = c phi_rel + d w_rel).
+
+Examples: `Friction` (3 s), `OneWayClutch` (2 s), `OneWayClutchDisengaged` (2 s), `SimpleGearShift` (5 s), each
+an `Example` with its rotor system, initial state, compared signals on the reference's names and mode conventions.
+Reference results (Friction, OneWayClutch): the Modelica Association's, in `tests/data/msl/` (README there).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...engines.signals import Pulse, Ramp, Signal, Sine, Step
+from ...errors import ModelFileError, ParameterError
+from ...paths import models_root
+from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring
+
+MU0 = 0.5  #: Modelica's default mu_pos = [0, 0.5]
+EPS0 = 1.0e-4  #: OneWayClutch: relative hysteresis epsilon (tau0_max_low = eps0 mu0 cgeo fn_max)
+TUBE = 2.0e-3  #: the Modelica Association's regression tube: 2e-3 of each signal's range
+
+
+# ---- components -------------------------------------------------------------------------------------------------
+def clutch(name: str, a: int, b: int, fn_max: float, *, cgeo: float = 1.0, peak: float = 1.0,
+           f_normalized: Signal | None = None, g: tuple[float, ...] | None = None) -> Friction:
+    """Modelica `Clutch` between flange_a (rotor a) and flange_b (rotor b): w_rel = w_b - w_a (or g . w)."""
+    if not (math.isfinite(fn_max) and fn_max >= 0 and math.isfinite(cgeo) and cgeo >= 0):
+        raise ParameterError(f"clutch '{name}': fn_max and cgeo must be >= 0, got {fn_max!r}, {cgeo!r}")
+    return Friction(name, a, b, [Part(name, MU0 * cgeo * fn_max, schedule=f_normalized)], peak=peak, g=g)
+
+
+def brake(name: str, body: int, n: int, fn_max: float, *, cgeo: float = 1.0, peak: float = 1.0,
+          f_normalized: Signal | None = None, g: tuple[float, ...] | None = None) -> Friction:
+    """Modelica `Brake` on rotor `body` (of n) against the support: w_relfric = w of the flange (or g . w), so its
+    modes read as Modelica's (forward = the shaft turning positive)."""
+    row = g if g is not None else tuple(1.0 if i == body else 0.0 for i in range(n))
+    return clutch(name, body, -1, fn_max, cgeo=cgeo, peak=peak, f_normalized=f_normalized, g=row)
+
+
+def one_way_clutch(name: str, a: int, b: int, fn_max: float, *, cgeo: float = 1.0, peak: float = 1.0,
+                   f_normalized: Signal | None = None) -> Friction:
+    """Modelica `OneWayClutch` between flange_a (rotor a) and flange_b (rotor b), w_rel = w_b - w_a >= 0."""
+    f = clutch(name, a, b, fn_max, cgeo=cgeo, peak=max(peak, 1.0 + EPS0), f_normalized=f_normalized)
+    f.one_way_hold = EPS0 * MU0 * cgeo * fn_max
+    return f
+
+
+def planetary_ring_row(ratio: float, sun: int, carrier: int, n: int) -> np.ndarray:
+    """`IdealPlanetary` with a massless ring: (1 + ratio) w_carrier = w_sun + ratio w_ring, so
+    w_ring = ((1 + ratio) w_carrier - w_sun) / ratio as a row over the n rotors."""
+    if not (math.isfinite(ratio) and ratio > 0):
+        raise ParameterError(f"planetary ratio (ring/sun teeth) must be > 0, got {ratio!r}")
+    row = np.zeros(n)
+    row[carrier] += (1.0 + ratio) / ratio
+    row[sun] -= 1.0 / ratio
+    return row
+
+
+def ideal_gear_row(ratio: float, a: int, n: int) -> np.ndarray:
+    """`IdealGear` (w_a = ratio w_b) with flange b massless: w_b = w_a / ratio as a row over the n rotors."""
+    if not (math.isfinite(ratio) and ratio != 0):
+        raise ParameterError(f"gear ratio must be finite and non-zero, got {ratio!r}")
+    row = np.zeros(n)
+    row[a] = 1.0 / ratio
+    return row
+
+
+def quadratic_speed_torque(label: str, body: int, tau_nominal: float, w_nominal: float) -> Source:
+    """`QuadraticSpeedDependentTorque` (TorqueDirection = true): tau = tau_nominal (w / w_nominal)^2."""
+    if not (math.isfinite(w_nominal) and w_nominal > 0):
+        raise ParameterError(f"quadratic load '{label}': w_nominal must be > 0 rad/s, got {w_nominal!r}")
+    return Source(label, body, 0.0, 0.0, c2=tau_nominal / w_nominal**2)
+
+
+# ---- the examples -----------------------------------------------------------------------------------------------
+@dataclass
+class Example:
+    """One MSL example: rotor system, initial state, duration, the compared signals (reference name -> function of
+    (q, w) arrays), the friction elements' names in the reference, and the reference CSV (None: none published)."""
+
+    name: str
+    system: RotorSystem
+    q0: tuple[float, ...]
+    w0: tuple[float, ...]
+    t_end: float
+    signals: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]]
+    compared: tuple[str, ...]
+    reference: str | None = None
+    mode_columns: dict[str, str] = field(default_factory=dict)  # element -> reference mode column
+    units: dict[str, str] = field(default_factory=dict)
+
+
+def _sig(signals: dict[str, tuple[Callable, str]]) -> tuple[dict, dict]:
+    return {k: v[0] for k, v in signals.items()}, {k: v[1] for k, v in signals.items()}
+
+
+def friction_example() -> Example:
+    """`Examples.Friction`: torque 200 sin(100 t) until 0.5 s -> inertia3 (J 1, w 100) -> clutch (fn_max 160,
+    engaged) -> inertia2 (J 0.05, w 90) -> spring-damper (c 160, d 1) -> brake (fn_max 1600, engaged at 0.5 s, on
+    the support) = inertia1 (J 1, w 90)."""
+    t_off = 0.5
+    f = 50.0 / math.pi  # Modelica sine f = 50/pi Hz: 200 sin(100 t)
+    sources = [Source("torque", 0, 200.0, shape=Sine(frequency=f)),
+               # product with step2 (1 -> 0 at 0.5 s): subtract the same sine from 0.5 s on
+               Source("torque_off", 0, -200.0, shape=Sine(frequency=f, t0=t_off, phase=2 * math.pi * f * t_off))]
+    system = RotorSystem(names=["inertia3", "inertia2", "inertia1"], J=np.array([1.0, 0.05, 1.0]), B=np.zeros(3),
+                         springs=[Spring("spring", 1, 2, 160.0, D=1.0)],
+                         frictions=[clutch("clutch", 0, 1, 160.0),
+                                    brake("brake", 2, 3, 1600.0, f_normalized=Step(t0=t_off))],
+                         sources=sources, breaks=[t_off])
+    sig, units = _sig({
+        "clutch.phi_rel": (lambda q, w: q[1] - q[0], "rad"), "clutch.w_rel": (lambda q, w: w[1] - w[0], "rad/s"),
+        "inertia3.phi": (lambda q, w: q[0], "rad"), "inertia3.w": (lambda q, w: w[0], "rad/s"),
+        "spring.phi_rel": (lambda q, w: q[2] - q[1], "rad"), "spring.w_rel": (lambda q, w: w[2] - w[1], "rad/s"),
+        "inertia2.w": (lambda q, w: w[1], "rad/s"), "inertia1.w": (lambda q, w: w[2], "rad/s")})
+    return Example("msl_friction", system, (0.0, 0.0, 0.0), (100.0, 90.0, 90.0), 3.0, sig,
+                   ("clutch.phi_rel", "clutch.w_rel", "inertia3.phi", "inertia3.w", "spring.phi_rel",
+                    "spring.w_rel"), "Friction_MSL-4.1.0_reference.csv",
+                   {"clutch": "clutch.mode", "brake": "brake.mode"}, units)
+
+
+def _one_way_signals() -> tuple[dict, dict]:
+    return _sig({
+        "inertiaIn.phi": (lambda q, w: q[0], "rad"), "inertiaIn.w": (lambda q, w: w[0], "rad/s"),
+        "oneWayClutch.phi_rel": (lambda q, w: q[1] - q[0], "rad"),
+        "oneWayClutch.w_rel": (lambda q, w: w[1] - w[0], "rad/s"), "inertiaOut.w": (lambda q, w: w[1], "rad/s")})
+
+
+def one_way_clutch_example() -> Example:
+    """`Examples.OneWayClutch`: torque 10 sin(6 pi t) -> inertiaIn (J 1, w -0.5) -> one-way clutch (peak 25,
+    fn_max 3, engaged by a pulse: width 50 %, period 1.3 s, from 0.3 s) -> inertiaOut (J 1, w 0)."""
+    pulse = Pulse(amplitude=1.0, width=0.5, period=1.3, t0=0.3)
+    system = RotorSystem(names=["inertiaIn", "inertiaOut"], J=np.ones(2), B=np.zeros(2),
+                         frictions=[one_way_clutch("oneWayClutch", 0, 1, 3.0, peak=25.0, f_normalized=pulse)],
+                         sources=[Source("torque", 0, 10.0, shape=Sine(frequency=3.0))],
+                         breaks=[0.3, 0.95, 1.6])
+    sig, units = _one_way_signals()
+    return Example("msl_one_way_clutch", system, (0.0, 0.0), (-0.5, 0.0), 2.0, sig,
+                   ("inertiaIn.phi", "inertiaIn.w", "oneWayClutch.phi_rel", "oneWayClutch.w_rel"),
+                   "OneWayClutch_MSL-4.1.0_reference.csv", {}, units)
+
+
+def one_way_clutch_disengaged_example() -> Example:
+    """`Examples.OneWayClutchDisengaged`: torque 0.3 + 10 sin(4 pi t) -> inertiaIn (J 1, w -0.5) -> one-way clutch
+    (peak 25, fn_max 3, never engaged: f_normalized = 0) -> inertiaOut (J 1, w 0) with a load torque -0.3 N m."""
+    system = RotorSystem(names=["inertiaIn", "inertiaOut"], J=np.ones(2), B=np.zeros(2),
+                         frictions=[one_way_clutch("oneWayClutch", 0, 1, 3.0, peak=25.0,
+                                                   f_normalized=Step(height=0.0))],
+                         sources=[Source("torque", 0, 10.0, shape=Sine(frequency=2.0)),
+                                  Source("torque_offset", 0, 0.3), Source("torqueLoad", 1, -0.3)])
+    sig, units = _one_way_signals()
+    return Example("msl_one_way_clutch_disengaged", system, (0.0, 0.0), (-0.5, 0.0), 2.0, sig,
+                   ("inertiaIn.phi", "inertiaIn.w", "oneWayClutch.phi_rel", "oneWayClutch.w_rel"), None, {}, units)
+
+
+RATIO_PLANETARY = 75.0 / 50.0
+
+
+def simple_gear_shift_example() -> Example:
+    """`Examples.SimpleGearShift`: torque step 20 N m at 0.5 s -> engine (J 1) = planetary sun; load (J 10, quadratic
+    load -20 N m at 100 rpm) = carrier; ring massless, held by a brake (cgeo 2, fn_max 100, f = 1 - ramp) and
+    coupled to the sun by a clutch (cgeo 2, fn_max 100, f = ramp 0 -> 1 over 2.0-2.1 s); ratio 75/50."""
+    r, n = RATIO_PLANETARY, 2
+    ring = planetary_ring_row(r, sun=0, carrier=1, n=n)
+    sun = np.array([1.0, 0.0])
+    ramp = Ramp(height=1.0, duration=0.1, t0=2.0)
+    inv = Ramp(height=-1.0, duration=0.1, t0=2.0, offset=1.0)
+    system = RotorSystem(names=["engine", "load"], J=np.array([1.0, 10.0]), B=np.zeros(2),
+                         frictions=[clutch("clutch", 0, -1, 100.0, cgeo=2.0, f_normalized=ramp,
+                                           g=tuple(ring - sun)),
+                                    brake("brake", 0, n, 100.0, cgeo=2.0, f_normalized=inv, g=tuple(ring))],
+                         sources=[Source("torqueStep", 0, 20.0, shape=Step(t0=0.5)),
+                                  quadratic_speed_torque("quadraticSpeedDependentTorque", 1, -20.0,
+                                                         10.471975511966)],
+                         breaks=[0.5, 2.0, 2.1])
+    sig, units = _sig({
+        "engine.w": (lambda q, w: w[0], "rad/s"), "load.w": (lambda q, w: w[1], "rad/s"),
+        "engine.phi": (lambda q, w: q[0], "rad"), "load.phi": (lambda q, w: q[1], "rad"),
+        "clutch.w_rel": (lambda q, w: (ring - sun) @ w, "rad/s"), "brake.w": (lambda q, w: ring @ w, "rad/s")})
+    return Example("msl_simple_gear_shift", system, (0.0, 0.0), (0.0, 0.0), 5.0, sig,
+                   ("engine.w", "load.w", "clutch.w_rel", "brake.w"), None, {}, units)
+
+
+EXAMPLES: dict[str, Callable[[], Example]] = {
+    "msl_friction": friction_example,
+    "msl_one_way_clutch": one_way_clutch_example,
+    "msl_one_way_clutch_disengaged": one_way_clutch_disengaged_example,
+    "msl_simple_gear_shift": simple_gear_shift_example,
+}
+
+#: units of every signal the examples produce (for the model's output table)
+SIGNAL_UNITS: dict[str, str] = {k: u for f in EXAMPLES.values() for k, u in f().units.items()}
+
+
+def example(name: str) -> Example:
+    if name not in EXAMPLES:
+        raise ParameterError(f"unknown MSL example {name!r}; valid: {sorted(EXAMPLES)}")
+    return EXAMPLES[name]()
+
+
+# ---- results, references, comparisons ---------------------------------------------------------------------------
+def signals_of(ex: Example, res: RefResult) -> dict[str, np.ndarray]:
+    return {k: np.asarray(f(res.q, res.w), float) for k, f in ex.signals.items()}
+
+
+def reference_path(ex: Example) -> Path:
+    if ex.reference is None:
+        raise ModelFileError(f"{ex.name}: the Modelica Association publishes no reference result for this example")
+    p = models_root() / "tests" / "data" / "msl" / ex.reference
+    if not p.is_file():
+        raise ModelFileError(f"reference result not found: {p} (it ships with the repository in tests/data/msl/)")
+    return p
+
+
+def load_reference(ex: Example) -> dict[str, np.ndarray]:
+    """The reference CSV as columns on their Modelica names (event rows duplicated, as published)."""
+    with open(reference_path(ex)) as fh:
+        names = [h.strip().strip('"') for h in fh.readline().split(",")]
+    data = np.loadtxt(reference_path(ex), delimiter=",", skiprows=1)
+    return {nm: data[:, i] for i, nm in enumerate(names)}
+
+
+MODE_CODE = {"backward": -1, "stuck": 0, "forward": 1, "free": 2}
+
+
+def reference_events(ex: Example, ref: dict[str, np.ndarray]) -> list[dict[str, Any]]:
+    """Mode changes of the reference: from its mode columns; for the one-way clutch (no mode column) from w_rel:
+    stuck while w_rel = 0 (|w_rel| < 1e-9 rad/s), the lock at the first such row, the release at the last."""
+    t = ref["time"]
+    out = []
+    for el, col in ex.mode_columns.items():
+        m = ref[col].astype(int)
+        for i in np.nonzero(np.diff(m))[0]:
+            out.append({"t": float(t[i + 1]), "element": el, "from": int(m[i]), "to": int(m[i + 1])})
+    if "oneWayClutch.w_rel" in ref:
+        st = (np.abs(ref["oneWayClutch.w_rel"]) < 1e-9).astype(int)
+        for i in np.nonzero(np.diff(st))[0]:
+            if st[i + 1]:
+                out.append({"t": float(t[i + 1]), "element": "oneWayClutch", "from": 1, "to": 0})
+            else:
+                out.append({"t": float(t[i]), "element": "oneWayClutch", "from": 0, "to": 1})
+    return sorted(out, key=lambda e: (e["t"], e["element"]))
+
+
+def events_as_codes(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [{"t": float(e["t"]), "element": e["element"], "from": MODE_CODE[e["from"]], "to": MODE_CODE[e["to"]]}
+            for e in events]
+
+
+def pair_events(ours: list[dict[str, Any]], ref: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Pair two event lists in order (same element and transition): rows with both times (None: unmatched)."""
+    rows, pool = [], list(ours)
+    for r in ref:
+        o = next((x for x in pool if (x["element"], x["from"], x["to"]) == (r["element"], r["from"], r["to"])), None)
+        if o is not None:
+            pool.remove(o)
+        rows.append({"element": r["element"], "from": r["from"], "to": r["to"], "t_ref": r["t"],
+                     "t": None if o is None else o["t"]})
+    rows += [{"element": o["element"], "from": o["from"], "to": o["to"], "t_ref": None, "t": o["t"]} for o in pool]
+    return rows
+
+
+def tube_check(ex: Example, res: RefResult, ref: dict[str, np.ndarray]) -> dict[str, dict[str, float]]:
+    """Every compared signal against the reference on the reference's time grid: the largest deviation relative to
+    the regression tube TUBE x (range of the reference signal) (<= 1: inside). Ours is interpolated linearly from
+    its output grid."""
+    sig = signals_of(ex, res)
+    t_ref = ref["time"]
+    out = {}
+    for k in ex.compared:
+        y_ref = ref[k]
+        y = np.interp(t_ref, res.t, sig[k])
+        width = TUBE * float(np.ptp(y_ref))
+        dev = np.abs(y - y_ref)
+        i = int(np.argmax(dev))
+        out[k] = {"max_dev": float(dev[i]), "tube": width, "ratio": float(dev[i] / width), "t": float(t_ref[i])}
+    return out

@@ -190,27 +190,77 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
     signals = [x for x in (args.signals.split(",") if args.signals else []) if x] or \
         sorted(results[0]["signals"]) if results else []
     head = [f"{s}.{n}" for s, n, _ in axes]
+    units = {h: _axis_unit(scene, s, n) for h, (s, n, _) in zip(head, axes, strict=True)}
+    sig_units = {sig: scene.spec.outputs.get(sig, "") for sig in signals}
     rows, cols = [], {h: [] for h in head}
     for combo, r in zip(combos, results, strict=True):
-        row = list(combo)
         for h, v in zip(head, combo, strict=True):
             cols[h].append(v)
         for sig in signals:
             st = r["signals"].get(sig)
             if st is None:
                 raise MbsuiteError(f"signal {sig!r} not in the results; available: {sorted(r['signals'])}")
-            row += [st["min"], st["max"], st["mean"]]
+            rows.append([*combo, sig, sig_units[sig], st["min"], st["max"], st["mean"]])
             for k in ("min", "max", "mean"):
                 cols.setdefault(f"{sig}_{k}", []).append(st[k])
-        rows.append(row)
-    table = format_table(head + [f"{sig} {k}" for sig in signals for k in ("min", "max", "mean")], rows, ".5g")
-    data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "points": [
-        {"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}
+    heads = [f"{h} [{units[h]}]" if units[h] else h for h in head]
+    table = format_table([*heads, "signal", "unit", "min", "max", "mean"], rows, ".5g")
+    data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "units": {**units, **sig_units},
+            "points": [{"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}
 
     def write(out: Path) -> list[Path]:
-        return [write_csv(Path(out) / "sweep.csv", [(k, "", v) for k, v in cols.items()])]
+        from .plotting import save
+
+        csv_cols = [(k, units[k] if k in units else sig_units[k.rsplit("_", 1)[0]], v) for k, v in cols.items()]
+        return [write_csv(Path(out) / "sweep.csv", csv_cols),
+                save(_plot_sweep(head, units, combos, results, signals, sig_units), Path(out) / "sweep.png")]
 
     _emit(Report(data, table, write), args, scene.to_dict())
+
+
+def _axis_unit(scene, section: str, name: str) -> str:
+    """The SI unit of a swept key, from its declaration (parameter field, input key or solver setting)."""
+    from .limits import limit_of
+    from .scenes import SOLVER_LIMITS
+
+    lim = None
+    if section == "params":
+        try:
+            lim = limit_of(scene.spec.params_cls, name)
+        except (KeyError, TypeError):
+            lim = None
+    elif section == "input":
+        lim = (scene.spec.inputs.get(scene.input.get("type"), {}) or {}).get(name)
+    elif section == "solver":
+        lim = SOLVER_LIMITS.get(name)
+    return getattr(lim, "unit", "") or ""
+
+
+def _plot_sweep(head: list[str], units: dict, combos: list, results: list, signals: list[str], sig_units: dict):
+    """Each signal's mean (line) and min-max (band) against the first swept key; one line per combination of the
+    other keys (at most 8)."""
+    from .plotting import figure
+
+    shown = signals[:6]
+    fig, axs = figure(len(shown), 1, size=(8.0, 1.8 + 2.0 * len(shown)), sharex=True, squeeze=False)
+    groups: dict = {}
+    for i, c in enumerate(combos):
+        groups.setdefault(tuple(c[1:]), []).append(i)
+    numeric = all(isinstance(c[0], int | float) and not isinstance(c[0], bool) for c in combos)
+    for ax, sig in zip(axs[:, 0], shown, strict=True):
+        for rest, idx in list(groups.items())[:8]:
+            x = [combos[i][0] if numeric else str(combos[i][0]) for i in idx]
+            st = [results[i]["signals"][sig] for i in idx]
+            label = ", ".join(f"{h} = {v}" for h, v in zip(head[1:], rest, strict=True)) or None
+            line, = ax.plot(x, [s["mean"] for s in st], marker="o", ms=3, label=label)
+            ax.fill_between(x, [s["min"] for s in st], [s["max"] for s in st], color=line.get_color(), alpha=0.15)
+        ax.set_ylabel(f"{sig} [{sig_units[sig]}]" if sig_units[sig] else sig)
+        ax.grid(True, alpha=0.3)
+        if len(groups) > 1:
+            ax.legend(fontsize=6)
+    axs[-1, 0].set_xlabel(f"{head[0]} [{units[head[0]]}]" if units[head[0]] else head[0])
+    fig.suptitle("sweep: mean (line) and min-max over the run (band)", fontsize=9)
+    return fig
 
 
 def _scene_opts(p: argparse.ArgumentParser) -> None:

@@ -57,6 +57,43 @@ class SimResult:
         cols = [("t", "s", self.t)] + [(k, self.units.get(k, ""), v) for k, v in self.signals.items()]
         return write_csv(path, cols)
 
+    def to_pandas(self) -> Any:
+        """The signals as a `pandas.DataFrame` indexed by time `t [s]`, columns `name [unit]` (needs pandas:
+        `pip install mbsuite[pandas]`)."""
+        try:
+            import pandas as pd
+        except ModuleNotFoundError as exc:
+            raise ModuleNotFoundError("SimResult.to_pandas() needs pandas: pip install 'mbsuite[pandas]'") from exc
+        cols = {f"{k} [{self.units.get(k, '')}]" if self.units.get(k) else k: np.asarray(v)
+                for k, v in self.signals.items()}
+        return pd.DataFrame(cols, index=pd.Index(np.asarray(self.t), name="t [s]"))
+
+    def plot(self, signals: Sequence[str] | None = None, axes: Any = None) -> Any:
+        """Time histories, one panel per unit (signals sharing a unit share a panel). Draws on `axes` (a sequence
+        of Axes, one per unit) if given, else returns a new `matplotlib.figure.Figure`."""
+        from .plotting import figure
+
+        names = list(signals) if signals is not None else list(self.signals)
+        by_unit: dict[str, list[str]] = {}
+        for k in names:
+            by_unit.setdefault(self.units.get(k, "") or "-", []).append(k)
+        fig = None
+        if axes is None:
+            fig, axes = figure(len(by_unit), 1, size=(9.0, 1.8 + 1.9 * len(by_unit)), sharex=True, squeeze=False)
+            axes = axes[:, 0]
+        for ax, (unit, ks) in zip(axes, by_unit.items(), strict=True):
+            for k in ks:
+                ax.plot(self.t, self.signals[k], lw=0.9, label=k)
+            ax.set_ylabel(f"[{unit}]")
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=7, loc="upper right")
+        axes[-1].set_xlabel("t [s]")
+        if fig is not None:
+            model = self.scene.get("model", "")
+            name = self.scene.get("name", "")
+            fig.suptitle(f"{model}/{name} ({self.engine})" if model else self.engine, fontsize=9)
+        return fig if fig is not None else axes
+
     def report(self) -> Report:
         """A CLI report: per-signal min/max/final, events, solver stats; `--out` writes run.csv."""
         rows = [[k, self.units.get(k, ""), float(np.min(v)), float(np.max(v)), float(v[-1])]
@@ -76,7 +113,12 @@ class SimResult:
                 f"{f.name} {f.value:.3g} (bound {f.bound:.3g}{'' if f.ok else ', EXCEEDED'})" for f in self.health)
         for w in self.warnings:
             table += f"\n{w}"
-        return Report(self.summary(), table, lambda out: [self.write_csv(Path(out) / "run.csv")])
+        def write(out: Path) -> list[Path]:
+            from .plotting import save
+
+            return [self.write_csv(Path(out) / "run.csv"), save(self.plot(), Path(out) / "run.png")]
+
+        return Report(self.summary(), table, write)
 
 
 def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, engine: str,

@@ -177,11 +177,45 @@ def _table(rows: list[Row], best: list[dict], study: Study, ref_info: dict) -> s
     return "\n".join(lines)
 
 
-def _write(out: Path, rows: list[Row], best: list[dict], scene: Scene, study: Study) -> list[Path]:
-    import matplotlib
+def plot(rows: list[Row], study: Study, title: str = "", axes: Any = None) -> Any:
+    """Error against wall time for every (engine, method): state error (left) and physics error (right); each point
+    is labelled with its setting (step size, or rtol for the scipy paths). Draws on `axes` (two Axes) if given,
+    else returns a new Figure."""
+    from ..plotting import figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    fig = None
+    if axes is None:
+        fig, axes = figure(1, 2, size=(13, 5.5))
+    ok = [r for r in rows if r.error is None]
+    for key in sorted({(r.engine, r.method) for r in ok}):
+        rr = sorted([r for r in ok if (r.engine, r.method) == key], key=lambda r: r.time_s)
+        for ax, attr in zip(axes, ("state_error", "physics_error"), strict=True):
+            y = np.array([max(getattr(r, attr), 1e-17) for r in rr])
+            ax.errorbar([r.time_s for r in rr], y,
+                        xerr=[[r.time_s - r.time_min for r in rr], [r.time_max - r.time_s for r in rr]],
+                        marker="o" if key[0] == "mujoco" else "s", ls="-" if key[0] == "mujoco" else "--",
+                        label=f"{key[0]} {key[1]}", ms=4)
+            for r, yy in zip(rr, y, strict=True):
+                ax.annotate(_fmt_setting(r.setting), (r.time_s, yy), fontsize=5, alpha=0.7,
+                            xytext=(3, 3), textcoords="offset points")
+    for ax, what in zip(axes, (f"state error: {study.state_doc}", f"physics error: {study.physics_doc}"),
+                        strict=True):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("wall time (s): median, bars min-max; labels: step (s) or rtol")
+        ax.set_title(what, fontsize=7, wrap=True)
+        ax.grid(True, which="both", alpha=0.3)
+        for tol in TOLS:
+            ax.axhline(tol, color="grey", lw=0.6, ls=":")
+    axes[0].set_ylabel("relative error (dotted: 1e-2, 1e-4, 1e-6)")
+    axes[1].legend(fontsize=7, ncol=2)
+    if fig is not None and title:
+        fig.suptitle(title)
+    return fig if fig is not None else axes
+
+
+def _write(out: Path, rows: list[Row], best: list[dict], scene: Scene, study: Study) -> list[Path]:
+    from ..plotting import save
 
     out = Path(out)
     ok = [r for r in rows if r.error is None]
@@ -191,29 +225,6 @@ def _write(out: Path, rows: list[Row], best: list[dict], scene: Scene, study: St
         ("time_median", "s", [r.time_s for r in ok]), ("time_min", "s", [r.time_min for r in ok]),
         ("time_max", "s", [r.time_max for r in ok]), ("state_error", "-", [r.state_error for r in ok]),
         ("physics_error", "-", [r.physics_error for r in ok])])]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
-    for key in sorted({(r.engine, r.method) for r in ok}):
-        rr = sorted([r for r in ok if (r.engine, r.method) == key], key=lambda r: r.time_s)
-        for ax, attr in zip(axes, ("state_error", "physics_error"), strict=True):
-            y = np.array([max(getattr(r, attr), 1e-17) for r in rr])
-            ax.errorbar([r.time_s for r in rr], y,
-                        xerr=[[r.time_s - r.time_min for r in rr], [r.time_max - r.time_s for r in rr]],
-                        marker="o" if key[0] == "mujoco" else "s", ls="-" if key[0] == "mujoco" else "--",
-                        label=f"{key[0]} {key[1]}", ms=4)
-    for ax, title in zip(axes, (f"state error: {study.state_doc}", f"physics: {study.physics_doc}"), strict=True):
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("wall time (s), median; bars min-max")
-        ax.set_title(title, fontsize=7, wrap=True)
-        ax.grid(True, which="both", alpha=0.3)
-        for tol in TOLS:
-            ax.axhline(tol, color="grey", lw=0.6, ls=":")
-    axes[0].set_ylabel("error")
-    axes[1].legend(fontsize=7, ncol=2)
-    fig.suptitle(f"work-precision: {scene.model}/{scene.name}")
-    fig.tight_layout()
-    p = out / "workprecision.png"
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    files.append(p)
+    fig = plot(rows, study, title=f"work-precision: {scene.model}/{scene.name}")
+    files.append(save(fig, out / "workprecision.png"))
     return files

@@ -25,7 +25,7 @@ from mujoco import rollout
 
 import mbsuite
 from mbsuite.models.drives import coupled_clutches as cc
-from mbsuite.models.drives import drive
+from mbsuite.models.drives import drive, msl
 from mbsuite.models.drives.model import reference_signal
 from mbsuite.models.drives.mujoco_path import MujocoRotorSim
 from mbsuite.paths import mjcf_path
@@ -38,6 +38,10 @@ def setup(scene):
     eff = dict(scene.effects)
     sv = scene.solver
     mech = eff["mechanism"]
+    if mech in msl.EXAMPLES:
+        ex = msl.example(mech)
+        sim = MujocoRotorSim(ex.system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep, integrator=sv.integrator)
+        return sim, (ex.q0, ex.w0), lambda: None, sv.sample_dt or 5e-4
     if mech == "coupled_clutches":
         sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=sv.timestep,
                              integrator=sv.integrator)

@@ -159,7 +159,7 @@ def test_cli_design_and_run(capsys):
     assert d["K"] == pytest.approx(7.07, rel=0.01)
     assert main(["drive", "run", "drives/step_up_pwm", "--duration", "0.5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert abs(out["stats"]["energy_balance"]["relative"]) < 1e-5
+    assert abs(out["stats"]["energy_balance"]["relative"]) < 2e-7  # measured 3.0e-9 (hand path, 0.5 s)
     assert main(["drive", "run", "drives/nope"]) == 2
     assert "no scene" in capsys.readouterr().err
     assert main(["drive", "design", "springsz", "--K", "1", "--xmax", "2", "--fatigue", "2"]) == 2
@@ -169,7 +169,43 @@ def test_cli_design_and_run(capsys):
         args.update(dict(zip(bad[::2], bad[1::2], strict=True)))
         assert main(["drive", "design", "gains", *[x for kv in args.items() for x in kv]]) == 2
         err = capsys.readouterr().err
-        assert ("w0" if bad[1] == "0" else "J_l") in err and "Traceback" not in err
+        assert ("w0" if bad[1] == "0" else "--Jl = -0.0023") in err and "Traceback" not in err
     assert main(["drive", "design", "springsz", "--K", "0.98", "--xmax", "5.09", "--sigma-uts", "2e9", "--E", "207e9",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["V"] == pytest.approx(8.409e-5, rel=1e-3)
+
+
+_CC = ["drive", "coupled-clutches"]
+_GAINS = ["drive", "design", "gains", "--Jl", "0.0023", "--ts", "0.069", "--taul", "0.15", "--btotal", "2.5e-4"]
+
+
+@pytest.mark.parametrize("argv,fragment", [
+    (_CC + ["--timestep", "0"], "--timestep = 0.0 is invalid; valid: (0, 0.01] s"),
+    (_CC + ["--timestep", "nan"], "--timestep = nan is invalid"),
+    (_CC + ["--timestep=-1e-4"], "--timestep = -0.0001 is invalid"),
+    (_CC + ["--timestep", "1"], "--timestep = 1.0 is invalid"),
+    (_CC + ["--timestep", "1e-9"], "--timestep: 1.5 s at a step of 1e-09 s is 1.5e+09 steps"),
+    (["drive", "run", "drives/step_up_pwm", "--duration", "nan"], "--duration = nan is invalid"),
+    (["drive", "run", "drives/step_up_pwm", "--duration", "0"], "--duration = 0.0 is invalid"),
+    (["drive", "run", "drives/step_up_pwm", "--duration", "1e5", "--engine", "mujoco"], "max_steps"),
+    (["drive", "efficiency", "drives/step_up_efficiency", "--loads", "0,inf"], "--loads entry 2 = inf is invalid"),
+    (["drive", "efficiency", "drives/step_up_efficiency", "--duration", "-1"], "--duration = -1.0 is invalid"),
+    (["drive", "design", "srmin", "--P", "inf", "--wmin", "50", "--wrip", "5", "--Jl", "0.1"], "--P = inf"),
+    (["drive", "design", "srmin", "--P", "500", "--wmin", "50", "--wrip", "nan", "--Jl", "0.1"], "--wrip = nan"),
+    (["drive", "design", "cadjs", "--P", "500", "--srmin", "20,-1", "--wmax", "500", "--vm", "100"],
+     "--srmin entry 2 = -1.0 is invalid"),
+    (["drive", "design", "cadjs", "--P", "500", "--srmin", "20", "--wmax", "500", "--vm", "100", "--tau-c", "nan"],
+     "--tau-c = nan"),
+    (["drive", "design", "cadjs", "--P", "500", "--srmin", "20", "--wmax", "500", "--vm", "100", "--js", "0"],
+     "--js entry 1 = 0.0 is invalid"),
+    (["drive", "design", "springsz", "--K", "1", "--xmax", "-2"], "--xmax = -2.0 is invalid"),
+    (["drive", "design", "springsz", "--K", "1", "--xmax", "2", "--E", "nan"], "--E = nan"),
+    (_GAINS + ["--w0", "nan"], "--w0 = nan is invalid"),
+    (_GAINS + ["--w0", "400", "--ts", "inf"], "--ts = inf is invalid"),
+])
+def test_cli_numeric_options_checked(argv, fragment, capsys):
+    """Every numeric option of `mbsuite drive ...` is checked before any work (finite, range, the size guard on the
+    number of steps): exit status 2 and a one-line error naming the option, its value and the valid range."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and "Traceback" not in err, err

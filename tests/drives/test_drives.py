@@ -32,13 +32,20 @@ def test_spec_and_scenes_registered():
 
 
 @pytest.mark.parametrize("name", sorted(get_model("drives").scene_files()))
-def test_shipped_scenes_step_without_mujoco_warnings(name):
+def test_shipped_scenes_close_their_energy_balance(name):
+    """Every shipped scene on MuJoCo (the suite's menagerie test steps them; here the physical invariant): input -
+    output - losses - stored energy change = 0. Measured over 0.15 s (0.7 s for the MSL examples, which start
+    moving later): <= 7.2e-8 of the energy turnover (msl_friction; step-up scenes 5.3e-8); bound 5e-7, 7x. No MuJoCo
+    warning, no callback left installed."""
+    msl_scene = name.startswith("msl_")
     sc = load_scene(f"drives/{name}")
-    sc = sc.replace(solver={"engine": "mujoco", "duration": 0.15, "t_settle": 0.0})
-    res, _, _ = simulate_scene(sc)
+    sc = sc.replace(solver={"engine": "mujoco", "duration": 0.7 if msl_scene else 0.15, "t_settle": 0.0})
+    res, _, sys_ = simulate_scene(sc)
+    bal = drive.energy_balance(sys_, res)
+    assert max(abs(bal.input), abs(bal.output), abs(bal.stored)) > 1e-3  # the scene moved: a balance to check
+    assert abs(bal.relative) < 5e-7, bal
     assert res.stats["warnings"] == {}
     assert not mujoco_engine.active_callbacks()  # the drives install no MuJoCo callback at all
-    assert np.all(np.isfinite(res.w))
 
 
 def test_effect_off_builds_nothing():
@@ -68,14 +75,18 @@ def susd_pair():
 
 
 def _balance_ok(sys_, res):
+    """input - output - losses - stored change within 5e-6 of the input: measured <= 7.1e-7 (hand path, matched
+    resonant step-up, default rtol), <= 1.9e-7 (motor-resonant), <= 8.5e-8 (MuJoCo); bound 7x the worst. A loss
+    term of 1e-5 of the input left out of the books fails it."""
     b = drive.energy_balance(sys_, res)
-    assert abs(b.relative) < 0.005, b  # input - output - losses - stored within 0.5 % of the input
+    assert abs(b.relative) < 5e-6, b
     return b
 
 
 def test_step_up_paths_agree(step_up_pair):
-    """Issue acceptance over >= 20 energy cycles: same cycles, equal lock/release event counts, every lock-up and
-    release within one controller sample (2 ms), load speed within 0.5 %, both balances within 0.5 %.
+    """Over >= 20 energy cycles: same cycles, equal lock/release event counts, every lock-up and release within one
+    MuJoCo step (1e-4 s; measured max 2.5e-5 s, 4x), load speed within 1e-4 (measured 9.7e-6, 10x), both balances
+    closed (`_balance_ok`).
 
     Documented deviation (README "Deviations"): at t = 3.668 s the sliding brake's slip reverses *grazing* (the
     spring end dips to -0.03 rad/s for ~2 ms). The exact path passes through (holding torque above breakaway at its
@@ -85,7 +96,7 @@ def test_step_up_paths_agree(step_up_pair):
     (_, ra, ca, sys_), (_, rb, cb, _) = step_up_pair["reference"], step_up_pair["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.5), drive.cycle_stats(rb, cb, 0.5)
     assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]
-    assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 0.005
+    assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 1e-4
     cmd = drive.compare_commands(ca, cb)
     assert cmd["same_sequence"] and not cmd["flips"], cmd
     els = ["clutch", "spring_ground"]
@@ -96,18 +107,18 @@ def test_step_up_paths_agree(step_up_pair):
         assert not [e for e in ra.events if e["to"] == "stuck" and abs(e["t"] - t_s) < 3e-3]
     cmp = drive.compare_events(ra, drive.without_events(rb, blips), els)
     assert {"clutch->stuck", "clutch->free", "spring_ground->stuck"} <= set(cmp)
-    dt_c = 1.0 / 500.0
     for k, v in cmp.items():
         assert v["n_a"] == v["n_b"], (k, v)
-        assert v["max_dt"] <= dt_c, (k, v)
+        assert v["max_dt"] <= 1e-4, (k, v)  # one MuJoCo step (measured 2.5e-5 s); the controller sample is 2 ms
     _balance_ok(sys_, ra)
     _balance_ok(sys_, rb)
 
 
 def test_susd_paths_agree(susd_pair):
-    """Issue acceptance on the 100 W design over >= 20 energy cycles: equal event counts, energy packets (energy
-    taken up by the spring system per extraction, `drive.energy_packets`) within 1 %, load speed within 0.5 %, every
-    lock-up/release within one controller sample (1 ms).
+    """The 100 W design over >= 20 energy cycles: equal event counts, energy packets (energy taken up by the spring
+    system per extraction, `drive.energy_packets`) within 5e-3 (measured 1.0e-3, 5x), load speed within 3e-3
+    (measured 8.0e-4, 3.75x), every lock-up/release within one controller sample (1 ms; median measured 4.5e-5 s,
+    asserted 1e-4 s).
 
     Documented deviation (README "Deviations"): the controller turns a computed wait into samples with the thesis'
     int() truncation. Where the two paths' computed waits straddle an integer (here 11.990 vs 12.017 samples: the
@@ -119,13 +130,13 @@ def test_susd_paths_agree(susd_pair):
     (_, ra, ca, sys_), (_, rb, cb, _) = susd_pair["reference"], susd_pair["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.5), drive.cycle_stats(rb, cb, 0.5)
     assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]
-    assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 0.005
+    assert abs(sa["mean_load_speed"] / sb["mean_load_speed"] - 1) < 3e-3
     pa, pb = drive.energy_packets(sys_, ra, ca, 0.5), drive.energy_packets(sys_, rb, cb, 0.5)
     assert pa["stored"].size == pb["stored"].size >= 20
     np.testing.assert_allclose(pa["t"], pb["t"], rtol=0, atol=1e-9)  # the same cycles
     assert np.all(pa["stored"] > 1.0)  # J: real packets (demand 12.8 J, the capacity 1/2 K x_max^2)
-    assert np.max(np.abs(pa["stored"] / pb["stored"] - 1)) < 0.01
-    assert np.max(np.abs(pa["delivered"] / pb["delivered"] - 1)) < 0.01
+    assert np.max(np.abs(pa["stored"] / pb["stored"] - 1)) < 5e-3
+    assert np.max(np.abs(pa["delivered"] / pb["delivered"] - 1)) < 5e-3
     dt_c = 1e-3
     cmd = drive.compare_commands(ca, cb)
     assert cmd["same_sequence"], cmd
@@ -150,7 +161,7 @@ def test_susd_paths_agree(susd_pair):
 
 def test_reference_energy_balance_is_exact(susd_pair):
     _, ra, _, sys_ = susd_pair["reference"]
-    assert abs(drive.energy_balance(sys_, ra).relative) < 1e-5
+    assert abs(drive.energy_balance(sys_, ra).relative) < 2e-7  # measured 1.8e-8 (100 W design, 2.5 s): 11x
 
 
 # ---- controllers -----------------------------------------------------------------------------------------------------
@@ -212,37 +223,60 @@ def step_up_runs():
 
 
 def test_step_up_reproduction(step_up_runs):
+    """Published numbers asserted to their printed precision: "~3" (L915) is any ratio that rounds to 3, [2.5, 3.5)
+    (measured 3.29); "~50 %" (L959-969) rounds to the nearest 10 %, [45, 55) % (measured 54 %); the qualitative
+    orderings of L939 (resonant above PWM; measured 212 vs 209 rad/s) and L947 ("significant increase" by clutch
+    matching; measured +12 %, asserted > 5 %)."""
     pwm = step_up_runs["step_up_pwm"]
     ratio = pwm["mean_load_speed"] / pwm["mean_motor_speed"]
-    assert 2.7 < ratio < 3.6  # thesis: load ~3x the mean motor speed (L915)
+    assert 2.5 <= ratio < 3.5
     assert step_up_runs["step_up_resonant"]["mean_load_speed"] > pwm["mean_load_speed"]  # L939
     assert (step_up_runs["step_up_resonant_matched"]["mean_load_speed"]
             > 1.05 * step_up_runs["step_up_resonant"]["mean_load_speed"])  # L947 "significant increase"
     gain = step_up_runs["step_up_added_inertia"]["mean_load_speed"] / pwm["mean_load_speed"] - 1
-    assert 0.35 < gain < 0.65  # thesis: ~50 % (L959-969)
+    assert 0.45 <= gain < 0.55
 
 
-def test_susd_100w_design_reproduction():
-    """+-400 rad/s and ~5 rad extension as the thesis (L1987-2001). Switching rate: known deviation - ours 12.8
-    cycles/s against the thesis' ~14.5 (Table 6.2: 14.20), 12 % lower; README "Deviations" gives the measured cycle
-    breakdown. The assertion is a regression band around our value, the thesis number is printed next to it."""
+@pytest.fixture(scope="module")
+def susd_design():
     sc, res, ctrl, sys_ = _sim("susd_100w_design")
-    cs = drive.cycle_stats(res, ctrl, sc.solver.t_settle)
-    assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (L1987-1993)
-    print(f"switching rate {cs['switching_rate']:.2f} cycles/s (thesis ~14.5, L2001; Table 6.2 14.20)")
-    assert 12.4 < cs["switching_rate"] < 13.2  # ours 12.8; thesis 14.5: documented deviation (-12 %)
-    assert 4.6 < cs["max_extension"] < 5.3  # ~5 rad (L2001)
+    return sc, drive.cycle_stats(res, ctrl, sc.solver.t_settle), drive.cycle_phases(ctrl, sc.solver.t_settle)
+
+
+def test_susd_100w_design_reproduction(susd_design):
+    """+-400 rad/s and "~5 rad" extension as the thesis (L1987-2001), each to its printed precision.
+
+    Switching rate: the thesis' ~14.5 cycles/s (L2001; Table 6.2: 14.20) is asserted with the tolerance of a
+    documented deviation, not an accuracy: ours is 12.8 (-11.7 %), README "Deviations" 3 - the whole difference is
+    in the extraction (23.1 vs 18.1 ms in the design model, Eq 5.5); our slower motor (82 vs 96 rad/s) explains a
+    1.17x longer extraction, the rest is not explained. The free phases of the cycle (waits, transfer, restart) are
+    checked against the closed form instead: one free period 2 pi sqrt(J_s/K) plus one controller sample
+    (measured -0.46 %, bound 2 %, 4x)."""
+    sc, cs, ph = susd_design
+    assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (L1987-1993); measured -0.76 %
+    assert abs(cs["switching_rate"] / 14.5 - 1) < 0.15  # documented deviation (-11.7 %), see the docstring
+    assert 4.5 <= cs["max_extension"] < 5.5  # "~5 rad" (L2001) to its printed precision; measured 4.90
+    p = sc.build_params().resolved(sc.effects["param_set"])
+    free = ph["wait_extraction"] + ph["wait_transfer"] + ph["transfer"] + ph["restart"]
+    assert abs(free / (2 * math.pi * math.sqrt(p["J_s"] / p["K"]) + 1 / p["fs"]) - 1) < 0.02
     sc2, res2, ctrl2, _ = _sim("susd_100w_reverse")
     cs2 = drive.cycle_stats(res2, ctrl2, sc2.solver.t_settle)
-    assert abs(cs2["mean_load_speed"] / -400 - 1) < 0.05
+    assert abs(cs2["mean_load_speed"] / -400 - 1) < 0.05  # measured +1.5 % (-406 rad/s)
+
+
+def test_regression_susd_100w_switching_rate(susd_design):
+    """Regression only (no outside source for this value): 12.81 cycles/s, cycle 78.1 ms, extraction 23.1 ms."""
+    _, cs, ph = susd_design
+    assert cs["switching_rate"] == pytest.approx(12.81, rel=0.01)
+    assert ph["extraction"] == pytest.approx(0.0231, rel=0.02)
 
 
 # ---- bad input -------------------------------------------------------------------------------------------------------
 def test_bad_input():
     sc = load_scene("drives/step_up_pwm")
-    with pytest.raises(ParameterError, match="J_m"):
+    with pytest.raises(ParameterError, match=r"\bJ_m = -0\.0001 is invalid"):
         sc.replace(params={"J_m": -1e-4})
-    with pytest.raises(ParameterError, match="K"):
+    with pytest.raises(ParameterError, match=r"\bK = 0\.0 is invalid"):
         sc.replace(params={"K": 0.0})
     with pytest.raises(SceneError, match="controller"):
         sc.replace(effects={"controller": "fuzzy"})
@@ -262,7 +296,7 @@ def test_bad_input():
     ("tau_slope", 0.05), ("twist_tol", -0.1), ("min_motor_vel", -1.0),
 ])
 def test_bad_parameter_values_named(name, value):
-    with pytest.raises(ParameterError, match=name):
+    with pytest.raises(ParameterError, match=rf"\b{name} = {value!r} is invalid; valid: "):
         load_scene("drives/susd_100w_design").replace(params={name: value})
 
 
@@ -330,7 +364,8 @@ def test_windowed_energy_balance_and_zero_input(susd_pair):
     _, rb, _, sys_ = susd_pair["mujoco"]
     for a, b in ((0, -1), (500, 1500), (1000, rb.t.size - 1)):
         bal = drive.energy_balance(sys_, rb, a, b)
-        assert bal.losses["lock_impact"] > 0 and abs(bal.relative) < 1e-5, (a, b, bal)
+        # measured 1.9e-9, 3.5e-9, 1.8e-10 over the three windows: bound 3e-8, 8.5x the worst
+        assert bal.losses["lock_impact"] > 0 and abs(bal.relative) < 3e-8, (a, b, bal)
     assert rb.energy["lock_impact"][-1] == pytest.approx(rb.stats["reset_energy"])
     zero = drive.Balance(0.0, 0.0, {}, 0.0, 0.0)
     assert zero.relative == 0.0
@@ -338,24 +373,36 @@ def test_windowed_energy_balance_and_zero_input(susd_pair):
 
 
 def test_motor_resonant_keeps_motor_in_band():
+    """switch_mv (App. E): storage ends below min_vel, the brake re-engages above max_vel, so the mean motor speed lies
+    inside the scene's band [min_vel, max_vel] = [40, 60] rad/s (measured 52.9)."""
     sc, res, ctrl, sys_ = _sim("step_up_motor_resonant", duration=4.0, t_settle=2.0)
     cs = drive.cycle_stats(res, ctrl, 2.0)
-    assert 40.0 < cs["mean_motor_speed"] < 70.0  # kept near the 55 rad/s peak-power speed (12 V)
+    p = sc.build_params().resolved(sc.effects["param_set"])
+    assert p["min_vel"] < cs["mean_motor_speed"] < p["max_vel"]
     assert cs["n_cycles"] >= 8
     _balance_ok(sys_, res)
 
 
 def test_velocity_band_scheme_compares():
-    """The thesis' 0.01 rad/s locking band: close to the exact solution but creeping (CoupledClutches)."""
+    """The thesis' 0.01 rad/s locking band on CoupledClutches, against the Dymola result every 0.1 s: its error
+    (measured 6.2e-3 rad/s) stays below 2e-2 (3.2x) and is at least 10x that of the event-exact hand path on the same
+    grid (measured 6.0e-5: 103x) - the scheme creeps where the exact path holds."""
     from mbsuite.models.drives import coupled_clutches as cc
-    from mbsuite.models.drives.friction import simulate_velocity_band
+    from mbsuite.models.drives.friction import simulate_reference, simulate_velocity_band
 
     band = simulate_velocity_band(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
+    exact = simulate_reference(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
     ref = cc.load_reference()
-    j = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in (0.5, 1.0, 1.5)]
-    i = [int(np.argmin(np.abs(band.t - tt))) for tt in (0.5, 1.0, 1.5)]
-    err = np.max(np.abs(band.w[:, i] - ref["w"][:, j]))
-    assert 1e-4 < err < 2e-2  # worse than the event-exact path (6e-5), bounded by the band
+    grid = np.round(np.arange(0, 1.5 + 1e-9, 0.1), 10)
+    j = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
+
+    def err(res):
+        i = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
+        return float(np.max(np.abs(res.w[:, i] - ref["w"][:, j])))
+
+    e_band, e_exact = err(band), err(exact)
+    assert e_band < 2e-2
+    assert e_band > 10 * e_exact, (e_band, e_exact)
 
 
 def test_storage_time_nearest_sample_over_grid():

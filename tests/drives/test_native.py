@@ -97,7 +97,7 @@ def test_native_equals_python_twin_drive_with_controller():
     a, b = out["native"], out["python"]
     _same(a, b)
     assert len(a.events) >= 10 and a.stats["lock_trials"] >= 5
-    assert abs(drive.energy_balance(system, a).relative) < 1e-6
+    assert abs(drive.energy_balance(system, a).relative) < 2e-7  # measured 2.2e-8: 9x
     for c in a.u:
         assert np.array_equal(a.u[c], b.u[c])
 

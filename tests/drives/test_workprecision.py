@@ -12,5 +12,9 @@ def test_drives_paths_against_exact_reference():
     hand = _row(rep, "reference", "event-exact DOP853", 1e-6)
     mj = _row(rep, "mujoco", "rk4", 1e-4)
     assert hand["details"]["n_locks_ref"] > 0  # lock-ups are compared, not an empty metric
-    assert hand["physics_error"] < 1e-4 and mj["physics_error"] < 1e-3
-    assert rep.data["check_physics_error"] < 1e-6
+    # step_up_pwm has no output torque: no efficiency to compare (the metric is left out, not a vacuous 0)
+    assert set(hand["details"]) == {"load_speed_rel", "lock_time_rel", "n_locks_ref"}
+    # measured (quick mode, 1 s): hand rtol 1e-6 1.0e-7, MuJoCo rk4 1e-4 s 8.5e-6, the reference's rtol 1e-11 check
+    # 2.3e-10; bounds 10x, 6x, 8.5x
+    assert hand["physics_error"] < 1e-6 and mj["physics_error"] < 5e-5
+    assert rep.data["check_physics_error"] < 2e-9

@@ -21,19 +21,42 @@ from .mujoco_path import MujocoRotorSim
 
 
 # ================================================================================================ hard cases
+# Each case is the one source of truth for its situation (the model tests do not re-test it). Bounds carry the value
+# measured when they were set (hand path DOP853 at the default rtol, MuJoCo RK4) and the factor above it.
 def _drives_coupled_clutches(ck: Checker) -> None:
-    rev = cc.reference_events(cc.load_reference())
+    ref = cc.load_reference()
+    rev = cc.reference_events(ref)
     hand = simulate_reference(cc.build_system(), cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
     mj = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=1e-4).run(
         cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
-    for name, res, tol in (("hand path", hand, 1e-5), ("MuJoCo", mj, 2e-4)):
+    # vs Dymola: hand 1e-5 s (measured 4.1e-6; the reference's own event accuracy at DASSL tol 1e-6 is a few us);
+    # MuJoCo within one timestep, 1e-4 s (measured 4.7e-5; the path resolves an event only to its step)
+    for name, res, tol in (("hand path", hand, 1e-5), ("MuJoCo", mj, 1e-4)):
         rows = cc.match_events(cc.events_as_codes(res.events), rev)
         same = all(r["t"] is not None and r["t_ref"] is not None for r in rows)
-        ck.true(f"{name}: same clutch mode sequence as Dymola (lock/unlock x {len(rows)})", same)
+        ck.true(f"{name}: same clutch mode sequence as Dymola (lock/unlock x {len(rows)})", same and len(rows) == 9)
         dts = [abs(r["t"] - r["t_ref"]) for r in rows if r["t"] is not None and r["t_ref"] is not None]
         ck.le(f"{name}: max |event time - Dymola| (s)", max(dts) if dts else math.inf, tol)
         ck.finite(f"{name} speeds", res.w)
-    ck.le("hand path RHS calls", hand.stats.get("nfev", 0), 50_000)
+    # MuJoCo vs the event-exact hand path: interpolated event time within one step (measured 4.7e-5 s), the step at
+    # which the change is applied within two (measured 1.5e-4 s)
+    same = [(a["element"], a["from"], a["to"]) for a in mj.events] == [(b["element"], b["from"], b["to"])
+                                                                       for b in hand.events]
+    ck.true("MuJoCo: same events as the hand path", same)
+    if same:
+        ck.le("MuJoCo vs hand: max |t_event| (s)", max(abs(a["t"] - b["t"]) for a, b in zip(mj.events, hand.events,
+                                                                                             strict=True)), 1e-4)
+        ck.le("MuJoCo vs hand: max |t_applied - t_event| (s)",
+              max(abs(a["t_step"] - b["t"]) for a, b in zip(mj.events, hand.events, strict=True)), 2e-4)
+    # speeds every 0.1 s: hand vs Dymola 1e-4 rad/s (measured 6.0e-5, the reference's accuracy); MuJoCo vs hand
+    # 2e-4 rad/s (measured 4.6e-5, 4x)
+    grid = np.round(np.arange(0, cc.T_END + 1e-9, 0.1), 10)
+    j = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
+    i = [int(np.argmin(np.abs(hand.t - tt))) for tt in grid]
+    ck.le("hand vs Dymola: max |w| on the 0.1 s grid (rad/s)", np.max(np.abs(hand.w[:, i] - ref["w"][:, j])), 1e-4)
+    ck.le("MuJoCo vs hand: max |w| on the 0.1 s grid (rad/s)", np.max(np.abs(mj.w[:, i] - hand.w[:, i])), 2e-4)
+    ck.true("MuJoCo warnings", not mj.stats["warnings"], mj.stats["warnings"])
+    ck.le("hand path RHS calls (measured 2664)", hand.stats.get("nfev", 0), 10_000)
 
 
 def _rotors(frictions, J, springs=(), sources=(), breaks=()):
@@ -42,67 +65,100 @@ def _rotors(frictions, J, springs=(), sources=(), breaks=()):
 
 
 def _drives_load_reversal(ck: Checker) -> None:
-    sys_ = _rotors([Friction("load_ground", 2, -1, [Part("load", 0.05, output=True)])], [1.0, 1.0, 1e-3],
-                   springs=[Spring("k", 2, -1, 1.0)])
+    """Closed form: the load (J = 1e-3) on the spring (K = 1) under Coulomb C = 0.05 swings each half cycle about
+    +-C/K as a free oscillator, so direction changes fall at t_k = k pi sqrt(J/K) and the amplitude drops by 2C/K =
+    0.1 per half cycle: 1.0 -> 0.9 -> ... -> 0.1 -> 0.0, i.e. 9 reversals, then stuck at t_10 with theta = 0."""
+    C, K, J = 0.05, 1.0, 1e-3
+    sys_ = _rotors([Friction("load_ground", 2, -1, [Part("load", C, output=True)])], [1.0, 1.0, J],
+                   springs=[Spring("k", 2, -1, K)])
+    half = math.pi * math.sqrt(J / K)
     res = simulate_reference(sys_, [0, 0, 1.0], [0, 0, 0], 2.0, sample_dt=1e-3)
-    kinds = [(e["from"], e["to"]) for e in res.events]
-    n_rev = sum(1 for k in kinds if "stuck" not in k)
-    ck.true("hand path: ends stuck", bool(kinds) and kinds[-1][1] == "stuck")
-    ck.true("hand path: 9 reversals (amplitude 1.0 -> C/K in steps of 2C/K), no chatter", n_rev == 9, n_rev)
-    ck.le("hand path RHS calls", res.stats["nfev"], 20_000)
     mj = MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-4).run([0, 0, 1.0], [0, 0, 0], 2.0,
                                                                                   sample_dt=1e-3)
-    n_mj = sum(1 for e in mj.events if "stuck" not in (e["from"], e["to"]))
-    ck.le("MuJoCo reversals vs hand path", abs(n_mj - n_rev), 1)
-    ck.le("MuJoCo final |theta| within the stiction band C/K (+1e-3)", abs(mj.q[2, -1]), 0.05 + 1e-3)
+    # hand path: event times 1e-9 s (measured 2.0e-11), final theta 1e-9 rad (measured 3.6e-11). MuJoCo: each
+    # reversal is resolved at a step, costing 0.54 step of phase (measured: the k-th event 5.41e-5 k s late), so
+    # the k-th event within k steps (1e-4 k s, 1.85x); final theta 5e-5 rad (measured 7.3e-6, 7x)
+    for name, r, t_tol, q_tol in (("hand path", res, 1e-9, 1e-9), ("MuJoCo", mj, 1e-4, 5e-5)):
+        kinds = [(e["from"], e["to"]) for e in r.events]
+        n_rev = sum(1 for k in kinds if "stuck" not in k)
+        ck.true(f"{name}: 9 reversals then stuck (10 events), no chatter", n_rev == 9 and len(kinds) == 10
+                and kinds[-1][1] == "stuck", kinds)
+        if len(kinds) == 10:
+            errs = [abs(e["t"] - k * half) for k, e in enumerate(r.events, start=1)]
+            if name == "MuJoCo":
+                ck.le(f"{name}: max_k |t_k - k pi sqrt(J/K)| / k (s per event)", max(e / k for k, e in
+                                                                                   enumerate(errs, start=1)), t_tol)
+            else:
+                ck.le(f"{name}: max_k |t_k - k pi sqrt(J/K)| (s)", max(errs), t_tol)
+        ck.le(f"{name}: |final theta - 0| (rad)", abs(r.q[2, -1]), q_tol)
+    ck.le("hand path RHS calls (measured 3844)", res.stats["nfev"], 20_000)
     ck.true("MuJoCo warnings", mj.stats.get("warnings", {}) == {}, mj.stats.get("warnings"))
 
 
 def _drives_both_locked(ck: Checker) -> None:
+    """Closed form (all torques piecewise constant): clutch a (0.5 N m) closes 30 -> 10 rad/s on J_m = 1e-3 at
+    t = 20/500 = 0.04 s; the motor+spring group (3e-3) and the load (3e-3) meet at t = 0.05 s; the common speed is
+    the momentum over the inertia, 0.05/6e-3 = 8.333 rad/s; the brake (0.3 N m from 0.3 s) stops the group at
+    0.3 + 8.333/50 = 0.46667 s; every holding torque stays below its breakaway, so all three stay held."""
     brake = Step(height=1.0, t0=0.3)  # the brake engages at 0.3 s (a signal: the MuJoCo path evaluates it in C)
+    J = [1e-3, 2e-3, 3e-3]
     sys_ = _rotors([Friction("clutch_a", 0, 1, [Part("ca", 0.5)]), Friction("clutch_b", 1, 2, [Part("cb", 0.5)]),
-                    Friction("spring_ground", 1, -1, [Part("brake", 0.3, schedule=brake)])], [1e-3, 2e-3, 3e-3],
-                   breaks=[0.3])
+                    Friction("spring_ground", 1, -1, [Part("brake", 0.3, schedule=brake)])], J, breaks=[0.3])
     w0 = [30.0, 10.0, 0.0]
+    w_c = float(np.dot(J, w0)) / sum(J)
+    expected = [("clutch_a", "stuck", 0.04), ("clutch_b", "stuck", 0.05), ("spring_ground", "backward", 0.3),
+                ("spring_ground", "stuck", 0.3 + w_c / (0.3 / sum(J)))]
     res = simulate_reference(sys_, [0, 0, 0], w0, 1.0, sample_dt=1e-3)
     mj = MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-4).run([0, 0, 0], w0, 1.0,
                                                                                   sample_dt=1e-3)
-    stuck = [e["t"] for e in res.events if e["to"] == "stuck" and e["element"] in ("clutch_a", "clutch_b")]
-    ck.ge("both clutches lock (hand path)", len(stuck), 2)
-    ck.true("hand path: all three rotors held at the end", res.modes[:, -1].tolist() == [0, 0, 0])
-    ck.true("MuJoCo: all three rotors held at the end", mj.modes[:, -1].tolist() == [0, 0, 0])
-    ck.le("MuJoCo final speeds (rad/s)", np.max(np.abs(mj.w[:, -1])), 1e-6)
-    dt = []
-    for el in ("clutch_a", "clutch_b", "spring_ground"):
-        tr = [e["t"] for e in res.events if e["element"] == el]
-        tm = [e["t"] for e in mj.events if e["element"] == el]
-        ck.true(f"{el}: same number of events in both paths", len(tr) == len(tm), (len(tr), len(tm)))
-        if len(tr) == len(tm):
-            dt += [abs(a - b) for a, b in zip(tr, tm, strict=True)]
-    ck.le("max |event time MuJoCo - hand| (s)", max(dt) if dt else math.inf, 1e-4)
+    # event times vs the closed form 1e-12 s (measured 1.1e-15 both paths: constant accelerations, exact in RK4 and
+    # in the step interpolation); group speed 1e-12 relative (round-off); final speeds hand 1e-12 (measured 4e-30),
+    # MuJoCo 1e-10 rad/s (measured 1.1e-12, the soft lock's residual)
+    for name, r, w_tol in (("hand path", res, 1e-12), ("MuJoCo", mj, 1e-10)):
+        got = [(e["element"], e["to"]) for e in r.events]
+        ck.true(f"{name}: clutch a, clutch b lock, brake slides, brake holds",
+                got == [x[:2] for x in expected], got)
+        if len(got) == len(expected):
+            ck.le(f"{name}: max |t_event - closed form| (s)",
+                  max(abs(e["t"] - x[2]) for e, x in zip(r.events, expected, strict=True)), 1e-12)
+        i = int(np.searchsorted(r.t, 0.06))
+        ck.le(f"{name}: |w - p0/sum(J)| / (p0/sum(J)) at 0.06 s (one rigid group)",
+              np.max(np.abs(r.w[:, i] / w_c - 1)), 1e-12)
+        ck.true(f"{name}: all three rotors held at the end", r.modes[:, -1].tolist() == [0, 0, 0])
+        ck.le(f"{name}: final speeds (rad/s)", np.max(np.abs(r.w[:, -1])), w_tol)
 
 
 def _drives_mismatch(ck: Checker) -> None:
-    J1, J2, dw = 2e-3, 5e-4, 50.0
-    sys_ = _rotors([Friction("clutch_a", 0, 1, [Part("ca", 0.5)])], [J1, J2, 1.0], sources=[Source("motor", 0, 0.0)])
+    """Two free inertias engaged at a 50 rad/s mismatch: slip loss 1/2 J1 J2/(J1+J2) dw^2, common speed by
+    momentum, the slip closing at t = dw / (tau (1/J1 + 1/J2)) = 0.04 s."""
+    J1, J2, dw, tau = 2e-3, 5e-4, 50.0, 0.5
+    sys_ = _rotors([Friction("clutch_a", 0, 1, [Part("ca", tau)])], [J1, J2, 1.0], sources=[Source("motor", 0, 0.0)])
     expected = 0.5 * J1 * J2 / (J1 + J2) * dw**2
-    for name, res in (("hand path", simulate_reference(sys_, [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3)),
-                      ("MuJoCo", MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-5).run(
-                          [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3))):
+    t_lock = dw / (tau * (1 / J1 + 1 / J2))
+    # loss: hand 3e-10 (measured 4.2e-11, event location on the dense output), MuJoCo 1e-11 (measured 1.4e-13: the
+    # lock impact is booked exactly); common speed 1e-10 (measured 2e-16 / 1.2e-12); lock time 1e-12 s (measured
+    # 0 / 6.8e-15: constant torques, exact in both integrators and in the step interpolation)
+    for name, res, tol in (
+            ("hand path", simulate_reference(sys_, [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3), 3e-10),
+            ("MuJoCo", MujocoRotorSim(sys_, mjcf_path("drive_step_up_down"), timestep=1e-5).run(
+                [0, 0, 0], [dw, 0, 0], 0.2, sample_dt=1e-3), 1e-11)):
         lost = res.energy["ca"][-1] + res.stats["reset_energy"]
-        ck.le(f"{name}: slip loss vs 1/2 J1 J2/(J1+J2) dw^2, relative", abs(lost / expected - 1), 0.01)
+        ck.le(f"{name}: slip loss vs 1/2 J1 J2/(J1+J2) dw^2, relative", abs(lost / expected - 1), tol)
         ck.le(f"{name}: common speed vs momentum, relative",
-              float(np.max(np.abs(res.w[:2, -1] / (J1 * dw / (J1 + J2)) - 1))), 1e-4)
+              float(np.max(np.abs(res.w[:2, -1] / (J1 * dw / (J1 + J2)) - 1))), 1e-10)
         ck.true(f"{name}: one lock event", [e["to"] for e in res.events] == ["stuck"])
+        if res.events:
+            ck.le(f"{name}: |t_lock - dw / (tau (1/J1 + 1/J2))| (s)", abs(res.events[0]["t"] - t_lock), 1e-12)
 
 
 def _drives_big_step(ck: Checker) -> None:
     sc = load_scene("drives/step_up_pwm").replace(solver={"engine": "mujoco", "duration": 0.2, "t_settle": 0.0})
     ck.raises("a timestep that does not divide the controller period", lambda: run(sc.replace(
-        solver={"timestep": 3e-4})), SceneError, "must divide")
+        solver={"timestep": 3e-4})), SceneError, "must divide the controller period")
     res = run(sc.replace(solver={"timestep": 2e-3}))
     ck.finite("h = controller period (2 ms)", *res.signals.values())
-    ck.le("h = 2 ms: energy balance residual / input", abs(res.stats["energy_balance"]["relative"]), 1e-3)
+    # measured 9.1e-5 at h = 2 ms (RK4 truncation over a step as long as the controller period): bound 5.5x
+    ck.le("h = 2 ms: energy balance residual / input", abs(res.stats["energy_balance"]["relative"]), 5e-4)
 
 
 def _drives_energy_balance(ck: Checker) -> None:
@@ -110,23 +166,33 @@ def _drives_energy_balance(ck: Checker) -> None:
         for eng in ("reference", "mujoco"):
             res = run(load_scene(f"drives/{scene}").replace(solver={"engine": eng, "duration": 0.5, "t_settle": 0.0}))
             ck.finite(f"{scene} {eng}", *res.signals.values())
-            # README: <= 4e-5 of the input (hand path), <= 2e-7 (MuJoCo) over the shipped scenes
+            # measured over 0.5 s: 3.0e-9 / 2.2e-8 (step_up_pwm hand / MuJoCo), 7.2e-9 / 4.8e-9 (susd_500w_open):
+            # bound 2e-7, 9x the worst; a loss term dropped at 1e-6 of the input would fail it
             ck.le(f"{scene} {eng}: |input - output - losses - stored| / input", abs(
-                res.stats["energy_balance"]["relative"]), 1e-4)
+                res.stats["energy_balance"]["relative"]), 2e-7)
 
 
 def _drives_freewheel_grazing(ck: Checker) -> None:
+    """The OneWayClutch released at t_r = 7/6 + asin(3e-5)/(6 pi) (holding torque 5 sin(6 pi (t - 7/6)) reaching
+    tau0_max_low = 1.5e-4) closes again tangentially at 8/3 - t_r and is released at 1.5 + asin(3e-5)/(6 pi)."""
     from . import msl
 
+    s = math.asin(3e-5) / (6 * math.pi)
+    closed = {"release": 7 / 6 + s, "lock": 1.5 - s, "release2": 1.5 + s}
     ex = msl.example("msl_one_way_clutch")
-    t_graze = 1.5 - math.asin(3e-5) / (6 * math.pi)  # closed form: 8/3 - t_release (tests/drives/test_msl.py)
     hand = simulate_reference(ex.system, ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
     mj = MujocoRotorSim(ex.system, mjcf_path("drive_msl_one_way_clutch"), timestep=1e-4).run(
         ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
-    for name, res, tol in (("hand path", hand, 1e-8), ("MuJoCo", mj, 2e-4)):
-        locks = [e["t"] for e in res.events if e["to"] == "stuck" and abs(e["t"] - 1.5) < 1e-3]
-        ck.true(f"{name}: one lock at the tangency near 1.5 s", len(locks) == 1, locks)
-        ck.le(f"{name}: |t_lock - closed form| (s)", abs(locks[0] - t_graze) if locks else math.inf, tol)
+    # hand path 1e-9 s (measured 1.1e-10 at the default rtol, 2e-12 at rtol 1e-10); MuJoCo 2 steps, 2e-4 s
+    # (measured 1.24e-4: the release is applied up to 1.5 steps late and t_lock = 8/3 - t_release carries it over)
+    for name, res, tol in (("hand path", hand, 1e-9), ("MuJoCo", mj, 2e-4)):
+        got = {"release": [e["t"] for e in res.events if e["to"] == "forward" and abs(e["t"] - 7 / 6) < 1e-3],
+               "lock": [e["t"] for e in res.events if e["to"] == "stuck" and abs(e["t"] - 1.5) < 1e-3],
+               "release2": [e["t"] for e in res.events if e["to"] == "forward" and abs(e["t"] - 1.5) < 1e-3]}
+        ck.true(f"{name}: one release near 7/6 s, one lock and one release at the tangency near 1.5 s",
+                all(len(v) == 1 for v in got.values()), got)
+        ck.le(f"{name}: max |t - closed form| of those three (s)",
+              max((abs(v[0] - closed[k]) for k, v in got.items() if v), default=math.inf), tol)
         ck.true(f"{name}: 9 mode changes (as the reference)", len(res.events) == 9, len(res.events))
         ck.finite(f"{name} speeds", res.w)
 
@@ -142,52 +208,61 @@ def _drives_planetary_handover(ck: Checker) -> None:
         seq = [(e["element"], e["to"]) for e in res.events]
         ck.true(f"{name}: clutch engages, brake slips, brake free, clutch locks", seq == [
             ("clutch", "backward"), ("brake", "forward"), ("brake", "free"), ("clutch", "stuck")], seq)
+        # rigid 1:1 after the clutch lock: measured 8.8e-16 (hand), 7.2e-13 (MuJoCo, the soft lock's residual)
         ck.le(f"{name}: final |w_engine - w_load| / w_load (rigid 1:1 after the shift)",
-              abs(res.w[0, -1] - res.w[1, -1]) / abs(res.w[1, -1]), 1e-6)
+              abs(res.w[0, -1] - res.w[1, -1]) / abs(res.w[1, -1]), 1e-10)
+    same = len(hand.events) == len(mj.events)
     ck.le("MuJoCo vs hand: max event time difference (s)",
-          max(abs(a["t"] - b["t"]) for a, b in zip(hand.events, mj.events, strict=True)), 1e-4 + 1e-12)
+          max(abs(a["t"] - b["t"]) for a, b in zip(hand.events, mj.events, strict=True)) if same else math.inf,
+          1e-4 + 1e-12)
 
 
 HARD_CASES: tuple[HardCase, ...] = (
     HardCase("drives_freewheel_grazing_lock", "drives",
              "a freewheel whose slip touches zero tangentially (the input torque reverses as the speeds meet)",
              "drives/msl_one_way_clutch at 1.5 s, both paths",
-             "one lock, at the closed-form time within 1e-8 s (hand) / 2e-4 s (MuJoCo); 9 mode changes",
+             "the release near 7/6 s and the lock and release at the tangency at their closed-form "
+             "times within 1e-9 s (hand) / 2e-4 s (MuJoCo); 9 mode changes",
              _drives_freewheel_grazing),
     HardCase("drives_planetary_handover", "drives",
              "clutch/brake hand-over across an ideal planetary with a massless ring (general elements, tendon locks)",
              "drives/msl_simple_gear_shift, 5 s, both paths",
-             "the MSL sequence (clutch bwd, brake fwd, brake free, clutch stuck); 1:1 after the shift; paths "
-             "within one MuJoCo step (1e-4 s; the engagement at 2.0+ s lands on the next step: measured exactly one)",
+             "the MSL sequence (clutch bwd, brake fwd, brake free, clutch stuck); 1:1 after the shift within "
+             "1e-10; paths within one MuJoCo step (1e-4 s; the engagement at 2.0+ s lands on the next step: measured "
+             "exactly one)",
              _drives_planetary_handover),
     HardCase("drives_clutch_lock_unlock", "drives",
              "clutch stick/slip with nested mode changes (Modelica CoupledClutches)",
              "drives/coupled_clutches machinery, both paths vs the Dymola result",
-             "same mode sequence; event times within 1e-5 s (hand) / 2e-4 s (MuJoCo); hand RHS calls <= 5e4",
+             "same mode sequence; event times vs Dymola within 1e-5 s (hand) / 1e-4 s (MuJoCo), MuJoCo vs hand 1e-4 s; "
+             "speeds every 0.1 s within 1e-4 (hand vs Dymola) / 2e-4 rad/s (MuJoCo vs hand); hand RHS calls <= 1e4",
              _drives_coupled_clutches),
     HardCase("drives_load_reversal", "drives",
              "Coulomb load on a spring reversing direction: chatter or stall at every reversal",
              "rotor system: load with 0.05 N m Coulomb friction on a 1 N m/rad spring, 2 s",
-             "9 reversals then stuck; hand RHS calls <= 2e4; MuJoCo reversals within 1, ends inside the stiction band",
+             "9 reversals at k pi sqrt(J/K) (hand 1e-9 s; MuJoCo the k-th within k steps), stuck at theta = 0 "
+             "(hand 1e-9, MuJoCo 5e-5 rad); hand RHS calls <= 2e4",
              _drives_load_reversal),
     HardCase("drives_both_clutches_locked", "drives",
              "both clutches locked (one rigid group) then a brake holds the group: nested locks",
              "three rotors, clutches a/b, brake at 0.3 s, both paths",
-             "all rotors held; same events in both paths within 1e-4 s; MuJoCo speeds <= 1e-6 rad/s",
+             "locks at 0.04 and 0.05 s, brake holds at 0.46667 s (closed form, 1e-12 s, both paths); "
+             "group speed by momentum; all rotors held (speeds <= 1e-12 hand / 1e-10 rad/s MuJoCo)",
              _drives_both_locked),
     HardCase("drives_engagement_mismatch", "drives",
              "engagement with a 50 rad/s speed mismatch: plastic lock, energy bookkeeping",
              "two free inertias and a clutch, both paths",
-             "slip loss = 1/2 J1 J2/(J1+J2) dw^2 within 1 %; common speed within 1e-4; one lock event",
+             "slip loss = 1/2 J1 J2/(J1+J2) dw^2 within 3e-10 (hand) / 1e-11 (MuJoCo); common speed within 1e-10; "
+             "one lock event at dw/(tau (1/J1 + 1/J2)) within 1e-12 s",
              _drives_mismatch),
     HardCase("drives_over_large_timestep", "drives",
              "MuJoCo step not aligned with the controller, or as long as the controller period",
              "drives/step_up_pwm on MuJoCo at 0.3 ms and 2 ms",
-             "SceneError 'must divide' for 0.3 ms; 2 ms finite with energy balance <= 1e-3", _drives_big_step),
+             "SceneError 'must divide' for 0.3 ms; 2 ms finite with energy balance <= 5e-4", _drives_big_step),
     HardCase("drives_energy_balance", "drives",
              "energy bookkeeping through locks, slips and controller switching",
              "drives/step_up_pwm and drives/susd_500w_open, 0.5 s, both paths",
-             "|input - output - losses - stored| <= 1e-4 of the input; no NaN", _drives_energy_balance),
+             "|input - output - losses - stored| <= 2e-7 of the input; no NaN", _drives_energy_balance),
 )
 
 
@@ -268,7 +343,9 @@ class DrivesStudy(Study):
                 ein = r["E_in"][m][-1] - r["E_in"][m][0]
                 return (r["E_out"][m][-1] - r["E_out"][m][0]) / ein if ein else math.nan
 
-            det["efficiency_rel"] = _rel(eff(res), eff(ref))
+            e_ref = eff(ref)
+            if math.isfinite(e_ref) and e_ref > 0:  # a scene without an output torque has no efficiency to compare
+                det["efficiency_rel"] = _rel(eff(res), e_ref)
         lr, lf = self._locks(res), self._locks(ref)
         by_el: dict[str, tuple[list, list]] = {}
         for el, t in lf:

@@ -7,10 +7,42 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import SceneError
+from ...errors import MbsuiteError, SceneError
+from ...limits import Limit
 from ...results import Report, format_table
-from ...scenes import load_scene
+from ...scenes import DEFAULT_MAX_STEPS, load_scene
 from . import design as D
+
+#: most time steps of `drive coupled-clutches` (scene runs are guarded by the scene's solver.max_steps)
+MAX_STEPS = DEFAULT_MAX_STEPS
+#: most entries of a comma list option (--srmin, --js, --loads)
+MAX_LIST = 1000
+
+_POS = {"lo": 0.0, "lo_open": True}
+#: valid range of every numeric option, by flag; checked before any work (finite, range; lists entry by entry)
+OPTION_LIMITS: dict[str, Limit] = {
+    "--P": Limit(**_POS, hi=1e7, unit="W", doc="drive power"),
+    "--wmin": Limit(lo=0.0, hi=1e5, unit="rad/s", doc="lowest load speed"),
+    "--wrip": Limit(**_POS, hi=1e5, unit="rad/s", doc="allowed speed ripple"),
+    "--Jl": Limit(**_POS, hi=1e3, unit="kg m^2", doc="load inertia"),
+    "--srmin": Limit(**_POS, hi=1e4, unit="1/s", doc="minimum switching rate"),
+    "--wmax": Limit(**_POS, hi=1e5, unit="rad/s", doc="highest load speed"),
+    "--vm": Limit(**_POS, hi=1e5, unit="rad/s", doc="motor speed"),
+    "--js": Limit(**_POS, hi=1e3, unit="kg m^2", doc="spring-system inertia"),
+    "--tau-c": Limit(**_POS, hi=1e5, unit="N m", doc="clutch torque"),
+    "--K": Limit(**_POS, hi=1e6, unit="N m/rad", doc="spring rate"),
+    "--xmax": Limit(**_POS, hi=1e4, unit="rad", doc="largest spring twist"),
+    "--fatigue": Limit(**_POS, hi=1.0, doc="fatigue stress / ultimate tensile stress"),
+    "--sigma-uts": Limit(**_POS, hi=1e11, unit="Pa", doc="ultimate tensile stress"),
+    "--E": Limit(**_POS, hi=1e13, unit="Pa", doc="Young's modulus"),
+    "--ts": Limit(**_POS, hi=1e3, unit="s", doc="energy-cycle period"),
+    "--taul": Limit(lo=0.0, hi=1e5, unit="N m", doc="load torque"),
+    "--w0": Limit(lo=-1e5, hi=1e5, unit="rad/s", doc="operating speed (not 0)"),
+    "--btotal": Limit(lo=0.0, hi=1e5, unit="N m s", doc="total viscous coefficient"),
+    "--duration": Limit(**_POS, hi=1e5, unit="s", doc="simulated time"),
+    "--loads": Limit(lo=-1e4, hi=1e4, unit="N m", doc="load torque"),
+    "--timestep": Limit(**_POS, hi=1e-2, unit="s", doc="MuJoCo timestep"),
+}
 
 
 def _floats(text: str) -> list[float]:
@@ -18,6 +50,31 @@ def _floats(text: str) -> list[float]:
         return [float(x) for x in text.split(",") if x.strip()]
     except ValueError as exc:
         raise SceneError(f"expected a comma-separated list of numbers, got {text!r}") from exc
+
+
+def _check_options(a: argparse.Namespace, *flags: str) -> None:
+    """Check the given numeric options of a parsed command against `OPTION_LIMITS` (an unset option is skipped);
+    raise MbsuiteError naming the flag, its value and the valid range (the CLI exits with status 2)."""
+    for flag in flags:
+        v = getattr(a, flag[2:].replace("-", "_"), None)
+        if v is None:
+            continue
+        lim = OPTION_LIMITS[flag]
+        if isinstance(v, list):
+            if not v or len(v) > MAX_LIST:
+                raise MbsuiteError(f"{flag} needs 1 to {MAX_LIST} numbers, got {len(v)}")
+            for i, x in enumerate(v):
+                lim.check(f"{flag} entry {i + 1}", x, MbsuiteError)
+        else:
+            lim.check(flag, v, MbsuiteError)
+
+
+def _check_steps(flag: str, duration: float, dt: float) -> None:
+    """Size guard: duration / dt time steps (or samples) at most MAX_STEPS."""
+    n = duration / dt
+    if n > MAX_STEPS:
+        raise MbsuiteError(f"{flag}: {duration:g} s at a step of {dt:g} s is {n:.3g} steps; at most {MAX_STEPS:.3g} "
+                           "(shorten the run or enlarge the step)")
 
 
 def register(sub, add_common, emit) -> None:
@@ -38,6 +95,7 @@ def register(sub, add_common, emit) -> None:
     add_common(q)
 
     def _srmin(a):
+        _check_options(a, "--P", "--wmin", "--wrip", "--Jl")
         v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
         emit(Report({"Sr_min": v}, f"Sr_min = {v:.6g} cycles/s"), a, None)
 
@@ -54,6 +112,7 @@ def register(sub, add_common, emit) -> None:
     add_common(q)
 
     def _cadjs(a):
+        _check_options(a, "--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c")
         rows, data = [], []
         for sr in a.srmin:
             ds_ = ([D.at_clutch_torque(a.P, sr, a.wmin, a.wmax, a.vm, a.tau_c)] if a.tau_c
@@ -77,6 +136,7 @@ def register(sub, add_common, emit) -> None:
     add_common(q)
 
     def _spr(a):
+        _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
         r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
         emit(Report(r, format_table(list(r), [list(r.values())], ".4g")), a, None)
 
@@ -90,6 +150,7 @@ def register(sub, add_common, emit) -> None:
     add_common(q)
 
     def _gains(a):
+        _check_options(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
         if a.btotal is None:
             if a.P is None:
                 raise SceneError("give --btotal or --P (Eq 5.38)")
@@ -135,6 +196,7 @@ def register(sub, add_common, emit) -> None:
     def _eff(a):
         from .analysis import efficiency
 
+        _check_options(a, "--loads")
         sc = _scene(a)
         loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
         emit(efficiency(sc, loads, engine=a.engine), a, sc.to_dict())
@@ -146,8 +208,11 @@ def register(sub, add_common, emit) -> None:
     add_common(q)
 
     def _cc(a):
+        from . import coupled_clutches as cc
         from .model import coupled_clutches_table
 
+        _check_options(a, "--timestep")
+        _check_steps("--timestep", cc.T_END, a.timestep)
         d = coupled_clutches_table(timestep=a.timestep)
         rows = []
         for i, r in enumerate(d["reference"]["events"]):
@@ -165,14 +230,16 @@ def register(sub, add_common, emit) -> None:
 
 
 def _scene(a: argparse.Namespace):
+    _check_options(a, "--duration")
     sc = load_scene(a.scene)
     if sc.model != "drives":
         raise SceneError(f"scene {a.scene!r} is a '{sc.model}' scene, not a drives scene")
     upd = {}
     if getattr(a, "engine", None):
         upd["engine"] = a.engine
-    if getattr(a, "duration", None):
+    if getattr(a, "duration", None) is not None:
         upd["duration"] = a.duration
         if sc.solver.t_settle >= a.duration:
             upd["t_settle"] = 0.5 * a.duration
+    # the scene's solver checks duration / timestep against solver.max_steps (the size guard)
     return sc.replace(solver=upd) if upd else sc

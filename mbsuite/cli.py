@@ -330,6 +330,7 @@ def _hook_command(hook: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The `mbsuite` argument parser: the generic commands plus each model's own command group."""
     from . import __version__
 
     ap = argparse.ArgumentParser(

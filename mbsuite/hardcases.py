@@ -23,12 +23,14 @@ from .errors import MbsuiteError
 
 @dataclass
 class Check:
+    """One assertion of a hard case: what, whether it held, the measured value and its bound."""
     what: str
     ok: bool
     value: Any = None
     bound: Any = None
 
     def line(self) -> str:
+        """The assertion as one report line."""
         v = "" if self.value is None else f" = {_fmt(self.value)}"
         b = "" if self.bound is None else f" (bound {_fmt(self.bound)})"
         return f"[{'ok' if self.ok else 'FAIL'}] {self.what}{v}{b}"
@@ -48,21 +50,26 @@ class Checker:
         self.measured: dict[str, Any] = {}
 
     def le(self, what: str, value: float, bound: float) -> None:
+        """Assert `value <= bound` (a NaN fails)."""
         value = float(value)
         self.checks.append(Check(what, bool(math.isfinite(value) and value <= bound), value, f"<= {bound:g}"))
 
     def ge(self, what: str, value: float, bound: float) -> None:
+        """Assert `value >= bound` (a NaN fails)."""
         value = float(value)
         self.checks.append(Check(what, bool(math.isfinite(value) and value >= bound), value, f">= {bound:g}"))
 
     def true(self, what: str, cond: bool, value: Any = None) -> None:
+        """Assert a condition, recording `value` beside it."""
         self.checks.append(Check(what, bool(cond), value))
 
     def finite(self, what: str, *arrays: Any) -> None:
+        """Assert every value of every array is finite."""
         ok = all(np.all(np.isfinite(np.asarray(a, float))) for a in arrays)
         self.checks.append(Check(f"{what}: no NaN/inf", ok))
 
     def raises(self, what: str, fn: Callable[[], Any], exc: type[BaseException] | tuple, match: str) -> None:
+        """Assert that `fn()` raises `exc` with `match` in its message (any other outcome fails)."""
         try:
             fn()
         except exc as e:  # noqa: B030 - exc is a class or tuple of classes
@@ -76,6 +83,7 @@ class Checker:
 
 @dataclass(frozen=True)
 class HardCase:
+    """A situation that breaks naive multibody codes: what makes it hard, the scene, what is asserted, the check."""
     name: str
     model: str
     hard: str  # what makes it hard
@@ -89,6 +97,7 @@ class HardCase:
 
 @dataclass
 class Outcome:
+    """The result of running one hard case: its checks, what was measured, an unexpected error if any."""
     case: HardCase
     checks: list[Check]
     measured: dict[str, Any]
@@ -96,9 +105,11 @@ class Outcome:
 
     @property
     def passed(self) -> bool:
+        """True when no unexpected error occurred and every check (at least one) held."""
         return self.error is None and bool(self.checks) and all(c.ok for c in self.checks)
 
     def text(self) -> str:
+        """The outcome as report lines."""
         lines = [f"{self.case.name}: {'PASS' if self.passed else 'FAIL'}"]
         if self.error:
             lines.append(f"  error: {self.error}")
@@ -143,6 +154,7 @@ def registry() -> tuple[HardCase, ...]:
 
 
 def cases(model: str | None = None, include_slow: bool = True) -> list[HardCase]:
+    """The hard cases of one model (or all), optionally without the slow ones."""
     out = [c for c in registry() if (model is None or c.model == model) and (include_slow or not c.slow)]
     if model is not None and not out:
         raise MbsuiteError(f"no hard cases for model {model!r}; models: {sorted({c.model for c in registry()})}")
@@ -150,6 +162,7 @@ def cases(model: str | None = None, include_slow: bool = True) -> list[HardCase]
 
 
 def get(name: str) -> HardCase:
+    """The hard case called `name` (an MbsuiteError listing the valid names if unknown)."""
     for c in registry():
         if c.name == name:
             return c

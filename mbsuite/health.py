@@ -47,9 +47,11 @@ class Figure:
 
     @property
     def ok(self) -> bool:
+        """True when the value is finite and within its bound."""
         return math.isfinite(self.value) and self.value <= self.bound
 
     def message(self, what: str = "") -> str:
+        """The figure past its bound, in words, with what to change."""
         where = f"{what}: " if what else ""
         unit = f" {self.unit}" if self.unit else ""
         fix = f"; {self.fix}" if self.fix else ""
@@ -57,6 +59,7 @@ class Figure:
                 f"({self.doc}){fix}")
 
     def to_dict(self) -> dict[str, Any]:
+        """The figure as a JSON-able dictionary (with `ok`)."""
         return {**asdict(self), "ok": self.ok}
 
 

@@ -43,6 +43,7 @@ class Limit:
 
     @property
     def has_default(self) -> bool:
+        """True when a default is declared (the scene loader then fills it in)."""
         return self.default is not _NO_DEFAULT
 
     def describe(self) -> str:

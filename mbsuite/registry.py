@@ -28,6 +28,7 @@ class Effect:
     doc: str = ""
 
     def check(self, name: str, value: Any) -> Any:
+        """Return `value` if it is one of the choices, else a SceneError listing them."""
         # bools are compared by identity so that 1/0 are not silently taken for true/false
         ok = any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool))
                  for c in self.choices)
@@ -78,9 +79,11 @@ class ModelSpec:
         return importlib.import_module(self.cases) if self.cases else None
 
     def param_names(self) -> list[str]:
+        """The names of the model's parameters (its parameter dataclass's fields)."""
         return [f.name for f in dataclasses.fields(self.params_cls)]
 
     def scene_files(self) -> dict[str, Path]:
+        """The shipped scenes, name -> TOML path."""
         return {p.stem: p for p in sorted(self.scenes_dir.glob("*.toml"))}
 
 
@@ -105,6 +108,7 @@ def models() -> dict[str, ModelSpec]:
 
 
 def get_model(name: str) -> ModelSpec:
+    """The model called `name` (a SceneError listing the valid models if unknown)."""
     ms = models()
     if name not in ms:
         raise SceneError(f"unknown model '{name}'; valid models: {sorted(ms)}")

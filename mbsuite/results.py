@@ -38,6 +38,7 @@ class SimResult:
         return self.signals[name]
 
     def summary(self) -> dict[str, Any]:
+        """Per-signal min/max/final with units, the resolved inputs, events, stats, health figures and warnings."""
         out = {"engine": self.engine, "n_samples": int(self.t.size), "t_end": float(self.t[-1]) if self.t.size else 0.0}
         out["signals"] = {
             k: {"unit": self.units.get(k, ""), "min": float(np.min(v)), "max": float(np.max(v)), "final": float(v[-1])}
@@ -54,6 +55,7 @@ class SimResult:
         return out
 
     def write_csv(self, path: str | Path) -> Path:
+        """Write `t` and every signal as CSV (header `name [unit]`)."""
         cols = [("t", "s", self.t)] + [(k, self.units.get(k, ""), v) for k, v in self.signals.items()]
         return write_csv(path, cols)
 
@@ -168,6 +170,7 @@ def _fmt(x: Any) -> str:
 
 
 def versions() -> dict[str, str]:
+    """The versions of mbsuite, its engines and Python, for summary.json."""
     import mujoco
     import pinocchio
     import scipy
@@ -203,6 +206,7 @@ def to_jsonable(obj: Any) -> Any:
 
 
 def write_summary(out_dir: str | Path, scene: Mapping[str, Any] | None, results: Mapping[str, Any]) -> Path:
+    """Write `summary.json` (versions, scene, results) into `out_dir`."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = out / "summary.json"
@@ -243,9 +247,11 @@ class Progress:
 
     @property
     def n(self) -> int:
+        """How many units are done."""
         return int(self._bar.n)
 
     def update(self, k: int = 1) -> None:
+        """Advance by `k` units."""
         self._bar.update(k)
 
     def __enter__(self) -> Progress:
@@ -265,6 +271,7 @@ class Report:
     write: Any = None  # Callable[[Path], list[Path]] | None
 
     def save(self, out_dir: str | Path, scene: Mapping[str, Any] | None) -> list[Path]:
+        """Write the report's files and summary.json into `out_dir`; return their paths."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         files = list(self.write(out)) if self.write else []

@@ -69,6 +69,7 @@ class SolverSettings:
     max_steps: float = DEFAULT_MAX_STEPS
 
     def check(self, engines: tuple[str, ...]) -> None:
+        """Check every setting (type, finiteness, range, the size guard); a SceneError names the first bad one."""
         for name in ("engine", "integrator", "method"):
             v = getattr(self, name)
             if not isinstance(v, str):
@@ -133,6 +134,7 @@ class Scene:
 
     @property
     def spec(self) -> ModelSpec:
+        """The model's declaration (ModelSpec)."""
         return get_model(self.model)
 
     def build_params(self):
@@ -140,6 +142,7 @@ class Scene:
         return self.spec.params_cls(**dict(self.params))
 
     def to_dict(self) -> dict[str, Any]:
+        """The scene as a plain dictionary (the TOML's structure, every default resolved)."""
         return {
             "model": self.model,
             "name": self.name,
@@ -317,4 +320,5 @@ def load_scene(ref: str | Path) -> Scene:
 
 
 def shipped_scenes() -> dict[str, list[str]]:
+    """Every model's shipped scenes, by model."""
     return {name: sorted(spec.scene_files()) for name, spec in models().items()}

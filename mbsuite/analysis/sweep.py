@@ -902,6 +902,7 @@ def rollout_sweep(models: Any, initial_states: np.ndarray, controls: np.ndarray,
 
 
 def state_size(model: Any) -> int:
+    """The length of MuJoCo's full physics state of `model` (`mj_stateSize`, `mjSTATE_FULLPHYSICS`)."""
     import mujoco
 
     return mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)

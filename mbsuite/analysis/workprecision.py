@@ -29,6 +29,8 @@ TOLS = (1e-2, 1e-4, 1e-6)
 
 @dataclass
 class Row:
+    """One measured setting of a work-precision study: engine, method, setting, wall times (median, min, max) and
+    the two errors."""
     engine: str
     method: str
     setting: Any
@@ -41,12 +43,14 @@ class Row:
     error: str | None = None
 
     def as_dict(self) -> dict:
+        """The row as a JSON-able dictionary."""
         return {"engine": self.engine, "method": self.method, "setting": self.setting, "time_s": self.time_s,
                 "time_min": self.time_min, "time_max": self.time_max, "state_error": self.state_error,
                 "physics_error": self.physics_error, "details": self.details, "error": self.error}
 
 
 def timed(fn: Callable[[], Any], repeats: int) -> tuple[Any, float, float, float]:
+    """Run `fn` `repeats` times; return its last result and the median, min and max wall time (s)."""
     times, res = [], None
     for _ in range(max(1, repeats)):
         t0 = time.perf_counter()
@@ -61,6 +65,7 @@ def _rel(a: float, b: float, floor: float = 1e-300) -> float:
 
 @dataclass
 class Setting:
+    """One setting of a study: which engine and method, the setting value (step, rtol...), and how to run it."""
     engine: str
     method: str
     setting: Any
@@ -78,15 +83,19 @@ class Study:
         self.quick = quick
 
     def settings(self) -> list[Setting]:
+        """Every setting the study measures."""
         raise NotImplementedError
 
     def reference(self) -> tuple[Any, dict]:
+        """The converged reference solution the errors are measured against."""
         raise NotImplementedError
 
     def state_error(self, res: Any, ref: Any) -> float:
+        """Relative error of a run's state trajectory against the reference."""
         raise NotImplementedError
 
     def physics_error(self, res: Any, ref: Any) -> tuple[float, dict]:
+        """Relative error of a run's physics figure (the quantity an engineer reads) against the reference."""
         raise NotImplementedError
 
 

@@ -333,6 +333,7 @@ class Stepper:
                            f"{hint}")
 
     def channels_flat_bound(self, col: int) -> tuple[float, float]:
+        """The plausibility bounds of every recorded column, flattened in recording order."""
         return float(self._lo[col]), float(self._hi[col])
 
 

@@ -58,6 +58,7 @@ def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False)
 
 
 def set_integrator(model: mujoco.MjModel, integrator: str, timestep: float) -> None:
+    """Set a model's integrator (by name) and timestep; an unknown name is a SceneError listing the valid ones."""
     if integrator not in INTEGRATOR:
         raise SceneError(f"unknown integrator {integrator!r}; valid: {list(INTEGRATOR)}")
     model.opt.integrator = INTEGRATOR[integrator]

@@ -31,6 +31,7 @@ def load_mjcf(path: str | Path) -> pin.Model:
 
 
 def frame_id(model: pin.Model, name: str) -> int:
+    """The id of frame `name`; a ModelFileError listing the frames if it is missing."""
     if not model.existFrame(name):
         raise ModelFileError(f"model '{model.name}' has no frame '{name}'; frames: {[f.name for f in model.frames]}")
     return model.getFrameId(name)

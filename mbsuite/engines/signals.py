@@ -28,9 +28,11 @@ class Signal:
     kind: int = -1
 
     def values(self, t: np.ndarray) -> np.ndarray:
+        """The signal at the times `t` (vectorised; equal to the C evaluation to rounding)."""
         raise NotImplementedError
 
     def params(self) -> Sequence[float]:
+        """The parameters in the order the C evaluator reads them."""
         raise NotImplementedError
 
     def __call__(self, t):
@@ -38,6 +40,7 @@ class Signal:
         return float(y) if np.ndim(y) == 0 else y
 
     def spec(self) -> np.ndarray:
+        """The signal as the C evaluator's parameter row (kind code, then parameters)."""
         return np.array([float(self.kind), *map(float, self.params())], dtype=np.float64)
 
 
@@ -52,9 +55,11 @@ class Constant(Signal):
         _finite("constant", value=self.value)
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         return np.full_like(t, self.value)
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.value,)
 
 
@@ -71,9 +76,11 @@ class Step(Signal):
         _finite("step", height=self.height, offset=self.offset, t0=self.t0)
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         return self.offset + np.where(t >= self.t0, self.height, 0.0)
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.offset, self.height, self.t0)
 
 
@@ -93,10 +100,12 @@ class Sine(Signal):
                 t0=self.t0)
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         return self.offset + np.where(t >= self.t0, self.amplitude * np.sin(
             2.0 * math.pi * self.frequency * (t - self.t0) + self.phase), 0.0)
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.offset, self.amplitude, self.frequency, self.phase, self.t0)
 
 
@@ -116,12 +125,14 @@ class Ramp(Signal):
             raise ParameterError(f"ramp signal: duration must be >= 0, got {self.duration!r}")
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         if self.duration <= 0:
             return self.offset + np.where(t >= self.t0, self.height, 0.0)
         frac = np.clip((t - self.t0) / self.duration, 0.0, 1.0)
         return self.offset + self.height * frac
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.offset, self.height, self.t0, self.duration)
 
 
@@ -145,6 +156,7 @@ class Pulse(Signal):
             raise ParameterError(f"pulse signal: need 0 <= width <= 1, period > 0, n >= 0; got {self}")
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         k = np.floor((t - self.t0) / self.period)
         phase = (t - self.t0) - k * self.period
         on = (t >= self.t0) & (phase < self.width * self.period)
@@ -153,6 +165,7 @@ class Pulse(Signal):
         return self.offset + np.where(on, self.amplitude, 0.0)
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.offset, self.amplitude, self.width, self.period, self.t0, self.n)
 
 
@@ -178,9 +191,11 @@ class Table(Signal):
         return cls(ts, tuple(float(fn(x)) for x in ts))
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         return np.interp(t, self.times, self.points)
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (len(self.times), *self.times, *self.points)
 
 
@@ -197,7 +212,9 @@ class CosineLift(Signal):
         _finite("cosine lift", offset=self.offset, amplitude=self.amplitude, frequency=self.frequency)
 
     def values(self, t):
+        """The formula in the class docstring at the times `t` (vectorised)."""
         return self.offset + self.amplitude * (1.0 - np.cos(2.0 * math.pi * self.frequency * t))
 
     def params(self):
+        """The parameters in the order the C evaluator reads them."""
         return (self.offset, self.amplitude, self.frequency)

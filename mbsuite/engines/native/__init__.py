@@ -77,6 +77,7 @@ def _compiler() -> list[str]:
 
 
 def cache_root() -> Path:
+    """Where the native library is built and cached: $MBSUITE_NATIVE_DIR, else ~/.cache/mbsuite."""
     env = os.environ.get("MBSUITE_NATIVE_DIR")
     if env:
         return Path(env)

@@ -42,13 +42,13 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", metavar="DIR", help="write CSV/PNG/summary.json into DIR")
 
 
-ANALYSES = ("run", "equilibrium", "modes", "freqresp")
+ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view")
 CLI_GROUPS: dict[str, str] = {}  # model -> its own command group (filled when the parser is built)
 
 
 def _analyses(spec: registry.ModelSpec) -> list[str]:
     """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
-    out = [a for a in ANALYSES if getattr(spec, a) is not None]
+    out = [a for a in ANALYSES if getattr(spec, "mujoco_model" if a == "view" else a) is not None]
     if spec.run is not None:
         out.append("sweep")
     if spec.cases:
@@ -263,6 +263,20 @@ def _plot_sweep(head: list[str], units: dict, combos: list, results: list, signa
     return fig
 
 
+def _cmd_view(args: argparse.Namespace) -> None:
+    """Open MuJoCo's interactive viewer on the scene's MuJoCo model (its effects active, its initial state)."""
+    scene = _load(args)
+    if scene.spec.mujoco_model is None:
+        raise MbsuiteError(f"model '{scene.model}' has no MuJoCo model to view")
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or sys.platform == "darwin"):
+        raise MbsuiteError("mbsuite view needs a display (no DISPLAY or WAYLAND_DISPLAY is set); on a headless "
+                           "machine render offscreen instead (MUJOCO_GL=egl, mujoco.Renderer)")
+    import mujoco.viewer
+
+    model, data = scene.spec.mujoco_model(scene)
+    mujoco.viewer.launch(model, data)
+
+
 def _scene_opts(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-inaccurate", action="store_true",
                    help="keep a result whose health figures exceed their bounds (with a loud warning) instead of an "
@@ -366,6 +380,10 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--workers", type=int, default=0, help="parallel processes (0 = all cores)")
             _sweep_args(p)
         p.set_defaults(func=_hook_command(hook))
+
+    p = sub.add_parser("view", help="open MuJoCo's viewer on a scene's model, its effects active")
+    p.add_argument("scene", help="scene TOML path, model name (default scene) or model/scene")
+    p.set_defaults(func=_cmd_view)
 
     p = sub.add_parser("sweep", help="parameter study: run a scene over a grid of inputs/parameters/settings")
     p.add_argument("scene", help="scene TOML path, model name (default scene) or model/scene")

@@ -54,6 +54,8 @@ class ModelSpec:
       returns the validated value or raises SceneError naming the bad key); e.g. the catenary's `[pantograph]`.
     - `under_wire(params, effects, engine, timestep) -> pantograph`: a pantograph of this model that the catenary can
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
+    - `mujoco_model(scene) -> (MjModel, MjData)`: the MuJoCo model of exactly the scene's effects, in its initial state
+      (what `mbsuite view` shows; None: the model has no MuJoCo model).
     """
 
     name: str
@@ -73,6 +75,7 @@ class ModelSpec:
     sections: Mapping[str, Callable[[Any], Any]] = field(default_factory=dict)
     cases: str | None = None
     under_wire: Callable[..., Any] | None = None
+    mujoco_model: Callable[..., Any] | None = None
 
     def suite(self) -> Any:
         """The model's suite module (`cases`), or None if it declares none."""

@@ -363,3 +363,15 @@ def test_two_models_in_two_threads_equal_their_serial_runs():
 def test_scene_errors_are_scene_errors():
     with pytest.raises(SceneError, match="solver.timestep"):
         load_scene("pantograph").replace(solver={"timestep": math.nan})
+
+
+def test_view_without_a_display_is_a_clear_error(monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    viewable = [n for n, s in registry.models().items() if s.mujoco_model is not None]
+    for name in viewable:
+        rc, _, err = _run_cli(["view", name], capsys)
+        assert rc == 2 and "needs a display" in err, (name, err)
+    for name in sorted(set(MODELS) - set(viewable)):
+        rc, _, err = _run_cli(["view", name], capsys)
+        assert rc == 2 and "no MuJoCo model" in err, (name, err)

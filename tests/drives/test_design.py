@@ -16,7 +16,7 @@ from mbsuite.models.drives.analysis import TABLE_5_2, TABLE_6_2
 
 @pytest.mark.parametrize("sr", sorted(TABLE_5_2))
 def test_table_5_2(sr):
-    """500 W example (L1834-1840), family read at the chosen 20 N m clutch torque. The Sr_min = 10 row's (K, J_s)
+    """500 W example (Table 5.2), family read at the chosen 20 N m clutch torque. The Sr_min = 10 row's (K, J_s)
     pair is off its own curve by ~4.5 % (Eq 5.13 with the printed K, J_s gives Sr_max 14.43, not 15.07)."""
     d = D.at_clutch_torque(500, sr, 0, 500, 100, 20.0)
     tol = 0.045 if sr == 10 else 0.03
@@ -104,7 +104,7 @@ def test_springsz_closed_forms_for_a_stated_material():
     assert r["d"] == pytest.approx(d, rel=1e-12)
     assert r["DN"] == pytest.approx(DN, rel=1e-12)
     assert d**4 * E / (64 * r["DN"]) == pytest.approx(K, rel=1e-12)  # (5.14) holds for the returned d, DN
-    # scaling laws (5.19)/(5.21): V ~ 1/sf^2 (16x at 1/4 of the stress, L1537), d ~ sf^(-1/3)
+    # scaling laws (5.19)/(5.21): V ~ 1/sf^2 (16x at 1/4 of the stress, Sec. 5.1.2), d ~ sf^(-1/3)
     half = D.springsz(K, x, fatigue=0.5, sigma_uts=sig, E=E)
     assert r["V"] / half["V"] == pytest.approx(4.0, rel=1e-12)
     assert r["d"] / half["d"] == pytest.approx(2 ** (1 / 3), rel=1e-12)
@@ -113,7 +113,7 @@ def test_springsz_closed_forms_for_a_stated_material():
 
 def test_springsz_calibration_and_table_6_3():
     """The thesis prints no material data. E = 209 GPa follows from the Table 6.3 spring alone via (5.14); the
-    default sigma_uts = 1.465 GPa is a calibration to the recommended 1.58e-4 m^3 (L2026), so that volume is
+    default sigma_uts = 1.465 GPa is a calibration to the recommended 1.58e-4 m^3 (Sec. 6.3), so that volume is
     reproduced by construction - this test checks the calibration and the Table 6.3 geometry, it reproduces nothing."""
     d, Dc, N, K = 3.43e-3, 27.81e-3, 12.3, 1.32  # Table 6.3
     E = 64 * Dc * N * K / d**4

@@ -223,16 +223,16 @@ def step_up_runs():
 
 
 def test_step_up_reproduction(step_up_runs):
-    """Published numbers asserted to their printed precision: "~3" (L915) is any ratio that rounds to 3, [2.5, 3.5)
-    (measured 3.29); "~50 %" (L959-969) rounds to the nearest 10 %, [45, 55) % (measured 54 %); the qualitative
-    orderings of L939 (resonant above PWM; measured 212 vs 209 rad/s) and L947 ("significant increase" by clutch
-    matching; measured +12 %, asserted > 5 %)."""
+    """Published numbers asserted to their printed precision: "~3" (Sec 4.2.1) is any ratio that rounds to 3, [2.5, 3.5)
+    (measured 3.29); "~50 %" (Sec. 4.2.4) rounds to the nearest 10 %, [45, 55) % (measured 54 %); the qualitative
+    orderings of Sec 4.2.2 (resonant above PWM; measured 212 vs 209 rad/s) and Sec 4.2.3 ("significant increase"
+    by clutch matching; measured +12 %, asserted > 5 %)."""
     pwm = step_up_runs["step_up_pwm"]
     ratio = pwm["mean_load_speed"] / pwm["mean_motor_speed"]
     assert 2.5 <= ratio < 3.5
-    assert step_up_runs["step_up_resonant"]["mean_load_speed"] > pwm["mean_load_speed"]  # L939
+    assert step_up_runs["step_up_resonant"]["mean_load_speed"] > pwm["mean_load_speed"]  # Sec. 4.2.2
     assert (step_up_runs["step_up_resonant_matched"]["mean_load_speed"]
-            > 1.05 * step_up_runs["step_up_resonant"]["mean_load_speed"])  # L947 "significant increase"
+            > 1.05 * step_up_runs["step_up_resonant"]["mean_load_speed"])  # Sec. 4.2.3 "significant increase"
     gain = step_up_runs["step_up_added_inertia"]["mean_load_speed"] / pwm["mean_load_speed"] - 1
     assert 0.45 <= gain < 0.55
 
@@ -244,18 +244,18 @@ def susd_design():
 
 
 def test_susd_100w_design_reproduction(susd_design):
-    """+-400 rad/s and "~5 rad" extension as the thesis (L1987-2001), each to its printed precision.
+    """+-400 rad/s and "~5 rad" extension as the thesis (Sec. 6.2), each to its printed precision.
 
-    Switching rate: the thesis' ~14.5 cycles/s (L2001; Table 6.2: 14.20) is asserted with the tolerance of a
+    Switching rate: the thesis' ~14.5 cycles/s (Sec. 6.2; Table 6.2: 14.20) is asserted with the tolerance of a
     documented deviation, not an accuracy: ours is 12.8 (-11.7 %), README "Deviations" 3 - the whole difference is
     in the extraction (23.1 vs 18.1 ms in the design model, Eq 5.5); our slower motor (82 vs 96 rad/s) explains a
     1.17x longer extraction, the rest is not explained. The free phases of the cycle (waits, transfer, restart) are
     checked against the closed form instead: one free period 2 pi sqrt(J_s/K) plus one controller sample
     (measured -0.46 %, bound 2 %, 4x)."""
     sc, cs, ph = susd_design
-    assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (L1987-1993); measured -0.76 %
+    assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (Sec. 6.2); measured -0.76 %
     assert abs(cs["switching_rate"] / 14.5 - 1) < 0.15  # documented deviation (-11.7 %), see the docstring
-    assert 4.5 <= cs["max_extension"] < 5.5  # "~5 rad" (L2001) to its printed precision; measured 4.90
+    assert 4.5 <= cs["max_extension"] < 5.5  # "~5 rad" (Sec. 6.2) to its printed precision; measured 4.90
     p = sc.build_params().resolved(sc.effects["param_set"])
     free = ph["wait_extraction"] + ph["wait_transfer"] + ph["transfer"] + ph["restart"]
     assert abs(free / (2 * math.pi * math.sqrt(p["J_s"] / p["K"]) + 1 / p["fs"]) - 1) < 0.02

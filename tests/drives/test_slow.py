@@ -14,7 +14,7 @@ pytestmark = pytest.mark.slow
 
 
 def test_susd_100w_efficiency_band():
-    """Thesis (L2269-2277, read from its figure): 70-80 % over ~60-260 rad/s, ~40 % near 400 rad/s. The loads are
+    """Thesis (Sec. 6.5, read from its Fig 6.20): 70-80 % over ~60-260 rad/s, ~40 % near 400 rad/s. The loads are
     chosen to land in that speed range (measured 227, 156, 105, 67 rad/s). Efficiency: the thesis band widened by 5
     points each side - figure reading plus the stated model limitation (spring hysteresis only as the thesis' viscous
     B_s refit); measured 67, 77, 81, 79 %, i.e. up to 3 points outside the band. Near 400 rad/s "~40 %" to +-10
@@ -49,7 +49,7 @@ def test_susd_closed_loop_tracking_and_regeneration():
     ref = reference_signal(dict(sc.input), 0.0)
     r = np.array([ref(t) for t in res.t])
     hold = ((res.t % 4.0 > 2.0) & (res.t < 8.0)) | (res.t > 12.5)
-    assert np.max(np.abs(res.w[2][hold] - r[hold])) < 0.085 * 400  # L2297-2311
+    assert np.max(np.abs(res.w[2][hold] - r[hold])) < 0.085 * 400  # Sec. 6.6, Fig 6.24
     assert min(e["eps"] for e in ctrl.log if e["event"] == "cycle") < 0  # energy returned to the motor
     assert np.max(res.w[0][(res.t > 8) & (res.t < 10)]) > 197  # motor driven above its no-load speed
 

@@ -37,7 +37,7 @@ SPEC = ModelSpec(
                               "step-up PI (state stored before the clamp, winds up), used by step_up_closed_loop"),
         "clutch_delays": Effect((True, False), True, "pure actuation delays quantised to controller samples"),
         "bearing_friction": Effect((True, False), True, "viscous + Coulomb bearings (with stiction)"),
-        "added_motor_inertia": Effect((True, False), False, "add J_add to the motor (L959, L1987)"),
+        "added_motor_inertia": Effect((True, False), False, "add J_add to the motor (Sec. 4.2.4, Sec. 6.2)"),
     },
     inputs={
         # `value` has no fixed default: without it (and without a profile) the parameter set's `ref` is the reference

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +18,7 @@ from .model import simulate_scene
 
 
 def steady_window(scene: Scene) -> float:
+    """Start of the averaging window [s]: solver.t_settle, or half the run when it is 0."""
     return scene.solver.t_settle if scene.solver.t_settle > 0 else 0.5 * scene.solver.duration
 
 
@@ -41,7 +44,22 @@ def efficiency_point(scene: Scene) -> dict[str, Any]:
     return out
 
 
+#: short column names of the loss terms in the CLI table (the figure and the CSV use `plots.LOSS_LABELS` / the keys)
+LOSS_SHORT = {"viscous_motor": "visc_m", "viscous_spring": "visc_s", "viscous_load": "visc_l",
+              "motor_bearing": "coul_m", "spring_bearing": "coul_s", "load_bearing": "coul_l", "brake": "brake",
+              "clutch": "clutch", "clutch_a": "clutch_a", "clutch_b": "clutch_b", "lock_impact": "lockup"}
+#: columns of the efficiency table and CSV: (key of an efficiency point, CSV name, unit, table header, factor)
+EFF_COLUMNS = (("tau_l", "tau_l", "N m", "tau_l [N m]", 1.0), ("load_speed", "w_load", "rad/s", "w_l [rad/s]", 1.0),
+               ("motor_speed", "w_motor", "rad/s", "w_m [rad/s]", 1.0), ("P_in", "P_in", "W", "P_in [W]", 1.0),
+               ("P_out", "P_out", "W", "P_out [W]", 1.0), ("efficiency", "efficiency", "%", "eta [%]", 100.0),
+               ("switching_rate", "Sr", "1/s", "Sr [1/s]", 1.0),
+               ("balance_relative", "balance_residual", "1", "balance [-]", 1.0))
+
+
 def efficiency(scene: Scene, loads: list[float], engine: str | None = None) -> Report:
+    """Open-loop efficiency sweep over load torques (one `efficiency_point` per load): a table of the operating
+    points and one of the mean loss powers; `--out` writes efficiency.csv (SI units in the header) and efficiency.png
+    (`plots.efficiency_figure`: the curve ordered by load speed, non-switching points apart, losses as sorted bars)."""
     if scene.effects["mechanism"] == "coupled_clutches":
         raise SceneError("efficiency needs a drive scene (mechanism step_up or step_up_down)")
     if scene.effects.get("closed_loop"):
@@ -52,60 +70,69 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None) -> R
             raise SceneError(f"load torque must be >= 0, got {tl}")
         sc = scene.replace(params={"tau_l": float(tl)}, solver={"engine": engine} if engine else {})
         pts.append(efficiency_point(sc))
-    labels = sorted({k for p in pts for k in p["losses_W"]})
-    rows = [[p["tau_l"], p["load_speed"], p["motor_speed"], p["P_in"], p["P_out"], 100 * p["efficiency"],
-             p["switching_rate"], p["balance_relative"]] + [p["losses_W"].get(k, 0.0) for k in labels] for p in pts]
-    head = ["tau_l", "w_load", "w_motor", "P_in", "P_out", "eff_%", "Sr", "bal_rel"] + labels
-    table = format_table(head, rows, ".4g")
+    labels = sorted({k for p in pts for k in p["losses_W"]}, key=lambda k: list(LOSS_SHORT).index(k)
+                    if k in LOSS_SHORT else len(LOSS_SHORT))
+
+    rows = [[f * p[k] for k, _, _, _, f in EFF_COLUMNS] for p in pts]
+    shown = [[("-" if isinstance(v, float) and math.isnan(v) else v) for v in r] for r in rows]
+    table = format_table([c[3] for c in EFF_COLUMNS], shown, ".4g")
+    table += "\n" + textwrap.fill(
+        "Sr = switching rate (energy cycles per second over t >= t_settle; '-' = no complete cycle: the drive does not "
+        "switch, that point is not on the efficiency curve); eta = P_out / P_in; balance = energy residual / turnover.",
+        100)
+    lrows = [[p["tau_l"]] + [_tidy(p["losses_W"].get(k, 0.0), p["P_in"]) for k in labels] for p in pts]
+    table += "\n\nmean loss power [W] by term:\n" + format_table(
+        ["tau_l [N m]"] + [LOSS_SHORT.get(k, k) for k in labels], lrows, ".3g")
+    from .plots import loss_label
+
+    table += "\n" + textwrap.fill("; ".join(f"{LOSS_SHORT.get(k, k)} = {loss_label(k)}" for k in labels), 100)
 
     def write(out: Path) -> list[Path]:
-        files = [write_csv(out / "efficiency.csv", [(h, "", [r[i] for r in rows]) for i, h in enumerate(head)])]
-        import matplotlib
+        from ...plotting import save
+        from .plots import efficiency_figure
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-        sp = [abs(p["load_speed"]) for p in pts]
-        ax[0].plot(sp, [100 * p["efficiency"] for p in pts], "o-")
-        ax[0].set(xlabel="steady load speed |w_l| (rad/s)", ylabel="efficiency (%)", title=scene.name)
-        bottom = np.zeros(len(pts))
-        for k in labels:
-            v = np.array([p["losses_W"].get(k, 0.0) for p in pts])
-            ax[1].bar(range(len(pts)), v, bottom=bottom, label=k)
-            bottom += v
-        ax[1].set_xticks(range(len(pts)), [f"{s:.0f}" for s in sp], rotation=60)
-        ax[1].set(xlabel="load speed (rad/s)", ylabel="loss (W)")
-        ax[1].legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "efficiency.png", dpi=120)
-        plt.close(fig)
-        return files + [out / "efficiency.png"]
+        cols = [(name, unit, [r[i] for r in rows]) for i, (_, name, unit, _, _) in enumerate(EFF_COLUMNS)]
+        cols += [(f"loss_{k}", "W", [p["losses_W"].get(k, 0.0) for p in pts]) for k in labels]
+        fig = efficiency_figure(pts, scene.name)
+        return [write_csv(out / "efficiency.csv", cols), save(fig, out / "efficiency.png")]
 
     return Report({"scene": scene.name, "points": pts}, table, write)
 
 
+def _tidy(v: float, scale: float) -> float:
+    """A loss power for the table: round-off (below 1e-9 of the input power) shown as 0."""
+    return 0.0 if abs(v) < 1e-9 * max(abs(scale), 1e-300) else v
+
+
 # ---- design tables ---------------------------------------------------------------------------------------------------
 TABLE_5_2 = {5: (3.94e-4, 7.52, 11.5, 1.71, 113.07), 10: (2.03e-4, 15.07, 5.88, 3.43, 59.29),
-             15: (1.32e-4, 22.63, 3.81, 5.36, 38.90), 20: (1.00e-4, 30.0, 2.86, 7.07, 28.91)}  # L1834-1840
+             15: (1.32e-4, 22.63, 3.81, 5.36, 38.90), 20: (1.00e-4, 30.0, 2.86, 7.07, 28.91)}  # Sec. 5.4, Table 5.2
+#: Table 6.2 (the 100 W design, Sec. 6.2)
 TABLE_6_2 = {10: (7.3e-5, 14.20, 5.09, 0.98), 15: (4.8e-5, 21.20, 3.36, 1.48), 20: (3.5e-5, 28.32, 2.56, 1.95)}
 
 
+#: SI units of the design quantities (K_p, K_I: the energy-packet PI maps a speed-squared error [rad^2/s^2] to an
+#: energy packet [J], Eqs 5.32-5.37)
+DESIGN_UNITS = {"J_s": "kg m^2", "Sr_max": "1/s", "x_max": "rad", "K": "N m/rad", "capacity": "J", "Kp": "kg m^2",
+                "KI": "kg m^2/s"}
+
+
 def design_tables() -> Report:
-    """Tables 5.2 and 6.2 (the CADJS families read at the chosen clutch torque), gains of Eq 6.1 and Sec. 5.4."""
+    """Tables 5.2 and 6.2 (the CADJS families read at the chosen clutch torque), gains of Eq 6.1 and Sec. 5.4, each
+    against the thesis' printed value; `--out` writes design_tables.csv and design_tables.png (relative differences)."""
     rows = []
     data: dict[str, Any] = {"table_5_2": [], "table_6_2": [], "gains": []}
     for sr, th in TABLE_5_2.items():
         d = D.at_clutch_torque(500, sr, 0, 500, 100, 20.0)
         ours = (d.J_s, d.Sr_max, d.x_max, d.K, d.capacity)
         for nm, o, t in zip(("J_s", "Sr_max", "x_max", "K", "capacity"), ours, th, strict=True):
-            rows.append(["5.2", sr, nm, o, t, 100 * (o / t - 1)])
-            data["table_5_2"].append({"Sr_min": sr, "quantity": nm, "ours": o, "thesis": t})
+            rows.append(["5.2", sr, nm, DESIGN_UNITS[nm], o, t, 100 * (o / t - 1)])
+            data["table_5_2"].append({"Sr_min": sr, "quantity": nm, "unit": DESIGN_UNITS[nm], "ours": o, "thesis": t})
     for sr, th in TABLE_6_2.items():
         d = D.at_clutch_torque(100, sr, 0, 400, 96, 5.0)
         for nm, o, t in zip(("J_s", "Sr_max", "x_max", "K"), (d.J_s, d.Sr_max, d.x_max, d.K), th, strict=True):
-            rows.append(["6.2", sr, nm, o, t, 100 * (o / t - 1)])
-            data["table_6_2"].append({"Sr_min": sr, "quantity": nm, "ours": o, "thesis": t})
+            rows.append(["6.2", sr, nm, DESIGN_UNITS[nm], o, t, 100 * (o / t - 1)])
+            data["table_6_2"].append({"Sr_min": sr, "quantity": nm, "unit": DESIGN_UNITS[nm], "ours": o, "thesis": t})
     kp, ki = D.gains(0.0023, 1 / 14.5, 2.5e-4, 0.15, 400.0)
     _, ki14 = D.gains(0.0023, 1 / 14.0, 2.5e-4, 0.15, 400.0)
     bt = D.b_total(500, 500, 0.8)
@@ -114,7 +141,22 @@ def design_tables() -> Report:
     for nm, o, t in (("Kp 100W (Sr 14.5)", kp, 0.00112), ("KI 100W (Sr 14.5)", ki, 0.0161),
                      ("KI 100W (Sr 14)", ki14, 0.0161), ("Kp 500W @500", kp5a, 0.00246),
                      ("Kp 500W @50", kp5b, 0.00222), ("KI 500W", ki5, 0.075)):
-        rows.append(["gains", "", nm, o, t, 100 * (o / t - 1)])
-        data["gains"].append({"quantity": nm, "ours": o, "thesis": t})
-    table = format_table(["table", "Sr_min", "quantity", "ours", "thesis", "diff_%"], rows, ".4g")
-    return Report(data, table)
+        unit = DESIGN_UNITS[nm.split()[0]]
+        rows.append(["gains", "", nm, unit, o, t, 100 * (o / t - 1)])
+        data["gains"].append({"quantity": nm, "unit": unit, "ours": o, "thesis": t})
+    head = ["table", "Sr_min [1/s]", "quantity", "unit", "ours", "thesis", "diff [%]"]
+    table = format_table(head, rows, ".4g")
+
+    def write(out: Path) -> list[Path]:
+        from ...plotting import save
+        from .plots import design_tables_figure
+
+        cols = [("table", "", [r[0] for r in rows]), ("Sr_min", "1/s", [r[1] for r in rows]),
+                ("quantity", "", [r[2] for r in rows]), ("unit", "", [r[3] for r in rows]),
+                ("ours", "", [r[4] for r in rows]), ("thesis", "", [r[5] for r in rows]),
+                ("diff", "%", [r[6] for r in rows])]
+        fig = design_tables_figure([{"label": f"Table {r[0]}, Sr_min {r[1]}: {r[2]} [{r[3]}]" if r[1] != ""
+                                     else f"{r[2]} [{r[3]}]", "ours": r[4], "thesis": r[5]} for r in rows])
+        return [write_csv(out / "design_tables.csv", cols), save(fig, out / "design_tables.png")]
+
+    return Report(data, table + "\n'ours' and 'thesis' are in the unit of the row.", write)

@@ -301,6 +301,7 @@ class DrivesStudy(Study):
         self.ts = ts
 
     def settings(self) -> list[Setting]:
+        """The settings of the study: hand-path tolerances and MuJoCo integrators x timesteps."""
         out = []
         for r in ((1e-6,) if self.quick else self.HAND_RTOLS):
             sc = self.base.replace(solver={"engine": "reference", "rtol": r, "atol": r * 1e-2})
@@ -313,6 +314,7 @@ class DrivesStudy(Study):
         return out
 
     def reference(self):
+        """The reference run (hand path, rtol 1e-12) and its own accuracy (against rtol 1e-11)."""
         ref = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-12, "atol": 1e-14}))
         chk = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-11, "atol": 1e-13}))
         err, _ = self.physics_error(chk, ref)
@@ -321,6 +323,7 @@ class DrivesStudy(Study):
                      "check_physics_error": err}
 
     def state_error(self, res, ref) -> float:
+        """Largest speed difference from the reference, relative to the largest reference speed."""
         scale = max(float(np.max(np.abs(ref[s]))) for s in self.speeds) or 1.0
         return max(float(np.max(np.abs(np.interp(ref.t, res.t, res[s]) - ref[s]))) for s in self.speeds) / scale
 
@@ -329,6 +332,8 @@ class DrivesStudy(Study):
                 if e.get("to") == "stuck" and e.get("t") is not None and e["t"] >= self.ts]
 
     def physics_error(self, res, ref):
+        """The study's physics error: cycle-mean load speed, efficiency and lock-up times (over the cycle
+        period), relative; returns (error, details)."""
         det = {}
         period = 0.1
         if not self.cc:
@@ -367,6 +372,7 @@ class DrivesStudy(Study):
 
 
 def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    """The drives' work-precision study on `scene` (`mbsuite workprecision`)."""
     return DrivesStudy(scene, quick=quick)
 
 

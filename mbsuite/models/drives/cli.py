@@ -3,15 +3,25 @@
 from __future__ import annotations
 
 import argparse
+import math
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import MbsuiteError, SceneError
 from ...limits import Limit
-from ...results import Report, format_table
+from ...plotting import save
+from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene
 from . import design as D
+from .plots import cadjs_figure, coupled_clutches_figure, loss_label, run_figure
+
+#: names and units of the cycle statistics of a drive run (`drive.cycle_stats`)
+CYCLE_QUANTITIES = {"n_cycles": ("energy cycles in the window t >= t_settle", ""),
+                    "switching_rate": ("switching rate Sr (energy cycles per second)", "1/s"),
+                    "mean_load_speed": ("mean load speed", "rad/s"), "mean_motor_speed": ("mean motor speed", "rad/s"),
+                    "max_extension": ("largest spring twist", "rad")}
 
 #: most time steps of `drive coupled-clutches` (scene runs are guarded by the scene's solver.max_steps)
 MAX_STEPS = DEFAULT_MAX_STEPS
@@ -77,8 +87,31 @@ def _check_steps(flag: str, duration: float, dt: float) -> None:
                            "(shorten the run or enlarge the step)")
 
 
+def _csv_writer(name: str, columns: list[tuple[str, str, list]], figure=None):
+    """A `Report.write`: `name`.csv from `(column, unit, values)` and, if `figure` (a callable returning a Figure)
+    is given, `name`.png."""
+
+    def write(out: Path) -> list[Path]:
+        files = [write_csv(Path(out) / f"{name}.csv", columns)]
+        if figure is not None:
+            files.append(save(figure(), Path(out) / f"{name}.png"))
+        return files
+
+    return write
+
+
+def _quantity_table(items: list[tuple[str, str, float | str, str]]) -> str:
+    """A transposed table: one row per quantity (name, symbol/meaning, value, unit)."""
+    return format_table(["quantity", "meaning", "value", "unit"],
+                        [[k, m, (f"{v:.6g}" if isinstance(v, float) else v), u] for k, m, v, u in items])
+
+
 def register(sub, add_common, emit) -> None:
-    p = sub.add_parser("drive", help="switched-mode drives: design tools, runs, efficiency, CoupledClutches")
+    """Add the `drive` command group (alias `drives`) to the top-level parser: design tools, scene runs, efficiency
+    sweeps and the CoupledClutches check. Every command prints a table with units; `--out DIR` writes CSV (SI units
+    in the header), a PNG where a figure makes sense and summary.json."""
+    p = sub.add_parser("drive", aliases=["drives"],
+                       help="switched-mode drives: design tools, runs, efficiency, CoupledClutches")
     dsub = p.add_subparsers(dest="drive_command", required=True)
 
     # -- design --------------------------------------------------------------------------------------------------
@@ -97,7 +130,11 @@ def register(sub, add_common, emit) -> None:
     def _srmin(a):
         _check_options(a, "--P", "--wmin", "--wrip", "--Jl")
         v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
-        emit(Report({"Sr_min": v}, f"Sr_min = {v:.6g} cycles/s"), a, None)
+        items = [("P", "drive power", a.P, "W"), ("w_min", "lowest load speed", a.wmin, "rad/s"),
+                 ("w_rip", "allowed speed ripple", a.wrip, "rad/s"), ("J_l", "load inertia", a.Jl, "kg m^2"),
+                 ("Sr_min", "minimum switching rate (Eq 5.1)", v, "1/s")]
+        emit(Report({"Sr_min": v}, _quantity_table(items),
+                    _csv_writer("srmin", [(k, u, [x]) for k, _, x, u in items])), a, None)
 
     q.set_defaults(func=_srmin)
 
@@ -121,8 +158,15 @@ def register(sub, add_common, emit) -> None:
                 rows.append([sr, d.J_s, d.K, d.tau_c, d.x_max, d.Sr_max, d.capacity])
                 data.append({"Sr_min": sr, "J_s": d.J_s, "K": d.K, "tau_c": d.tau_c, "x_max": d.x_max,
                              "Sr_max": d.Sr_max, "capacity": d.capacity})
-        emit(Report({"designs": data}, format_table(["Sr_min", "J_s", "K", "tau_c", "x_max", "Sr_max", "capacity_J"],
-                                                    rows, ".4g")), a, None)
+        units = ["1/s", "kg m^2", "N m/rad", "N m", "rad", "1/s", "J"]
+        names = ["Sr_min", "J_s", "K", "tau_c", "x_max", "Sr_max", "capacity"]
+        table = format_table([f"{n} [{u}]" for n, u in zip(names, units, strict=True)], rows, ".4g")
+        table += "\n" + textwrap.fill(
+            "Sr_min/Sr_max: lowest/highest switching rate; J_s: spring-system inertia; K: spring rate; tau_c: clutch "
+            "torque; x_max: largest spring twist; capacity: spring energy 1/2 K x_max^2 (Eqs 5.9-5.13 corrected).", 100)
+        fig = (lambda: cadjs_figure(data)) if len(data) > len(a.srmin) else None
+        cols = [(n, u, [r[i] for r in rows]) for i, (n, u) in enumerate(zip(names, units, strict=True))]
+        emit(Report({"designs": data}, table, _csv_writer("cadjs", cols, fig)), a, None)
 
     q.set_defaults(func=_cadjs)
 
@@ -138,7 +182,15 @@ def register(sub, add_common, emit) -> None:
     def _spr(a):
         _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
         r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
-        emit(Report(r, format_table(list(r), [list(r.values())], ".4g")), a, None)
+        items = [("K", "spring rate", a.K, "N m/rad"), ("x_max", "largest twist", a.xmax, "rad"),
+                 ("fatigue", "allowed / ultimate tensile stress", a.fatigue, "1"),
+                 ("sigma_uts", "ultimate tensile stress", a.sigma_uts, "Pa"), ("E", "Young's modulus", a.E, "Pa"),
+                 ("d", "wire diameter (Eq 5.21)", r["d"], "m"),
+                 ("DN", "coil diameter x number of turns (Eq 5.14)", r["DN"], "m"),
+                 ("V", "spring volume (Eq 5.19)", r["V"], "m^3"),
+                 ("V_check", "pi^2 DN d^2 (same volume from d, DN)", r["V_check"], "m^3")]
+        emit(Report(r, _quantity_table(items), _csv_writer("springsz", [(k, u, [x]) for k, _, x, u in items])),
+             a, None)
 
     q.set_defaults(func=_spr)
 
@@ -160,7 +212,16 @@ def register(sub, add_common, emit) -> None:
         kp_crit = D.stability_kp(ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
         data = {"B_total": a.btotal, "Kp": kp, "KI": ki, "poles": [complex(x).real for x in poles],
                 "Kp_stability_line": kp_crit}
-        emit(Report(data, format_table(list(data), [[str(v) for v in data.values()]])), a, None)
+        items = [("J_l", "load inertia", a.Jl, "kg m^2"), ("t_s", "energy-cycle period", a.ts, "s"),
+                 ("tau_l", "load torque", a.taul, "N m"), ("w0", "operating speed", a.w0, "rad/s"),
+                 ("B_total", "total viscous coefficient (Eq 5.38 if not given)", a.btotal, "N m s"),
+                 ("Kp", "proportional gain (Eqs 5.32-5.37)", kp, "kg m^2"),
+                 ("KI", "integral gain", ki, "kg m^2/s")]
+        items += [(f"pole_{i + 1}", "closed-loop pole in z (real part)", float(x), "1")
+                  for i, x in enumerate(data["poles"])]
+        items += [("Kp_stability_line", "K_p on the stability line (Eq 5.36)", kp_crit, "kg m^2")]
+        emit(Report(data, _quantity_table(items), _csv_writer("gains", [(k, u, [x]) for k, _, x, u in items])),
+             a, None)
 
     q.set_defaults(func=_gains)
 
@@ -176,12 +237,20 @@ def register(sub, add_common, emit) -> None:
         res = sc.spec.run(sc)
         eb = res.stats["energy_balance"]
         cyc = res.stats.get("cycles", {})
-        rows = [["engine", res.engine], ["duration_s", float(res.t[-1])], ["events", len(res.events)]]
-        rows += [[k, v] for k, v in cyc.items()]
-        rows += [["E_in_J", eb["input"]], ["E_out_J", eb["output"]], ["stored_J", eb["stored"]],
-                 ["balance_residual_rel", eb["relative"]]] + [[f"loss_{k}_J", v] for k, v in eb["losses"].items()]
-        rep = Report({"summary": res.summary(), "stats": res.stats}, format_table(["quantity", "value"], rows),
-                     lambda out: [res.write_csv(Path(out) / "timeseries.csv")])
+        rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
+                ["events", "clutch/brake mode changes", len(res.events), ""]]
+        rows += [[k, *CYCLE_QUANTITIES.get(k, (k, ""))[:1], v, CYCLE_QUANTITIES.get(k, (k, ""))[1]]
+                 for k, v in cyc.items()]
+        rows += [["E_in", "input energy", eb["input"], "J"], ["E_out", "output energy", eb["output"], "J"],
+                 ["stored", "change of stored energy", eb["stored"], "J"],
+                 ["balance", "energy residual / turnover", eb["relative"], "1"]]
+        rows += [[f"loss_{k}", loss_label(k), v, "J"] for k, v in eb["losses"].items()]
+
+        def write(out: Path) -> list[Path]:
+            return [res.write_csv(Path(out) / "timeseries.csv"), save(run_figure(res), Path(out) / "run.png")]
+
+        rep = Report({"summary": res.summary(), "stats": res.stats}, _quantity_table(
+            [(k, m, float(v) if isinstance(v, float | np.floating) else str(v), u) for k, m, v, u in rows]), write)
         emit(rep, a, sc.to_dict())
 
     q.set_defaults(func=_run)
@@ -214,19 +283,48 @@ def register(sub, add_common, emit) -> None:
         _check_options(a, "--timestep")
         _check_steps("--timestep", cc.T_END, a.timestep)
         d = coupled_clutches_table(timestep=a.timestep)
+        mode = {v: k for k, v in cc.MODE_CODE.items()}
         rows = []
         for i, r in enumerate(d["reference"]["events"]):
             m = d["mujoco"]["events"][i]
-            rows.append([r["element"], r["from"], r["to"], r["t_ref"], r["t"], m["t"],
-                         None if r["t"] is None else r["t"] - r["t_ref"], None if m["t"] is None else m["t"] - r["t"]])
-        t1 = format_table(["clutch", "from", "to", "t_dymola", "t_hand", "t_mujoco", "hand-dymola", "mujoco-hand"],
-                          rows, ".10g")
-        rows2 = [[g] + list(np.round(wr, 6)) + list(np.round(wh, 6)) + list(np.round(wm, 6)) for g, wr, wh, wm in
-                 zip(d["grid"], d["w_ref"], d["reference"]["w"], d["mujoco"]["w"], strict=True)]
-        t2 = format_table(["t"] + [f"{s}{k}" for s in ("dym_w", "hand_w", "mj_w") for k in range(1, 5)], rows2, ".6g")
-        emit(Report(d, t1 + "\n\n" + t2), a, None)
+            rows.append([r["element"], mode.get(r["from"], r["from"]), mode.get(r["to"], r["to"]), r["t_ref"],
+                         r["t"], m["t"], None if r["t"] is None else r["t"] - r["t_ref"],
+                         None if m["t"] is None or r["t"] is None else m["t"] - r["t"]])
+        t1 = format_table(["clutch", "from", "to", "t_Dymola [s]", "t_hand [s]", "t_MuJoCo [s]", "hand-Dym [s]",
+                           "MuJoCo-hand [s]"], [r[:6] + [_e(x) for x in r[6:]] for r in rows], ".10g")
+        w_ref, w_h, w_m = (np.asarray(x) for x in (d["w_ref"], d["reference"]["w"], d["mujoco"]["w"]))
+        rows2 = [[g, *(np.round(wr, 6) + 0.0), _e(np.max(np.abs(wh - wr))), _e(np.max(np.abs(wm - wh)))]
+                 for g, wr, wh, wm in zip(d["grid"], w_ref, w_h, w_m, strict=True)]
+        t2 = format_table(["t [s]"] + [f"w{k} [rad/s]" for k in range(1, 5)]
+                          + ["dw hand-Dym [rad/s]", "dw MuJoCo-hand [rad/s]"], rows2, ".6g")
+        t2 += ("\nw1..w4: speeds of the inertias J1..J4 (Dymola reference, rounded to 1e-6); dw: largest"
+               " |difference|\nover w1..w4 (every path's values: --out DIR, coupled_clutches_w.csv).")
+        ev_cols = [("clutch", "", [r[0] for r in rows]), ("from", "", [r[1] for r in rows]),
+                   ("to", "", [r[2] for r in rows])]
+        ev_cols += [(n, "s", [_nan(r[i]) for r in rows]) for i, n in enumerate(
+            ("t_dymola", "t_hand", "t_mujoco", "hand_minus_dymola", "mujoco_minus_hand"), start=3)]
+        w_cols = [("t", "s", d["grid"])] + [(f"{src}_w{k + 1}", "rad/s", w[:, k]) for src, w in
+                                            (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
+
+        def write(out: Path) -> list[Path]:
+            ref = cc.load_reference()
+            fig = coupled_clutches_figure(d, ref["t"], ref["w"])
+            return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
+                    write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),
+                    save(fig, Path(out) / "coupled_clutches.png")]
+
+        emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2, write), a, None)
 
     q.set_defaults(func=_cc)
+
+
+def _e(x: float | None) -> str:
+    """A small difference for a table: 3 significant digits in exponent form, '-' for none."""
+    return "-" if x is None else f"{x:.2e}"
+
+
+def _nan(x: float | None) -> float:
+    return math.nan if x is None else float(x)
 
 
 def _scene(a: argparse.Namespace):

@@ -3,7 +3,7 @@
 Every controller is sampled at `fs` and returns the commanded clutch/brake states; the actuation delays are applied by
 `friction.CommandQueue` (quantised to samples, as the thesis' shift registers). Rotor order: motor 0, spring 1, load 2.
 The same controller object drives the hand-derived and the MuJoCo paths (as the thesis ran the prototype's C code in
-its simulator, L1153).
+its simulator, Sec. 4.3.5).
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def match_time(Omega: float, theta_e: float, w_e: float, w_t: float, theta_sign:
 @dataclass
 class StepUpController:
     """PWM (`switch_pwm`), resonant (`switch_fdt`) and motor-resonant (`switch_mv`) switching with optional clutch
-    matching (Eq 2.1) and the incremental PI on the storage time t_k (L2970-2978, every sample).
+    matching (Eq 2.1) and the incremental PI on the storage time t_k (App. E, every sample).
     `anti_windup=True` (default): t_k clamped to [0, max_tk] and the clamped value stored. `anti_windup=False`: the
     printed code - state stored before the clamp, upper clamp only - which winds up; the `step_up_closed_loop` scene
     selects it explicitly to reproduce the thesis' closed loop."""
@@ -77,7 +77,7 @@ class StepUpController:
     max_vel: float = 60.0
     clutch_matching: bool = False
     Omega: float = 65.6
-    delay_comp: float = 0.0  # clutch delay minus brake delay, subtracted from the loiter time (L496)
+    delay_comp: float = 0.0  # clutch delay minus brake delay, subtracted from the loiter time (Sec. 2.1.3)
     closed_loop: bool = False
     Kp: float = 0.12
     Ki: float = 4.4e-5
@@ -235,13 +235,14 @@ class EnergyPacketController:
         self.cd = delay_samples(self.clutch_delay, self.fs)
 
     def r(self, t: float) -> float:
+        """The speed reference at time t [rad/s] (a constant or a profile)."""
         return float(self.ref(t)) if callable(self.ref) else float(self.ref)
 
     def __call__(self, k: int, t: float, q: np.ndarray, w: np.ndarray) -> dict[str, int] | None:
         wm, ws, wl = w
         ths = q[1]
         out: dict[str, int] = {}
-        if self.state == 0:  # run-up: wait for the motor (App. F L3263-3266)
+        if self.state == 0:  # run-up: wait for the motor (App. F)
             if abs(wm) > 1.3 * self.min_motor_vel:
                 self.state = 1
             else:

@@ -34,6 +34,7 @@ def f_norm(k: int) -> Signal:
 
 
 def build_system() -> RotorSystem:
+    """The CoupledClutches rotor system: J1..J4 joined by clutch1..3, the sine torque on J1."""
     clutches = [
         Friction(f"clutch{k}", k - 1, k, [Part(f"clutch{k}", MU * FN_MAX, schedule=f_norm(k))], peak=PEAK)
         for k in (1, 2, 3)
@@ -85,6 +86,7 @@ def reference_events(ref: dict[str, np.ndarray]) -> list[dict]:
 
 
 def events_as_codes(events: list[dict]) -> list[dict]:
+    """Mode changes as {t, element, from, to} with the modes as codes (`MODE_CODE`)."""
     return [{"t": e["t"], "element": e["element"], "from": MODE_CODE[e["from"]], "to": MODE_CODE[e["to"]]}
             for e in events]
 

@@ -6,7 +6,7 @@
 * `cadk` (5.12 corrected): J_s for a given K (quadratic with a spurious root rejected by (5.11)).
 * `springsz` (5.14-5.21): wire diameter, D*N and volume of a helical torsion spring with a fatigue factor.
 * Discrete controller model (5.22-5.25), gain selection (5.32-5.37) and the stability line (5.36).
-Assumptions of the component-selection model (L1337-1343): frictionless, instant clutches, constant motor speed.
+Assumptions of the component-selection model (Sec. 5.1.1): frictionless, instant clutches, constant motor speed.
 For w_l < V_m the residual extension (5.8) is clamped at x_s = 0 ([DERIVED]; reproduces the tables).
 """
 
@@ -84,6 +84,8 @@ def x_f(P: float, Sr: float, w_l: float, V_m: float, K: float, J_s: float) -> fl
 
 @dataclass
 class Design:
+    """One CADJS design point: spring-system inertia J_s [kg m^2], spring rate K [N m/rad], highest
+    switching rate Sr_max [1/s], clutch torque tau_c [N m], largest twist x_max [rad] (Eqs 5.9-5.13 corrected)."""
     J_s: float
     K: float
     Sr_max: float
@@ -92,6 +94,7 @@ class Design:
 
     @property
     def capacity(self) -> float:
+        """Spring capacity 1/2 K x_max^2 [J]."""
         return 0.5 * self.K * self.x_max**2
 
 
@@ -133,7 +136,7 @@ def at_clutch_torque(P: float, Sr_min: float, w_min: float, w_max: float, V_m: f
 
 
 # ---- spring sizing ---------------------------------------------------------------------------------------------------
-SIGMA_UTS_CALIBRATED = 1.465e9  # Pa: calibrated so that the 100 W design gives the thesis' V = 1.58e-4 m^3 (L2026)
+SIGMA_UTS_CALIBRATED = 1.465e9  # Pa: calibrated so that the 100 W design gives the thesis' V = 1.58e-4 m^3 (Sec. 6.3)
 E_TABLE_6_3 = 209e9  # Pa: implied by the Table 6.3 spring via (5.14): d 3.43 mm, D 27.81 mm, N 12.3, K 1.32 N m/rad
 
 
@@ -143,7 +146,7 @@ def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = S
     V = E/(U sf^2) 1/2 K x^2 (5.19), d = (32 K^2 x^2 / (U sf^2 pi^2))^(1/6) (5.21), DN = d^4 E / (64 K) (5.14, equal
     to (5.20)). The thesis prints no material data. The defaults are not a material: E = 209 GPa is implied by the
     Table 6.3 spring ([DERIVED]) and sigma_uts = 1.465 GPa is a *calibration*, backed out of the recommended volume
-    1.58e-4 m^3 for the 100 W design (L2026) - so that volume is reproduced by construction, not predicted."""
+    1.58e-4 m^3 for the 100 W design (Sec. 6.3) - so that volume is reproduced by construction, not predicted."""
     _pos("K", K)
     _pos("x_max", x_max)
     _pos("sigma_uts", sigma_uts)

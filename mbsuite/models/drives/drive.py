@@ -3,7 +3,7 @@
 Step-up (Fig. 3.3): motor -K- spring end; brake spring end -> ground; clutch spring end -> load (Eqs 3.1-3.3).
 Step-up/step-down (Fig. 3.4): spring system -K- ground; clutch a motor -> spring; clutch b spring -> load (3.4-3.6).
 Bearings: viscous B w (implicit in each rotor) + Coulomb C as ground friction elements with stiction (event-exact);
-the load torque tau_l "always opposes motion" (L727) and is lumped with C_l as a Coulomb element whose share
+the load torque tau_l "always opposes motion" (Sec. 3.1.1) and is lumped with C_l as a Coulomb element whose share
 tau_l/(C_l+tau_l) of the dissipation is the output work (Eq 3.22).
 """
 
@@ -151,6 +151,8 @@ def run_paths(system: RotorSystem, mechanism: str, make_controller, t_end: float
 
 @dataclass
 class Balance:
+    """Energy balance of a run over a window [J]: input, output, losses by term, change of stored energy,
+    residual = input - output - sum(losses) - stored, and `relative` = residual / turnover (Eqs 3.21-3.24 corrected)."""
     input: float
     output: float
     losses: dict[str, float]
@@ -186,6 +188,7 @@ def energy_balance(system: RotorSystem, res: RefResult, i0: int = 0, i1: int = -
 
 
 def lock_times(res: RefResult, element: str, to: str = "stuck") -> np.ndarray:
+    """Times [s] at which `element` changed to mode `to` (default: locked up)."""
     return np.array([e["t"] for e in res.events if e["element"] == element and e["to"] == to])
 
 

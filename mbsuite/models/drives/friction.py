@@ -107,6 +107,8 @@ class Source:
 
 @dataclass
 class RotorSystem:
+    """Coaxial rotors (inertias J, viscous B) with friction elements, springs and torque sources: the
+    system both paths simulate (Eqs 3.1-3.6 for the drives; the Modelica examples)."""
     names: list[str]
     J: np.ndarray
     B: np.ndarray
@@ -158,12 +160,15 @@ class RotorSystem:
 
     @property
     def n(self) -> int:
+        """Number of rotors."""
         return len(self.names)
 
     def commands(self) -> list[str]:
+        """The command names (clutch/brake switches) of the system's parts."""
         return sorted({p.command for f in self.frictions for p in f.parts if p.command})
 
     def part_labels(self) -> list[str]:
+        """The labels of all friction parts, in element order (the loss terms)."""
         return [p.label for f in self.frictions for p in f.parts]
 
     def levels(self, t: float, u: dict[str, float]) -> np.ndarray:
@@ -180,6 +185,7 @@ class RotorSystem:
         return np.asarray(out, float)
 
     def w_rel(self, w: np.ndarray) -> np.ndarray:
+        """Slip speed of every friction element [rad/s] (w_b - w_a, or the element's row times w)."""
         return np.array([((w[f.b] if f.b >= 0 else 0.0) - w[f.a]) if f.g is None else float(self.rows[e] @ w)
                          for e, f in enumerate(self.frictions)])
 
@@ -198,9 +204,11 @@ class RotorSystem:
             f -= self.rows[e] * tau
 
     def dampers(self) -> list[Spring]:
+        """The springs with damping (their viscous loss is a term of the balance)."""
         return [s for s in self.springs if s.D > 0]
 
     def stored_energy(self, q: np.ndarray, w: np.ndarray) -> tuple[float, float]:
+        """Kinetic and spring energy (ke, pe) [J] at state (q, w)."""
         ke = 0.5 * float(np.sum(self.J * w**2))
         pe = 0.0
         for s in self.springs:
@@ -267,7 +275,7 @@ def time_to_samples(duration: float, fs: float, rounding: str = "nearest", what:
 
 def delay_samples(delay: float, fs: float) -> int:
     """Actuation delay in controller samples, as the thesis' shift registers: `count = (int)(delay*sample_rate)`
-    (App. C L2569-2575): truncation (`time_to_samples(delay, fs, "floor")`). The one conversion used by the command
+    (App. C): truncation (`time_to_samples(delay, fs, "floor")`). The one conversion used by the command
     queue, the controllers and `drive.build_controller`."""
     return time_to_samples(delay, fs, "floor", "actuation delay")
 
@@ -283,6 +291,7 @@ class CommandQueue:
         self.pending: list[tuple[float, str, int]] = []
 
     def issue(self, k: int, cmds: dict[str, int] | None) -> None:
+        """Queue the controller's commands of sample k; each takes effect after its quantised delay."""
         if not cmds:
             return
         for c, v in cmds.items():
@@ -296,6 +305,8 @@ class CommandQueue:
 
 @dataclass
 class RefResult:
+    """A run of either path: time t [s], angles q [rad] and speeds w [rad/s] per rotor, command states u,
+    mode-change events, cumulative energy terms [J] and solver statistics."""
     t: np.ndarray
     q: np.ndarray
     w: np.ndarray
@@ -342,6 +353,7 @@ class _Config:
             self.L = np.zeros((0, n))
 
     def lam(self, f: np.ndarray) -> np.ndarray:
+        """Constraint torques of the stuck elements for the generalised forces f."""
         return self.L @ f
 
 
@@ -809,7 +821,7 @@ def simulate_velocity_band(
     atol: float = 1e-6,
     max_step: float = 0.0019,
 ) -> RefResult:
-    """The thesis' numerical treatment (L805-813, App. C/D): no events; inside |w_rel| < velocity_tol an element is
+    """The thesis' numerical treatment (Sec. 3.2, App. C/D): no events; inside |w_rel| < velocity_tol an element is
     held (zero relative acceleration) while the torque it must carry is within its capacity; RK23 with the App. J
     settings (tol 1e-3, max step 1.9 ms). The velocity stays wherever it was inside the band, so positions creep.
     Held torques use the same capacity-weighted constraint solution as the event-exact path (the App. D two-body test

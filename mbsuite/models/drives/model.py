@@ -93,6 +93,8 @@ def simulate_scene(scene: Scene) -> tuple[RefResult, Any, Any]:
 
 
 def run(scene: Scene) -> SimResult:
+    """The `run` hook: simulate the scene on its engine and return a `SimResult` (speeds, angles, twist,
+    energies, commands; energy balance, cycle statistics and mode changes in `stats`)."""
     res, ctrl, system = simulate_scene(scene)
     mech = scene.effects["mechanism"]
     sig: dict[str, np.ndarray] = {}

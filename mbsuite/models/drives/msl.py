@@ -212,6 +212,7 @@ SIGNAL_UNITS: dict[str, str] = {k: u for f in EXAMPLES.values() for k, u in f().
 
 
 def example(name: str) -> Example:
+    """The Modelica example `name` (one of `EXAMPLES`)."""
     if name not in EXAMPLES:
         raise ParameterError(f"unknown MSL example {name!r}; valid: {sorted(EXAMPLES)}")
     return EXAMPLES[name]()
@@ -219,10 +220,12 @@ def example(name: str) -> Example:
 
 # ---- results, references, comparisons ---------------------------------------------------------------------------
 def signals_of(ex: Example, res: RefResult) -> dict[str, np.ndarray]:
+    """The example's output signals from a run."""
     return {k: np.asarray(f(res.q, res.w), float) for k, f in ex.signals.items()}
 
 
 def reference_path(ex: Example) -> Path:
+    """Path of the example's reference result (Modelica Association, MSL 4.1.0) in `tests/data/msl/`."""
     if ex.reference is None:
         raise ModelFileError(f"{ex.name}: the Modelica Association publishes no reference result for this example")
     p = models_root() / "tests" / "data" / "msl" / ex.reference
@@ -262,6 +265,7 @@ def reference_events(ex: Example, ref: dict[str, np.ndarray]) -> list[dict[str, 
 
 
 def events_as_codes(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Mode changes as {t, element, from, to} with the modes as codes."""
     return [{"t": float(e["t"]), "element": e["element"], "from": MODE_CODE[e["from"]], "to": MODE_CODE[e["to"]]}
             for e in events]
 

@@ -241,6 +241,7 @@ class RotorRun:
             self.u_arr[self.commands.index(c)] = v
 
     def event(self, t: float, t_step: float, e: int, old: int, new: int) -> dict[str, Any]:
+        """An event record: interpolated time t, the step boundary t_step where it was applied, modes."""
         return {"t": float(t), "element": self.sys.frictions[e].name, "from": MODE_NAME[int(old)],
                 "to": MODE_NAME[int(new)], "t_step": float(t_step)}
 

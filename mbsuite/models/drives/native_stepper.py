@@ -171,6 +171,7 @@ class NativeRotorRun:
             self.run_.sample(k)
 
     def run(self):
+        """Run on mbsuite's native core with the C state machine; returns the `RefResult`."""
         run = self.run_
         stepper = core.Stepper(run.m, run.d, [core.Channel("rec", "hook", 0, run.nrec)], every=run.every,
                                check_every=1, hook=self.hook, what="drives MuJoCo path", hint=HINT)

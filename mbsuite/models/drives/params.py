@@ -15,19 +15,20 @@ from ...errors import ParameterError
 from ...limits import param
 
 # ---- parameter sets -------------------------------------------------------------------------------------------------
-# Step-up prototype, Table 4.2 (L1155-1176). J_l printed 6.76e-5 is a typo: load disk A is 6.76e-4 (L1090); the clutch
-# parts J_c = 1.81e-5 (L1102) ride on the load. B units are N m s/rad (printed "kg m^2"), delays 0.006 s ("0.006 ms").
+# Step-up prototype, Table 4.2. J_l printed 6.76e-5 is a typo: load disk A is 6.76e-4; the clutch parts
+# J_c = 1.81e-5 ride on the load (both Sec. 4.3.2). B units are N m s/rad (printed "kg m^2"), delays 0.006 s
+# (printed "0.006 ms").
 TABLE_4_2: dict[str, float] = dict(
-    K_t=0.1101, K_e=0.1043, R=1.1, V_s=12.0,  # L1156-1160, 12 V supply (L915)
-    J_m=1.4e-4, C_m=0.0246, B_m=7.95e-5,  # L1158, L1161-1162
-    K=0.26, J_s=6.04e-5, C_s=0.0075, B_s=3.33e-5,  # L1163-1166
-    J_l=6.76e-4 + 1.81e-5, C_l=0.0075, B_l=3.33e-5,  # L1167-1170 (J_l typo fixed, + J_c)
-    tau_b=1.1, tau_c=1.1, d_on=0.006, d_off=0.006,  # L1171-1174, L1134-1140
-    fs=500.0, tau_l=0.0, J_add=0.0,  # L905
-    t_l=0.2, duty=0.5, t_n=0.048, twist_tol=0.15, Kp=0.12, Ki=4.4e-5, ref=287.0,  # L915, L931; t_n = pi/Omega (derived)
+    K_t=0.1101, K_e=0.1043, R=1.1, V_s=12.0,  # Table 4.2, 12 V supply (Sec. 4.2.1)
+    J_m=1.4e-4, C_m=0.0246, B_m=7.95e-5,  # Table 4.2
+    K=0.26, J_s=6.04e-5, C_s=0.0075, B_s=3.33e-5,  # Table 4.2
+    J_l=6.76e-4 + 1.81e-5, C_l=0.0075, B_l=3.33e-5,  # Table 4.2 (J_l typo fixed, + J_c)
+    tau_b=1.1, tau_c=1.1, d_on=0.006, d_off=0.006,  # Table 4.2, Sec. 4.3.4
+    fs=500.0, tau_l=0.0, J_add=0.0,  # Sec. 4.1
+    t_l=0.2, duty=0.5, t_n=0.048, twist_tol=0.15, Kp=0.12, Ki=4.4e-5, ref=287.0,  # Sec. 4.2.1; t_n = pi/Omega (derived)
     min_vel=40.0, max_vel=60.0,
 )
-# 100 W step-up/step-down, design-stage simulation (L1983-1987, Table 6.2 Sr=10 row L1972-1981): same motor at 21 V,
+# 100 W step-up/step-down, design-stage simulation (Sec. 6.2; Table 6.2, row Sr = 10): same motor at 21 V,
 # added motor inertia 1.6e-3, bearing friction = step-up values x2, 5 N m clutches, 4 ms delays, J_l = 0.0023.
 DESIGN_100W: dict[str, float] = dict(
     K_t=0.1101, K_e=0.1043, R=1.1, V_s=21.0,
@@ -35,22 +36,22 @@ DESIGN_100W: dict[str, float] = dict(
     K=0.98, J_s=7.3e-5, C_s=0.015, B_s=6.66e-5,
     J_l=0.0023, C_l=0.015, B_l=6.66e-5, tau_l=0.15,
     tau_c1=5.0, tau_c2=5.0, d_on=0.004, d_off=0.004, fs=1000.0,
-    Kp=0.00112, Ki=0.0161, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0,  # L2014; fs not stated (1 kHz assumed)
+    Kp=0.00112, Ki=0.0161, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0,  # Eq 6.1; fs not stated (1 kHz assumed)
 )
-# 100 W prototype as fitted to the 100 W open-loop test (L2200: B_s = 107e-5, K = 1.2; J_s = 7.76e-5 from
-# K/J = 18038, L2040-2042; output bearing Cl = 0.0025, Bl = 8.9e-5 (App. J "from MSD data", L3762-3764); spring
-# bearings = spring+output pair minus output (L2119); input bearing = spring+input minus spring (L2121-2123)).
+# 100 W prototype as fitted to the 100 W open-loop test (Sec. 6.4.3: B_s = 107e-5, K = 1.2; J_s = 7.76e-5 from
+# K/J = 18038, Sec. 6.3; output bearing Cl = 0.0025, Bl = 8.9e-5 (App. J "from MSD data"); spring
+# bearings = spring+output pair minus output (Sec. 6.4.1); input bearing = spring+input minus spring (Sec. 6.4.1)).
 PROTO_100W: dict[str, float] = dict(
     DESIGN_100W,
     K=1.2, J_s=7.76e-5, B_s=107e-5, C_s=0.0078 - 0.0025, C_l=0.0025, B_l=8.9e-5,
     C_m=0.0246 + (0.009 - 0.0053), B_m=7.95e-5 + (14.05e-5 - 7.2e-5), tau_l=0.0,
-    K_ctrl=1.32, Omega_ctrl=132.0,  # controller values on the prototype (L2072-2074)
+    K_ctrl=1.32, Omega_ctrl=132.0,  # controller values on the prototype (Sec. 6.3)
 )
-# 50 W open-loop fit (L2184-2198): spring viscous B_s = 67.6e-5 from the first free-vibration cycle, measured K = 1.40.
+# 50 W open-loop fit (Sec. 6.4.3): spring viscous B_s = 67.6e-5 from the first free-vibration cycle, measured K = 1.40.
 PROTO_50W: dict[str, float] = dict(PROTO_100W, B_s=67.6e-5, K=1.40)
-# 500 W example design, App. J parameter file (L3735-3809) and Sec. 5.4 (L1848-1895).
+# 500 W example design, App. J parameter file and Sec. 5.4.
 EXAMPLE_500W: dict[str, float] = dict(
-    tau_0=10.0, tau_slope=-0.05, J_m=0.005, J_add=0.0, C_m=0.0025, B_m=8.9e-5,  # T_m = 10 - 0.05 w (L3744-3748)
+    tau_0=10.0, tau_slope=-0.05, J_m=0.005, J_add=0.0, C_m=0.0025, B_m=8.9e-5,  # T_m = 10 - 0.05 w (App. J)
     K=7.07, J_s=1e-4, C_s=0.005, B_s=1.78e-4,
     J_l=0.005, C_l=0.0025, B_l=8.9e-5, tau_l=0.8,
     tau_c1=20.0, tau_c2=20.0, d_on=0.004, d_off=0.004, fs=1000.0,
@@ -92,7 +93,7 @@ class DriveParams:
     tau_slope: float | None = _p(-1e3, 0.0, "N m s/rad", "torque-speed slope of the straight-line motor (<= 0: a "
                                  "torque rising with speed runs away)")
     J_m: float | None = _p(0.0, 1e3, "kg m^2", "motor inertia", lo_open=True)
-    J_add: float | None = _p(0.0, 1e3, "kg m^2", "added motor inertia (L959: 1.42e-3; L1987: 1.6e-3)")
+    J_add: float | None = _p(0.0, 1e3, "kg m^2", "added motor inertia (Sec. 4.2.4: 1.42e-3; Sec. 6.2: 1.6e-3)")
     C_m: float | None = _p(0.0, 1e3, "N m", "motor bearing Coulomb torque")
     B_m: float | None = _p(0.0, 1e3, "N m s/rad", "motor bearing viscous coefficient")
     # spring system and load

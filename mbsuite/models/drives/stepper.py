@@ -94,9 +94,11 @@ class RotorStepper:
 
     # ---- the state ------------------------------------------------------------------------------------------------
     def w(self, i: int) -> float:
+        """Speed of rotor i [rad/s]."""
         return float(self.d.qvel[self.dof[i]])
 
     def q(self, i: int) -> float:
+        """Angle of rotor i [rad]."""
         return float(self.d.qpos[self.qadr[i]])
 
     def levels(self, t: float) -> tuple[list[float], list[float]]:
@@ -120,10 +122,12 @@ class RotorStepper:
         return lv, el
 
     def shape(self, s: int, t: float) -> float:
+        """Value of source shape s at time t (1 without a shape)."""
         sig = self.run.shapes[s]
         return 1.0 if sig is None else sig(t)
 
     def slips(self) -> None:
+        """Update the slip speed of every friction element from the current state."""
         for e, f in enumerate(self.fr):
             if self.general:
                 v = 0.0

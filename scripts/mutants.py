@@ -55,6 +55,38 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    s_moment = 2 * p.R * math.cos(math.pi / 4 - p.gamma) * l0 / l",
              "    s_moment = 2 * math.cos(math.pi / 4 - p.gamma) * l0 / l",
              "the closed-form condition number missing a factor R", "tests/coupler"),
+    # --- IFToMM ------------------------------------------------------------------------------------------------------
+    Mutation("iftomm_mujoco_gravity_sign", "mbsuite/models/iftomm/mechanisms.py",
+             "    m.opt.gravity[:] = [0.0, -gravity, 0.0]", "    m.opt.gravity[:] = [0.0, gravity, 0.0]",
+             "gravity pointing up in the MuJoCo model of the benchmarks (a sign in the equations of motion)",
+             "tests/iftomm"),
+    # --- drives ------------------------------------------------------------------------------------------------------
+    Mutation("drives_breakaway_scaled_1pct", "mbsuite/models/drives/friction.py",
+             "        return float(self.peaks[e] * el[e])", "        return float(1.01 * self.peaks[e] * el[e])",
+             "a clutch's stuck-torque bound (breakaway) scaled by 1.01 on the hand path", "tests/drives"),
+    Mutation("drives_lock_impact_dropped", "mbsuite/models/drives/drive.py",
+             "    resid = e_in - e_out - sum(d.values()) - stored",
+             "    resid = e_in - e_out - sum(v for k, v in d.items() if k != 'lock_impact') - stored",
+             "a loss term (the kinetic energy removed by plastic locks) dropped from the energy balance",
+             "tests/drives"),
+    Mutation("drives_event_one_step_late", "mbsuite/models/drives/native/drives.c",
+             "  row[0] = te;", "  row[0] = te + S->dt;",
+             "every mode change of the MuJoCo path located one step late", "tests/drives"),
+    # --- engine core, signals, scenes, store -------------------------------------------------------------------------
+    Mutation("signals_c_sine_phase", "mbsuite/engines/native/core.c",
+             "s[2] * sin(2.0 * M_PI * s[3] * (t - s[5]) + s[4])",
+             "s[2] * sin(2.0 * M_PI * s[3] * (t - s[5]) + 1.001 * s[4])",
+             "the C evaluation of a sine input with its phase off by 0.1 %", "tests/engines"),
+    Mutation("limits_upper_end_ignored", "mbsuite/limits.py",
+             "        if self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi)):",
+             "        if False:",
+             "every declared upper limit ignored (too large values accepted silently)",
+             "tests/suite/test_reliability.py"),
+    Mutation("store_checksum_not_verified", "mbsuite/analysis/sweep.py",
+             "        if _digest(body) != rec[\"sha256\"]:\n            self._report(n, offset, \"checksum mismatch",
+             "        if False:\n            self._report(n, offset, \"checksum mismatch",
+             "the sweep store trusts records whose checksum fails (a forged result comes back)",
+             "tests/suite/test_store.py"),
 )
 
 

@@ -98,21 +98,26 @@ class SimResult:
 
     def report(self) -> Report:
         """A CLI report: per-signal min/max/final, events, solver stats; `--out` writes run.csv."""
+        import textwrap
+
         rows = [[k, self.units.get(k, ""), float(np.min(v)), float(np.max(v)), float(v[-1])]
                 for k, v in self.signals.items()]
         table = format_table(["signal", "unit", "min", "max", "final"], rows, ".6g")
         if self.scene.get("input"):
-            table = "input (resolved, defaults included): " + ", ".join(
-                f"{k} = {_plain(v)}" for k, v in self.scene["input"].items()) + "\n" + table
+            resolved = ", ".join(f"{k} = {_plain(v)}" for k, v in self.scene["input"].items())
+            table = textwrap.fill(f"input (resolved, defaults included): {resolved}", 100,
+                                  subsequent_indent="  ") + "\n" + table
         if self.events:
             kinds: dict[str, int] = {}
             for e in self.events:
                 kinds[e.get("kind", "event")] = kinds.get(e.get("kind", "event"), 0) + 1
             table += "\nevents: " + ", ".join(f"{k} x{n}" for k, n in sorted(kinds.items()))
-        table += f"\nengine {self.engine}; " + ", ".join(f"{k} = {_plain(v)}" for k, v in self.stats.items())
+        stats = ", ".join(f"{k} = {_plain(v)}" for k, v in self.stats.items())
+        table += "\n" + textwrap.fill(f"engine {self.engine}; {stats}", 100, subsequent_indent="  ")
         if self.health:
-            table += "\nhealth: " + ", ".join(
-                f"{f.name} {f.value:.3g} (bound {f.bound:.3g}{'' if f.ok else ', EXCEEDED'})" for f in self.health)
+            table += "\n" + textwrap.fill("health: " + ", ".join(
+                f"{f.name} {f.value:.3g} (bound {f.bound:.3g}{'' if f.ok else ', EXCEEDED'})" for f in self.health),
+                100, subsequent_indent="  ")
         for w in self.warnings:
             table += f"\n{w}"
         def write(out: Path) -> list[Path]:
@@ -141,9 +146,14 @@ def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, en
 
 
 def _plain(v: Any) -> str:
-    """A stats value for a table: numpy scalars as plain numbers, floats to 6 significant digits."""
+    """A stats value for a table: numpy scalars as plain numbers, floats to 6 significant digits, an empty container
+    as "none", a mapping as `k: v` pairs."""
     if isinstance(v, np.generic):
         v = v.item()
+    if isinstance(v, Mapping | list | tuple) and not v:
+        return "none"
+    if isinstance(v, Mapping):
+        return "{" + ", ".join(f"{k}: {_plain(x)}" for k, x in v.items()) + "}"
     if isinstance(v, float):
         return f"{v:.6g}"
     return str(v)

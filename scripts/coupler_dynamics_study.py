@@ -12,17 +12,15 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-import mbsuite  # noqa: E402
-from mbsuite.engines.core import map_threads  # noqa: E402
-from mbsuite.models.coupler import SPEC  # noqa: E402
-from mbsuite.results import format_table  # noqa: E402
-from mbsuite.scenes import load_scene  # noqa: E402
+import mbsuite
+from mbsuite.engines.core import map_threads
+from mbsuite.models.coupler import SPEC
+from mbsuite.models.coupler.plots import dynamics_figure
+from mbsuite.plotting import save
+from mbsuite.results import format_table
+from mbsuite.scenes import load_scene
 
 KEYS = ("phi_c_err_max", "phi_c_kin_fluctuation_pp", "closure_residual_max", "torque_in_mean", "torque_in_ripple_pp",
         "link_force_max_abs")
@@ -59,25 +57,8 @@ def main() -> None:
     print(format_table(["factor", "ripple_pp", "mean|F|", "spread|F|", "closure_res"], rows, ".4g"))
 
     r = mbsuite.run(load_scene("coupler/double_lateral"))
-    fig, axs = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
-    axs[0].plot(r.t, r["phi_c_err"])
-    axs[0].set_ylabel("phi_c - phi_c,kin [rad]")
-    axs[1].plot(r.t, r["closure_residual"])
-    axs[1].set_ylabel("closure residual [m]")
-    axs[1].set_yscale("log")
-    axs[2].plot(r.t, r["torque_in"])
-    axs[2].set_ylabel("input torque [N m]")
-    for k in range(8):
-        axs[3].plot(r.t, r[f"link_force_{k + 1}"], lw=0.8, label=f"link {k + 1}")
-    axs[3].set_ylabel("link tension [N]")
-    axs[3].set_xlabel("t [s]")
-    axs[3].legend(ncol=4, fontsize=7)
-    for ax in axs:
-        ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out / "double_lateral_timeseries.png", dpi=110)
-    print(f"\nwrote {out / 'double_lateral_timeseries.png'}")
-
+    path = save(dynamics_figure(r), out / "double_lateral_timeseries.png")
+    print(f"\nwrote {path}")
 
 if __name__ == "__main__":
     main()

@@ -108,7 +108,7 @@ def test_regression_criteria_table_double_c5(capsys):
     against a 4096-sample brute force in test_c5_extremum_converged_against_brute_force)."""
     rep = analysis.criteria_report(gammas=(0.297,), eys=(0.1,), alphas=(0.07,), zcs=(0.1,), lbs=(2.0,),
                                    phibcs=(math.pi / 2,), n=121)
-    assert "gamma = 0.29671 rad (17 deg), e_y = 0.1, R = 1" in rep.table
+    assert "gamma = 0.29671 rad (17 deg), e_y = 0.1 m, R = 1 m" in rep.table
     assert rep.data["double"][0]["gamma"] == pytest.approx(math.radians(17))
     assert rep.data["double"][0]["c5"] == pytest.approx(1.37364e-3, rel=5e-6)
 
@@ -133,7 +133,7 @@ def test_omitted_inputs_are_resolved_and_shown(tmp_path, capsys):
     assert d["input"]["z_c"] == 0.0 and d["scene"]["input"]["load_torque"] == 1000.0
     assert json.loads((out / "summary.json").read_text())["scene"]["input"]["z_c"] == 0.0
     assert main(["coupler", "dynamics", str(scene)]) == 0
-    assert re.search(r"input \(resolved, defaults included\): .*z_c = 0\b", capsys.readouterr().out)
+    assert re.search(r"input \(resolved, defaults included\): .*z_c = 0\b", capsys.readouterr().out, re.S)
 
 
 def test_fpp_size_guard(capsys):

@@ -29,11 +29,11 @@ def test_eq1_link_length_is_the_chord_of_the_assembled_points():
 
 
 def test_eq15_reproduced_with_documented_layout():
-    """Eq (15) (l.245) digit for digit: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y). Every entry
+    """Eq (15) digit for digit: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y). Every entry
     rounded to the paper's 4 decimals is the printed one (the largest gap, 4.76e-5, is 0.88295 printed as 0.8829)."""
     J = ref.single_jacobian(CouplerParams(e_y=0.0))
     assert np.array_equal(np.round(ref.paper_eq15_layout(J), 4), ref.EQ15)
-    # with gamma = 0.297 exactly the moment entry is 0.8831, not 0.8829 (reference B1): the paper used 17 deg
+    # with gamma = 0.297 exactly the moment entry is 0.8831, not 0.8829 (README erratum 7): the paper used 17 deg
     J297 = ref.single_jacobian(CouplerParams(gamma=0.297, e_y=0.0))
     assert np.max(np.abs(ref.paper_eq15_layout(J297) - ref.EQ15)) > 1e-4
 
@@ -103,17 +103,17 @@ def test_single_fpp_full_revolution_continuation_largest_misalignment():
 def test_c1_quadratic_in_alpha_period_pi_independent_of_ey():
     p = CouplerParams(e_y=0.1)
     c = [analysis.single_criteria(p, a, 121) for a in (0.02, 0.04)]
-    # parabolic in alpha (l.292): ratio 4 (1 + O(alpha^2)), measured 4.0008; bound 5x the deviation
+    # parabolic in alpha (Sect. 3.4): ratio 4 (1 + O(alpha^2)), measured 4.0008; bound 5x the deviation
     assert c[1]["c1"] / c[0]["c1"] == pytest.approx(4.0, rel=1e-3)
     d = c[1]["rev"].phi_a[:-1] - c[1]["rev"].u[:-1, 0]
     spec = np.abs(np.fft.rfft(d - d.mean()))
-    assert int(np.argmax(spec)) == 2  # two oscillations per revolution (not one, as l.275 says)
+    assert int(np.argmax(spec)) == 2  # two oscillations per revolution (not one, as Sect. 3.4 says of Fig 6)
     c3 = analysis.single_criteria(CouplerParams(e_y=0.3), 0.04, 121)
-    assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-9)  # "virtually not influenced by e_y" (l.292): measured 0
-    # c2 "proportional to" alpha (l.280, l.294): measured ratio 1.9655 for doubling alpha (1.7 % below 2); bound 3x
+    assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-9)  # "virtually not influenced by e_y" (Sect. 3.4): measured 0
+    # c2 "proportional to" alpha (Sect. 3.4): measured ratio 1.9655 for doubling alpha (1.7 % below 2); bound 3x
     assert c[1]["c2"] / c[0]["c2"] == pytest.approx(2.0, rel=0.05)
-    # "c4 achieves 10 times greater values than c3" (l.296, read off Fig 9): measured 9.12 and 9.21. The paper's beta
-    # angles are defined in its Fig 3c, which is not in the text (ours: README), so a 15 % reading tolerance.
+    # "c4 achieves 10 times greater values than c3" (Sect. 3.4, read off Fig 9): measured 9.12 and 9.21. The
+    # paper's beta angles are defined in its Fig 3c, not in the text (ours: README): a 15 % reading tolerance.
     for ci in c:
         assert ci["c4"] / ci["c3"] == pytest.approx(10.0, rel=0.15)
 
@@ -126,7 +126,8 @@ def test_c1_improves_with_slimmer_platform():
 def test_double_homokinetic_at_phibc_0_not_at_pi_2():
     c0 = analysis.double_c5(CouplerParams(), 0.08, n=37)
     c90 = analysis.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=37)
-    # phi_bc = 0: full homokineticity (l.327) although the intermediate shaft fluctuates (measured 1.7e-16 vs 5.0e-4)
+    # phi_bc = 0: full homokineticity (Sect. 4.3) although the intermediate shaft fluctuates (measured 1.7e-16
+    # vs 5.0e-4)
     assert c0["c5"] < 1e-12 < 1e-4 < c0["c1_intermediate"]
     # phi_bc = pi/2: the two couplers' fluctuations add, c5 = 2 c1 of shaft b (measured ratio 1.0154; bound 3x)
     assert c90["c5"] == pytest.approx(2 * c90["c1_intermediate"], rel=0.05)

@@ -95,3 +95,65 @@ def test_malformed_files_raise(tmp_path):
         mf.closures_from_urdf(bad)
     with pytest.raises(ModelFileError, match="kind"):
         mf.urdf_text(CouplerParams(), "triple")
+
+
+def _physics_only(path) -> mujoco.MjModel:
+    """The model file with every visual-only element removed (geoms, lights, cameras, materials, textures)."""
+    spec = mujoco.MjSpec.from_file(str(path))
+    for lst in (spec.geoms, spec.lights, spec.cameras, spec.materials, spec.textures):
+        for el in list(lst):
+            spec.delete(el)
+    return spec.compile()
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_visual_elements_change_no_physics(kind):
+    """Floor, light, camera, platform discs, shafts and link rods are visual only: the shipped model and the same
+    model stripped of them have identical masses, inertias, mass matrix and a bitwise-identical 200-step trajectory
+    (from a perturbed assembled pose with an input speed)."""
+    path = mjcf_path(f"coupler_{kind}")
+    full = mujoco.MjModel.from_xml_path(str(path))
+    bare = _physics_only(path)
+    assert full.ngeom > 0 and bare.ngeom == 0 and full.ncam == 1 and full.nlight == 1
+    assert np.all(full.geom_contype == 0) and np.all(full.geom_conaffinity == 0)
+    for f in ("body_mass", "body_inertia", "body_ipos", "dof_damping"):
+        np.testing.assert_array_equal(getattr(full, f), getattr(bare, f), err_msg=f)
+    ds = []
+    for m in (full, bare):
+        d = mujoco.MjData(m)
+        d.qvel[0] = 3.0  # shaft a spinning
+        mujoco.mj_forward(m, d)
+        ds.append(d)
+    mass = [np.zeros((m.nv, m.nv)) for m in (full, bare)]
+    for m, d, M in zip((full, bare), ds, mass, strict=True):
+        mujoco.mj_fullM(m, d, M)
+    np.testing.assert_array_equal(mass[0], mass[1])
+    for _ in range(200):
+        for m, d in zip((full, bare), ds, strict=True):
+            mujoco.mj_step(m, d)
+    np.testing.assert_array_equal(ds[0].qpos, ds[1].qpos)
+    np.testing.assert_array_equal(ds[0].qvel, ds[1].qvel)
+    assert np.max(np.abs(ds[0].qpos)) > 1e-3  # it moved
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_platform_discs_follow_the_design(kind):
+    """Each platform carries a disc of radius DISC_RADIUS x R whose face lies in the platform's joint plane (all four
+    joint sites of that platform at distance R from the disc axis, on its face), also for an MjSpec variant."""
+    for p in (CouplerParams(), VARIANT):
+        m = mf.mjspec_variant(p, kind).compile()
+        d = mujoco.MjData(m)
+        mujoco.mj_kinematics(m, d)
+        names = {"A": "platform_a_disc"} | ({"B": "platform_b_disc"} if kind == "single" else
+                                             {"BA": "platform_ba_disc", "BC": "platform_bc_disc",
+                                              "C": "platform_c_disc"})
+        for prefix, gname in names.items():
+            g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, gname)
+            assert m.geom_size[g, 0] == pytest.approx(mf.DISC_RADIUS * p.R, rel=1e-12)
+            axis = d.geom_xmat[g].reshape(3, 3)[:, 2]
+            for k in range(4):
+                s = d.site_xpos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, f"{prefix}_S{k + 1}")]
+                rel = s - d.geom_xpos[g]
+                along = float(rel @ axis)
+                assert abs(abs(along) - m.geom_size[g, 1]) < 1e-12  # on a face: half thickness from the centre
+                assert np.linalg.norm(rel - along * axis) == pytest.approx(p.R, rel=1e-12)

@@ -27,12 +27,12 @@ def test_full_criteria_grid_trends():
     for a in analysis.ALPHAS[1:]:
         for ey in analysis.EYS:
             c1 = [get(g, ey, a, "c1") for g in (0.11, 0.297, 0.391)]
-            assert c1[0] < c1[1] < c1[2]  # slimmer platforms are more homokinetic (seed l.292)
+            assert c1[0] < c1[1] < c1[2]  # slimmer platforms are more homokinetic (Sect. 3.4)
             c2 = [get(g, ey, a, "c2") for g in (0.11, 0.297, 0.391)]
             assert c2[0] < c2[1] < c2[2]
         for g in (0.11, 0.297, 0.391):
             c1e = [get(g, ey, a, "c1") for ey in analysis.EYS]
-            assert max(c1e) / min(c1e) < 1 + 1e-9  # c1 does not depend on e_y (l.292; measured equal to 1e-15)
+            assert max(c1e) / min(c1e) < 1 + 1e-9  # c1 does not depend on e_y (Sect. 3.4; measured equal to 1e-15)
             c2e = [get(g, ey, a, "c2") for ey in analysis.EYS]
             assert c2e[0] < c2e[1] < c2e[2]
             assert get(g, 0.1, a, "c4") > 5 * get(g, 0.1, a, "c3")
@@ -43,7 +43,7 @@ def test_full_criteria_grid_trends():
     for z in (0.04, 0.08):
         c5 = [next(r["c5"] for r in d if r["l_b"] == lb and r["phi_bc"] > 1 and r["z_c"] == z)
               for lb in (1.0, 2.0, 4.0)]
-        assert c5[0] > c5[1] > c5[2]  # the longer the middle shaft the better (seed l.327)
+        assert c5[0] > c5[1] > c5[2]  # the longer the middle shaft the better (Sect. 4.3)
 
 
 def test_dense_revolution_pinocchio_widest_platform_largest_inclination():

@@ -1,4 +1,4 @@
-"""Single and double 4-link (SS-link) couplers of low-floor tram drives (seed 001, Maniowski & Czauderna).
+"""Single and double 4-link (SS-link) couplers of low-floor tram drives (Maniowski & Czauderna).
 
 Kinematics hand-derived (reference.py) and in Pinocchio (pinocchio.py), cross-checked; double-coupler dynamics in
 MuJoCo (mujoco.py). See README.md in this package.

@@ -1,5 +1,5 @@
-"""Analyses of the coupler: Jacobian/mobility/screws (seed Sect. 2.3, 3.2, Table 2) and quality criteria c1-c5
-(seed Eqs 16-20, Figs 6-10), as `mbsuite.results.Report`s.
+"""Analyses of the coupler: Jacobian/mobility/screws (Maniowski & Czauderna, Sect. 2.3, 3.2, Table 2) and quality
+criteria c1-c5 (Eqs 16-20, Figs 6-10), as `mbsuite.results.Report`s.
 
 Criteria definitions (README has the discussion):
 - c1 = max |(phi_a - phi_b) - mean| over a revolution (Eq 16 without the pi/2 mounting offset); c1_pp = peak-to-peak.
@@ -26,7 +26,7 @@ from ...results import Report, format_table, write_csv
 from . import reference as ref
 from .params import GAMMAS_PAPER, CouplerParams
 
-TABLE2 = {  # seed l.233-241: e_y -> (S1 point y, S2 point y, |pitch|, chi)
+TABLE2 = {  # the paper's Table 2: e_y -> (S1 point y, S2 point y, |pitch|, chi)
     0.0: (0.0, 0.0, 0.0, 3e5),
     0.05: (0.0720, -0.0220, 0.0011, 87.0),
     0.1: (0.1439, -0.0439, 0.0045, 85.0),
@@ -49,6 +49,17 @@ def _closed_form_or_none(p: CouplerParams) -> float | None:
 
 
 # --------------------------------------------------------------------------------------------------- Jacobian report
+#: columns of the mechanism Jacobian (twist of platform B: velocity of O_b, angular velocity) and their units: a
+#: length rate [m/s] per velocity [m/s] is dimensionless, per angular velocity [rad/s] a length [m]
+J_COLUMNS = ("v_x", "v_y", "v_z", "w_x", "w_y", "w_z")
+J_UNITS = ("-", "-", "-", "m", "m", "m")
+
+
+def _z(x: float) -> float:
+    """A table entry with signed zeros and rounding-level values (|x| < 5e-15) shown as 0."""
+    return 0.0 if abs(x) < 5e-15 else float(x)
+
+
 def zero_pitch_pair(principal: list[ref.Screw]) -> list[ref.Screw] | None:
     """For a 2-system of finite-pitch screws with principal pitches of opposite sign, the two zero-pitch members of the
     cylindroid (the basis in which Table 2 lists its axes). None otherwise."""
@@ -98,7 +109,7 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
         "params": p.geometry(), "pose": {"phi_a": phi_a, "alpha_bx": alpha_bx, "alpha_bz": alpha_bz,
                                          "phi_b": pose.u[0], "x_b": pose.u[1], "y_b": pose.u[2], "z_b": pose.u[3]},
         "engine": engine,
-        "J": J, "J_columns": ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"],
+        "J": J, "J_columns": list(J_COLUMNS), "J_units": list(J_UNITS),
         "J_paper_layout": ref.paper_eq15_layout(J),
         "singular_values": an.singular_values, "rank": an.rank, "rank_rtol": ref.RANK_RTOL,
         "cond": an.cond, "cond_closed_form": _closed_form_or_none(p),
@@ -113,19 +124,42 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
         if p.e_y in TABLE2 and p.e_y > 0:
             h = TABLE2[p.e_y][2]
             data["paper_basis_angle"] = 0.5 * math.asin(min(1.0, h / (d / 2)))
-    rows = []
-    for label, lst in (("principal", an.principal_screws), ("zero-pitch", zp or []), ("SVD basis", an.svd_screws)):
-        for i, s in enumerate(lst):
-            rows.append([label, f"S{i + 1}", np.array2string(s.axis, precision=4, suppress_small=True),
-                         np.array2string(s.point, precision=4, suppress_small=True), s.pitch])
-    table = (f"single coupler Jacobian (rows = links 1-4, columns v_x v_y v_z w_x w_y w_z; v at o^b):\n"
-             f"{np.array2string(J, precision=4, suppress_small=True)}\n"
-             f"singular values {np.array2string(an.singular_values, precision=6)}, rank {an.rank} "
-             f"(rtol {ref.RANK_RTOL:g}), cond {an.cond:.6g} (closed form R^2 cos(2 gamma)/e_y = "
-             f"{'n/a (R too small)' if data['cond_closed_form'] is None else format(data['cond_closed_form'], '.6g')})"
-             "\nfree motions (null space of J) as screws:\n"
-             + format_table(["basis", "screw", "axis", "point", "pitch"], rows, ".4g"))
-    return Report(data, table)
+    screws = [(label, f"S{i + 1}", sc) for label, lst in (("principal", an.principal_screws),
+                                                          ("zero-pitch", zp or []), ("SVD basis", an.svd_screws))
+              for i, sc in enumerate(lst)]
+    cf = data["cond_closed_form"]
+    table = (f"single coupler Jacobian at phi_a = {phi_a:.6g} rad, alpha_bx = {alpha_bx:.6g} rad, "
+             f"alpha_bz = {alpha_bz:.6g} rad;\ngamma = {p.gamma:.6g} rad, e_y = {p.e_y:.6g} m, R = {p.R:.6g} m. "
+             "l_dot = J w: link length rates [m/s]\nfrom the twist w = (v at O_b [m/s], omega [rad/s]) of "
+             "platform B (Eqs 12-13)\n"
+             + format_table(["link", *(f"J_{c} [{u}]" for c, u in zip(J_COLUMNS, J_UNITS, strict=True))],
+                            [[f"{k + 1}", *(_z(x) for x in J[k])] for k in range(J.shape[0])], ".5f")
+             + "\n\n" + format_table(["singular value", "value [units of J]"],
+                                      [[f"sigma_{k + 1}", float(v)] for k, v in enumerate(an.singular_values)], ".6g")
+             + f"\nrank {an.rank} (relative tolerance {ref.RANK_RTOL:g}); condition number {an.cond:.6g} [-];\n"
+             f"closed form R^2 cos(2 gamma)/e_y = {'n/a (R too small)' if cf is None else f'{cf:.6g}'} [-]"
+             "\n\nfree motions (null space of J) as screws: a = unit axis, p = point of the axis nearest to O_b,\n"
+             "h = pitch (inf = translation)\n"
+             + format_table(["basis", "screw", "a_x [-]", "a_y [-]", "a_z [-]", "p_x [m]", "p_y [m]", "p_z [m]",
+                             "h [m]"],
+                            [[lab, nm, *(_z(x) for x in sc.axis), *(_z(x) for x in sc.point), _z(sc.pitch)]
+                             for lab, nm, sc in screws], ".4g"))
+
+    def write(out: Path) -> list[Path]:
+        cols = [("link", "", np.arange(1, J.shape[0] + 1))]
+        cols += [(f"J_{c}", u, J[:, i]) for i, (c, u) in enumerate(zip(J_COLUMNS, J_UNITS, strict=True))]
+        files = [write_csv(out / "jacobian.csv", cols)]
+        files.append(write_csv(out / "jacobian_singular_values.csv",
+                               [("index", "", np.arange(1, an.singular_values.size + 1)),
+                                ("sigma", "units of J", an.singular_values)]))
+        files.append(write_csv(out / "jacobian_screws.csv", [
+            ("basis", "", [lab for lab, _, _ in screws]), ("screw", "", [nm for _, nm, _ in screws]),
+            *((f"axis_{c}", "-", [sc.axis[i] for _, _, sc in screws]) for i, c in enumerate("xyz")),
+            *((f"point_{c}", "m", [sc.point[i] for _, _, sc in screws]) for i, c in enumerate("xyz")),
+            ("pitch", "m", [sc.pitch for _, _, sc in screws])]))
+        return files
+
+    return Report(data, table, write)
 
 
 # ---------------------------------------------------------------------------------------------------------- criteria
@@ -243,7 +277,7 @@ def double_c5(p: CouplerParams, z_c: float, alpha_cx: float = 0.0, alpha_cz: flo
             "rev": rev}
 
 
-ALPHAS = tuple(np.round(np.linspace(0.0, 0.07, 8), 4))  # up to +-4 deg (seed conclusions)
+ALPHAS = tuple(np.round(np.linspace(0.0, 0.07, 8), 4))  # up to +-4 deg (the paper's Sect. 5)
 EYS = (0.1, 0.2, 0.3)
 ZCS = tuple(np.round(np.linspace(0.0, 0.1, 6), 3))
 LBS = (1.0, 2.0, 4.0)
@@ -285,11 +319,13 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
                             "extrema": "c1 and c5: extrema refined between samples (bounded Brent on the FPP); "
                                        "mean over the open grid (closing sample left out); c2-c4: sampled",
                             }}
-    table = ("single coupler criteria [rad, R]\n"
-             + format_table(["gamma", "e_y", "alpha_b", "c1", "c2", "c3", "c4"], single_rows, ".4g")
-             + f"\n\ndouble coupler c5 [rad] at gamma = {pd.gamma:.5g} rad ({math.degrees(pd.gamma):.4g} deg), "
-             f"e_y = {pd.e_y:g}, R = {pd.R:g} (c1_b = intermediate shaft fluctuation)\n"
-             + format_table(["l_b", "phi_bc", "z_c", "c5", "c1_b"], double_rows, ".4g"))
+    table = (f"single coupler criteria over one revolution (R = {CouplerParams().R:g} m; c1-c4: Eqs 16-19)\n"
+             + format_table(["gamma [rad]", "e_y [m]", "alpha_b [rad]", "c1 [rad]", "c2 [m]", "c3 [rad]",
+                             "c4 [rad]"], single_rows, ".4g")
+             + f"\n\ndouble coupler c5 (Eq 20) at gamma = {pd.gamma:.5g} rad ({math.degrees(pd.gamma):.4g} deg), "
+             f"e_y = {pd.e_y:g} m, R = {pd.R:g} m;\nc1_b = fluctuation of the intermediate shaft b; "
+             "nan = no physical pose\n"
+             + format_table(["l_b [m]", "phi_bc [rad]", "z_c [m]", "c5 [rad]", "c1_b [rad]"], double_rows, ".4g"))
 
     def write(out: Path) -> list[Path]:
         files = [write_csv(out / "criteria_single.csv",
@@ -300,10 +336,11 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
                            [(k, u, [r[k] for r in double]) for k, u in (("gamma", "rad"), ("e_y", "m"), ("R", "m"),
                             ("l_b", "m"), ("phi_bc", "rad"), ("z_c", "m"), ("c5", "rad"), ("c5_pp", "rad"),
                             ("c5_sampled", "rad"), ("c1_intermediate", "rad"))])]
+        from ...plotting import save
         from . import plots
 
-        files += plots.fig9(single, out / "fig9_criteria_single.png")
-        files += plots.fig10(double, out / "fig10_c5_double.png")
+        files += [save(plots.fig9(single), out / "fig9_criteria_single.png"),
+                  save(plots.fig10(double), out / "fig10_c5_double.png")]
         files += plots.figs678(CouplerParams(gamma=0.297), out)
         return files
 
@@ -325,13 +362,22 @@ def fpp_report(p: CouplerParams, alpha_bx: float, alpha_bz: float, n: int, engin
     step = max(1, (n - 1) // 12)
     rows = [[rev.phi_a[i], rev.u[i, 0], rev.u[i, 1], rev.u[i, 2], rev.u[i, 3], d[i] - math.pi / 2]
             for i in range(0, n, step)]
-    table = format_table(["phi_a", "phi_b", "x_b", "y_b", "z_b", "phi_a-phi_b-pi/2"], rows, ".6g")
+    table = (f"single coupler pose over one revolution (Eqs 4-5), one row per {step} of the {n} samples;\n"
+             f"gamma = {p.gamma:.6g} rad, e_y = {p.e_y:.6g} m, R = {p.R:.6g} m, alpha_bx = {alpha_bx:.6g} rad, "
+             f"alpha_bz = {alpha_bz:.6g} rad;\nO_b = (x_b, e_y + y_b, z_b) is the centre of platform B\n"
+             + format_table(["phi_a [rad]", "phi_b [rad]", "x_b [m]", "y_b [m]", "z_b [m]",
+                             "phi_a-phi_b-pi/2 [rad]"], [[_z(x) for x in r] for r in rows], ".6g"))
     if "max_abs_diff_pinocchio" in data:
-        table += f"\nmax |reference - Pinocchio| over the revolution: {data['max_abs_diff_pinocchio']:.3e}"
+        table += (f"\nmax |reference - Pinocchio| over the revolution: {data['max_abs_diff_pinocchio']:.3e} "
+                  "(rad and m)")
 
     def write(out: Path) -> list[Path]:
+        from ...plotting import save
+        from . import plots
+
         return [write_csv(out / "fpp_single.csv", [("phi_a", "rad", rev.phi_a), ("phi_b", "rad", rev.u[:, 0]),
                                                    ("x_b", "m", rev.u[:, 1]), ("y_b", "m", rev.u[:, 2]),
-                                                   ("z_b", "m", rev.u[:, 3])])]
+                                                   ("z_b", "m", rev.u[:, 3])]),
+                save(plots.fpp_figure(p, rev.phi_a, rev.u, alpha_bx, alpha_bz), out / "fpp_single.png")]
 
     return Report(data, table, write)

@@ -233,6 +233,9 @@ HARD_CASES: tuple[HardCase, ...] = (
 
 # ================================================================================================ work-precision
 class CouplerStudy(Study):
+    """Work-precision study of the double coupler: the kinematic FPP (Gauss-Newton tolerance x continuation
+    steps) against scipy's trust-region solution, and the MuJoCo dynamics (integrator x timestep) against RK4 at
+    1e-4 s."""
     FPP_TOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-13)
     FPP_STEPS = (19, 37, 73, 181)
     MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
@@ -258,6 +261,7 @@ class CouplerStudy(Study):
 
     # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
     def fpp(self, tol: float, n: int) -> np.ndarray:
+        """Double-coupler FPP over one revolution with Gauss-Newton tolerance `tol` and `n` continuation steps."""
         from . import reference as ref
 
         phis = np.linspace(0.0, 2 * math.pi, n)
@@ -273,6 +277,7 @@ class CouplerStudy(Study):
         return np.array(out)
 
     def fpp_reference(self, n: int) -> np.ndarray:
+        """The same revolution solved by scipy `least_squares` (trf) to 1e-15: the FPP reference."""
         from scipy.optimize import least_squares
 
         from . import reference as ref
@@ -288,6 +293,7 @@ class CouplerStudy(Study):
         return np.array(out)
 
     def settings(self) -> list[Setting]:
+        """The settings of the study: FPP tolerances x steps, MuJoCo integrators x timesteps."""
         from mbsuite import run
 
         out = []
@@ -306,6 +312,7 @@ class CouplerStudy(Study):
         return out
 
     def reference(self):
+        """Reference solutions: the FPP per step count and a MuJoCo RK4 run at 1e-4 s."""
         from mbsuite import run
 
         self._fpp_ref = {n: self.fpp_reference(n) for n in ((19, 37) if self.quick else self.FPP_STEPS)}
@@ -319,6 +326,7 @@ class CouplerStudy(Study):
         return float(np.max(np.abs(d - d.mean())))
 
     def state_error(self, res, ref) -> float:
+        """State error of one setting against its reference (the class's `state_doc`)."""
         kind, n, r = res
         if kind == "fpp":
             return float(np.max(np.abs(r - self._fpp_ref[n])))
@@ -332,6 +340,7 @@ class CouplerStudy(Study):
         return max(err("phi_c"), err("omega_c") / om, err("torque_in") / tl)
 
     def physics_error(self, res, ref):
+        """Physics error of one setting and its parts (the class's `physics_doc`)."""
         from . import reference as cref
 
         kind, n, r = res

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import textwrap
 import warnings
 from pathlib import Path
-
-import numpy as np
 
 from ...errors import ParameterError
 from ...results import Report, format_table
@@ -56,7 +55,8 @@ def _cmd_jacobian(emit):
         msgs = [str(w.message) for w in caught if issubclass(w.category, analysis.SingularityWarning)]
         if msgs:
             rep.data["warnings"] = msgs
-            rep.table = "WARNING: " + "\nWARNING: ".join(msgs) + "\n" + rep.table
+            rep.table = "".join(textwrap.fill("WARNING: " + m, 100, subsequent_indent="  ") + "\n"
+                                for m in msgs) + rep.table
         emit(rep, args, None)
 
     return run
@@ -101,38 +101,70 @@ def _cmd_criteria(emit):
     return run
 
 
+#: units of the statistics of a dynamics run (`mujoco.stats`, `mujoco.run_reference`)
+STAT_UNITS = {"window_start": "s", "revolutions": "-", "phi_c_err_max": "rad", "phi_c_err_rms": "rad",
+              "phi_c_kin_fluctuation_pp": "rad", "closure_residual_max": "m", "closure_residual_max_all": "m",
+              "torque_in_mean": "N m", "torque_in_ripple_pp": "N m", "torque_in_ripple_rel": "-",
+              "torque_in_ripple_quasi_static_pp": "N m", "speed_ratio_min": "-", "speed_ratio_max": "-",
+              "link_force_max_abs": "N", "steps": "-", "timestep": "s"}
+
+
+def _plain(v: object) -> str:
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+def dynamics_table(scene_input: dict, res) -> str:
+    """The human table of `coupler dynamics`: resolved input, statistics with units, health, link forces."""
+    st = res.stats
+    units = dict(STAT_UNITS)
+    units.update({k: (u or "-") for k, u in res.units.items()})
+    inp_units = {"omega": "rad/s", "load_torque": "N m", "alpha_cx": "rad", "alpha_cz": "rad", "x_c": "m",
+                 "z_c": "m", "t_ramp": "s"}
+    table = textwrap.fill("input (resolved, defaults included): " + ", ".join(
+        f"{k} = {_plain(v)}" + (f" {inp_units[k]}" if k in inp_units else "") for k, v in scene_input.items()),
+        100, subsequent_indent="  ") + "\n"
+    rows = [[k, units.get(k, "?"), float(v) if isinstance(v, float) else v] for k, v in st.items()
+            if isinstance(v, int | float) and not isinstance(v, bool)]
+    table += format_table(["quantity", "unit", "value"], rows, ".6g")
+    if st.get("integrator"):
+        table += f"\nintegrator {st['integrator']}"
+    if "solref" in st:
+        table += f", closure solref = ({st['solref'][0]:g} s, {st['solref'][1]:g})"
+    if res.health:
+        table += "\n" + textwrap.fill("health: " + ", ".join(
+            f"{f.name} {f.value:.3g} {f.unit} (bound {f.bound:.3g} {f.unit}{'' if f.ok else ', EXCEEDED'})"
+            for f in res.health), 100, subsequent_indent="  ")
+    table += "\nMuJoCo warnings: " + (", ".join(f"{k} x{n}" for k, n in st["warnings"].items())
+                                      if st.get("warnings") else "none") if "warnings" in st else ""
+    if "link_force_mean" in st:
+        table += "\nmean link forces over the statistics window (tension > 0):\n" + format_table(
+            [f"link {k + 1} [N]" for k in range(len(st["link_force_mean"]))], [st["link_force_mean"]], ".1f")
+    return table
+
+
 def _cmd_dynamics(emit):
     def run(args: argparse.Namespace) -> None:
         scene = load_scene(args.scene)
         if args.engine:
             scene = scene.replace(solver={"engine": args.engine})
         res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)
-        st = res.stats
-        inputs = {k: v for k, v in scene.input.items()}  # resolved: declared defaults filled in by the scene loader
-        table = ("input (resolved, defaults included): "
-                 + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in inputs.items())
-                 + "\n")
-        rows = [[k, v] for k, v in st.items() if isinstance(v, int | float)]
-        table += format_table(["quantity", "value"], rows, ".6g")
-        if res.health:
-            table += "\nhealth: " + ", ".join(f"{f.name} {f.value:.3g} {f.unit} (bound {f.bound:.3g})"
-                                              for f in res.health)
-        if st.get("warnings"):
-            table += f"\nMuJoCo warnings: {st['warnings']}"
-        if "link_force_mean" in st:
-            table += "\nmean link forces (tension > 0) [N]: " + np.array2string(np.array(st["link_force_mean"]),
-                                                                              precision=1)
+        inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
+        table = dynamics_table(inputs, res)
 
         def write(out: Path) -> list[Path]:
-            return [res.write_csv(out / "timeseries.csv")]
+            from ...plotting import save
+            from .plots import dynamics_figure
 
-        emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": st, "summary": res.summary()}, table, write),
-             args, scene.to_dict())
+            return [res.write_csv(out / "timeseries.csv"), save(dynamics_figure(res), out / "timeseries.png")]
+
+        emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
+                    write), args, scene.to_dict())
 
     return run
 
 
 def register(sub, add_common, emit) -> None:
+    """Add the `mbsuite coupler jacobian | fpp | criteria | dynamics` commands to the parser `sub`."""
     g = sub.add_parser("coupler", help="4-link coupler kinematics (Jacobian, FPP, criteria) and dynamics")
     gs = g.add_subparsers(dest="coupler_command", required=True)
 

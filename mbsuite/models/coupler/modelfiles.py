@@ -33,6 +33,7 @@ PHI_B_OFFSET = -math.pi / 2  # phi_b = q_phi_b + PHI_B_OFFSET
 
 
 def phi_c_offset(p: CouplerParams) -> float:
+    """phi_c - q(phi_c) [rad]: the mounted frame of shaft c is turned by phi_bc."""
     return p.phi_bc  # phi_c = q_phi_c + phi_bc
 
 
@@ -199,7 +200,7 @@ def _mj_link(p: CouplerParams, name: str, start: np.ndarray, end: np.ndarray, in
             f'{ind}  <joint name="{name}_ball" type="ball" damping="{_f(p.joint_damping)}"/>\n'
             f'{ind}  <inertial pos="0 0 {_f(l / 2)}" mass="{_f(p.m_link)}" diaginertia="{_f(it)} {_f(it)} {_f(ia)}"/>\n'
             f'{ind}  <geom name="{name}_rod" type="capsule" pos="0 0 {_f(l / 2)}" size="{_f(p.link_radius)} '
-            f'{_f(l / 2)}" contype="0" conaffinity="0" mass="0"/>\n'
+            f'{_f(l / 2)}" material="link" {_VIS}/>\n'
             f'{ind}  <site name="{name}_end" pos="0 0 {_f(l)}"/>\n{ind}</body>\n')
 
 
@@ -217,6 +218,75 @@ def _mj_chain(prefix: str, ind: str) -> str:
     return out
 
 
+#: visual-only elements of the MJCF (no physics: contype = conaffinity = 0, mass 0, bodies' inertia stated
+#: explicitly): platform discs of radius DISC_RADIUS x R and thickness DISC_THICK x R behind each platform's joint plane
+DISC_RADIUS = 1.12
+DISC_THICK = 0.04
+_VIS = 'contype="0" conaffinity="0" mass="0"'
+
+
+def _span(p: CouplerParams, kind: str) -> tuple[float, float]:
+    """Axial extent (y from, y to) of the mechanism in the base frame [m]."""
+    return -0.5, (p.e_y if kind == "single" else 2 * p.e_y + p.l_b) + 0.5
+
+
+def scene_layout(p: CouplerParams, kind: str) -> dict[str, np.ndarray]:
+    """Positions of the visual-only elements for geometry `p`: the floor plane 1.6 R below the shaft axis (gravity is
+    -z), its half-size, the key light, and the `overview` camera (position and x/y axes, looking at the mechanism's
+    centre from the side and above)."""
+    y0, y1 = _span(p, kind)
+    yc, half = 0.5 * (y0 + y1), 0.5 * (y1 - y0)
+    target = np.array([0.0, yc, 0.0])
+    dist = 2.6 * max(half, 1.6 * p.R)
+    pos = target + dist * np.array([0.85, -0.38, 0.36])
+    f = (target - pos) / np.linalg.norm(target - pos)
+    x = np.cross(f, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(x, f)
+    return {"floor_pos": np.array([0.0, yc, -1.6 * p.R]),
+            "floor_size": np.array([2.5 * p.R + half, 2.5 * p.R + half, 0.05]),
+            "light_pos": np.array([0.0, yc, 4.0 * p.R + half]), "camera_pos": pos, "camera_xyaxes": np.r_[x, y]}
+
+
+def _disc(p: CouplerParams, name: str, y_from: float, y_to: float, ind: str) -> str:
+    return (f'{ind}<geom name="{name}" type="cylinder" fromto="0 {_f(y_from)} 0 0 {_f(y_to)} 0" '
+            f'size="{_f(DISC_RADIUS * p.R)}" material="platform" {_VIS}/>\n')
+
+
+def _discs(p: CouplerParams, kind: str) -> dict[str, tuple[str, float, float]]:
+    """Platform discs: name -> (body, y_from, y_to) in the body's frame, on the side away from the links."""
+    t = DISC_THICK * p.R
+    d = {"platform_a_disc": ("shaft_a", -t, 0.0)}
+    if kind == "single":
+        d["platform_b_disc"] = ("platform_b", 0.0, t)
+    else:
+        d |= {"platform_ba_disc": ("shaft_b", 0.0, t), "platform_bc_disc": ("shaft_b", p.l_b - t, p.l_b),
+              "platform_c_disc": ("shaft_c", 0.0, t)}
+    return d
+
+
+def _mj_header(p: CouplerParams, kind: str) -> str:
+    lay = scene_layout(p, kind)
+    return ("  <visual>\n    <headlight ambient=\"0.35 0.35 0.35\" diffuse=\"0.5 0.5 0.5\" specular=\"0.1 0.1 0.1\"/>\n"
+            '    <global offwidth="1280" offheight="960"/>\n  </visual>\n'
+            "  <asset>\n"
+            '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.65 0.78" rgb2="0.15 0.17 0.2" '
+            'width="512" height="512"/>\n'
+            '    <texture name="grid" type="2d" builtin="checker" width="512" height="512" rgb1="0.82 0.84 0.86" '
+            'rgb2="0.72 0.74 0.77"/>\n'
+            '    <material name="grid" texture="grid" texrepeat="4 4" texuniform="true" reflectance="0.05"/>\n'
+            '    <material name="platform" rgba="0.45 0.55 0.7 0.35"/>\n'
+            '    <material name="shaft" rgba="0.35 0.37 0.4 1"/>\n'
+            '    <material name="link" rgba="0.85 0.45 0.15 1"/>\n'
+            "  </asset>\n"
+            "  <worldbody>\n"
+            f'    <light name="key" pos="{_v(lay["light_pos"])}" dir="0 0 -1" directional="true" '
+            'diffuse="0.6 0.6 0.6"/>\n'
+            f'    <geom name="floor" type="plane" pos="{_v(lay["floor_pos"])}" size="{_v(lay["floor_size"])}" '
+            'material="grid" contype="0" conaffinity="0"/>\n'
+            f'    <camera name="overview" pos="{_v(lay["camera_pos"])}" xyaxes="{_v(lay["camera_xyaxes"])}"/>\n')
+
+
 def mjcf_text(p: CouplerParams, kind: str) -> str:
     """MJCF of the single or double coupler: one root body `coupler` (welded to the world) holding the shafts; each SS
     link a body with a ball joint at its driving-side point and a <connect> to the driven platform at its far end."""
@@ -232,13 +302,19 @@ def mjcf_text(p: CouplerParams, kind: str) -> str:
          + "; zero = aligned, assembled pose. -->\n"
          f'<mujoco model="coupler_{kind}">\n  <compiler angle="radian" autolimits="true"/>\n'
          '  <option timestep="0.0005" integrator="implicitfast" gravity="0 0 -9.81"/>\n'
-         "  <worldbody>\n"
+         + _mj_header(p, kind) +
          '    <body name="coupler">\n'
          f'      <body name="shaft_a">\n        <joint name="phi_a" type="hinge" axis="0 1 0"/>\n'
          f'        <inertial pos="0 0 0" mass="1" diaginertia="{_f(p.i_shaft_a / 2)} {_f(p.i_shaft_a)} '
          f'{_f(p.i_shaft_a / 2)}"/>\n'
-         f'        <geom name="shaft_a_geom" type="cylinder" fromto="0 -0.5 0 0 0 0" size="0.1" contype="0" '
-         'conaffinity="0" mass="0"/>\n')
+         f'        <geom name="shaft_a_geom" type="cylinder" fromto="0 -0.5 0 0 0 0" size="0.1" material="shaft" '
+         f'{_VIS}/>\n')
+    discs = _discs(p, kind)
+
+    def body_discs(body: str) -> str:
+        return "".join(_disc(p, n, y0, y1, I2 * 2) for n, (b, y0, y1) in discs.items() if b == body)
+
+    s += body_discs("shaft_a")
     s += _mj_sites("A", pts["A"], I2 * 2)
     driven = "B" if kind == "single" else "BA"
     # links of coupler 1: driving end at A_k, far end at driven point k+1 (nominal pose)
@@ -249,22 +325,25 @@ def mjcf_text(p: CouplerParams, kind: str) -> str:
     if kind == "single":
         s += f'      <body name="platform_b" pos="0 {_f(p.e_y)} 0">\n' + _mj_chain("b", I2 * 2)
         s += (f'        <inertial pos="0 0 0" mass="1" diaginertia="{_f(p.i_shaft_c / 2)} {_f(p.i_shaft_c)} '
-              f'{_f(p.i_shaft_c / 2)}"/>\n')
-        s += _mj_sites("B", pts["B"], I2 * 2) + "      </body>\n"
+              f'{_f(p.i_shaft_c / 2)}"/>\n'
+              f'        <geom name="shaft_b_geom" type="cylinder" fromto="0 0 0 0 0.5 0" size="0.1" material="shaft" '
+              f'{_VIS}/>\n')
+        s += body_discs("platform_b") + _mj_sites("B", pts["B"], I2 * 2) + "      </body>\n"
     else:
         s += f'      <body name="shaft_b" pos="0 {_f(p.e_y)} 0">\n' + _mj_chain("b", I2 * 2)
         s += (f'        <inertial pos="0 {_f(p.l_b / 2)} 0" mass="{_f(p.m_shaft_b)}" diaginertia="'
               f'{_f(p.i_shaft_b_trans)} {_f(p.i_shaft_b_axial)} {_f(p.i_shaft_b_trans)}"/>\n'
               f'        <geom name="shaft_b_geom" type="cylinder" fromto="0 0 0 0 {_f(p.l_b)} 0" size="0.1" '
-              'contype="0" conaffinity="0" mass="0"/>\n')
-        s += _mj_sites("BA", pts["BA"], I2 * 2) + _mj_sites("BC", pts["BC"], I2 * 2) + "      </body>\n"
+              f'material="shaft" {_VIS}/>\n')
+        s += body_discs("shaft_b") + _mj_sites("BA", pts["BA"], I2 * 2) + _mj_sites("BC", pts["BC"], I2 * 2)
+        s += "      </body>\n"
         yc = 2 * p.e_y + p.l_b
         s += f'      <body name="shaft_c" pos="0 {_f(yc)} 0">\n' + _mj_chain("c", I2 * 2)
         s += (f'        <inertial pos="0 0 0" mass="1" diaginertia="{_f(p.i_shaft_c / 2)} {_f(p.i_shaft_c)} '
               f'{_f(p.i_shaft_c / 2)}"/>\n'
-              f'        <geom name="shaft_c_geom" type="cylinder" fromto="0 0 0 0 0.5 0" size="0.1" contype="0" '
-              'conaffinity="0" mass="0"/>\n')
-        s += _mj_sites("C", pts["C"], I2 * 2)
+              f'        <geom name="shaft_c_geom" type="cylinder" fromto="0 0 0 0 0.5 0" size="0.1" material="shaft" '
+              f'{_VIS}/>\n')
+        s += body_discs("shaft_c") + _mj_sites("C", pts["C"], I2 * 2)
         # links of coupler 2: driving end at C_k, far end at BC_{k+1}, expressed in shaft_c's frame
         eBC = pts["BC"] + np.array([0.0, p.e_y, 0.0]) - np.array([0.0, yc, 0.0])
         for k in range(4):
@@ -454,6 +533,16 @@ def mjspec_variant(p: CouplerParams, kind: str, base: str | Path | None = None):
         eBC = pts["BC"] + np.array([0.0, p.e_y - yc, 0.0])
         for k in range(4):
             set_link(f"link{k + 5}", pts["C"][k], eBC[NEXT[k]])
+    for name, (_, y0, y1) in _discs(p, kind).items():  # visual only
+        g = spec.geom(name)
+        g.fromto = [0, y0, 0, 0, y1, 0]
+        g.size = [DISC_RADIUS * p.R, 0, 0]
+    lay = scene_layout(p, kind)
+    spec.geom("floor").pos = lay["floor_pos"]
+    spec.geom("floor").size = lay["floor_size"]
+    spec.light("key").pos = lay["light_pos"]
+    spec.camera("overview").pos = lay["camera_pos"]
+    spec.camera("overview").alt.xyaxes = lay["camera_xyaxes"]
     for c in closures(p, kind):
         eq = spec.equality(c.name)
         data = np.array(eq.data)

@@ -14,15 +14,15 @@ from dataclasses import dataclass
 from ...errors import ParameterError
 from ...limits import check_fields, param
 
-GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (reference B1)
-GAMMAS_PAPER = (0.11, 0.297, 0.391)  # seed l.212, l.292
+GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (README, erratum 7)
+GAMMAS_PAPER = (0.11, 0.297, 0.391)  # the paper's Sect. 3.1 and 3.4
 
 
 @dataclass(frozen=True)
 class CouplerParams:
     """Design and dynamic parameters (SI units).
 
-    Geometry (seed Table 1, l.96-101):
+    Geometry (the paper's Table 1):
       gamma   platform proportion angle [rad], 0 < gamma < pi/4 (Eq 1 gives a positive link length only there)
       e_y     axial shift between the platforms of one coupler [m], >= 0 (0 = coplanar singular pose)
       R       radius of the circle through the S-joint centres [m] (Eq 1; the paper's R = 1)
@@ -76,10 +76,11 @@ class CouplerParams:
 
     @property
     def link_length(self) -> float:
-        """Link length with the axial shift: l = sqrt(l0^2 + e_y^2) (reference B1)."""
+        """Link length with the axial shift: l = sqrt(l0^2 + e_y^2) (README, "Conventions and geometry")."""
         return math.hypot(self.l0, self.e_y)
 
     def geometry(self) -> dict[str, float]:
+        """The geometric design (gamma, e_y, R, l_b, phi_bc) as a dict (SI units)."""
         return {"gamma": self.gamma, "e_y": self.e_y, "R": self.R, "l_b": self.l_b, "phi_bc": self.phi_bc}
 
 

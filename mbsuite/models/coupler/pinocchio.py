@@ -112,20 +112,24 @@ class PinCoupler:
 
     # ---- coordinates
     def q_of(self, coords: dict[str, float]) -> np.ndarray:
+        """Pinocchio configuration q from the paper's coordinates (names of `iq`; mounting offsets removed)."""
         q = np.zeros(self.model.nq)
         for k, v in coords.items():
             q[self.iq[k]] = v - self.offsets.get(k, 0.0)
         return q
 
     def coord(self, q: np.ndarray, name: str) -> float:
+        """The paper's coordinate `name` at configuration q (mounting offset added)."""
         return float(q[self.iq[name]] + self.offsets.get(name, 0.0))
 
     # ---- kinematics
     def update(self, q: np.ndarray) -> None:
+        """Joint Jacobians and frame placements at q (the data every other method reads)."""
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
 
     def link_vectors(self) -> np.ndarray:
+        """Link vectors p(frame_b) - p(frame_a) (k, 3) in base axes at the last `update`."""
         return np.array([self.data.oMf[b].translation - self.data.oMf[a].translation for a, b in zip(self.fa, self.fb,
                                                                                                      strict=True)])
 
@@ -181,6 +185,7 @@ class PinCoupler:
             check_physical(self.p, -lv[4:], [axis("shaft_b"), axis("shaft_c")], "Pinocchio double coupler FPP")
 
     def coords(self, q: np.ndarray) -> np.ndarray:
+        """The FPP unknowns (in `unknowns` order) at configuration q."""
         return np.array([self.coord(q, n) for n in self.unknowns])
 
     def mechanism_jacobian(self, q: np.ndarray) -> np.ndarray:
@@ -195,6 +200,7 @@ class PinCoupler:
         return K @ np.linalg.inv(JP)
 
     def platform_origin(self, q: np.ndarray, frame: str = "platform_b") -> np.ndarray:
+        """Origin of `frame` (default platform B) in base coordinates at q."""
         pin.framesForwardKinematics(self.model, self.data, q)
         return self.data.oMf[pe.frame_id(self.model, frame)].translation.copy()
 
@@ -263,6 +269,7 @@ class PinMjcfCoupler:
         raise_on_gaps(self.path, gaps, stated.link_length, "Pinocchio")
 
     def residual_and_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Closure residuals of the <connect> points and their Jacobian at q."""
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
         r, J = [], []
@@ -338,4 +345,5 @@ def pin_to_mujoco_qpos(pm: pin.Model, q: np.ndarray, mj_model) -> np.ndarray:
 
 
 def rad_wrap(x: np.ndarray) -> np.ndarray:
+    """Angles wrapped to [-pi, pi)."""
     return (np.asarray(x) + math.pi) % (2 * math.pi) - math.pi

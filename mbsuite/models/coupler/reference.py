@@ -1,6 +1,7 @@
-"""Hand-derived kinematics of the single and double 4-link coupler (plain numpy; seed 001, Sect. 2, Eqs 2-7, 12-13).
+"""Hand-derived kinematics of the single and double 4-link coupler (plain numpy; Maniowski & Czauderna, Sect. 2,
+Eqs 2-7, 12-13).
 
-Conventions (reference B1, README):
+Conventions (README, "Conventions and geometry"):
 - base frame: y is the input-shaft axis; platforms lie in y = const planes; A's centre is the origin.
 - local S-joint centres of every platform: p_k = R (cos psi_k, 0, sin psi_k), psi_k = pi/2+g, pi/2-g, -pi/2+g, -pi/2-g.
 - R^a = R_y(phi_a) (Eq 2); R^b = R_z(alpha_bz) R_x(alpha_bx) R_y(phi_b) (inclination fixed in space, then spin).
@@ -33,6 +34,7 @@ EY = np.array([0.0, 1.0, 0.0])
 
 # ----------------------------------------------------------------------------------------------------------- rotations
 def rot_x(a: float) -> np.ndarray:
+    """Rotation about x by a [rad]."""
     c, s = math.cos(a), math.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
@@ -44,11 +46,13 @@ def rot_y(a: float) -> np.ndarray:
 
 
 def rot_z(a: float) -> np.ndarray:
+    """Rotation about z by a [rad]."""
     c, s = math.cos(a), math.sin(a)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def skew(v: np.ndarray) -> np.ndarray:
+    """Cross-product matrix: skew(v) @ u = v x u."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
@@ -68,7 +72,8 @@ def shaft_rotation_derivs(alpha_x: float, alpha_z: float, phi: float) -> tuple[n
 
 # ------------------------------------------------------------------------------------------------------------ geometry
 def platform_points(gamma: float, R: float = 1.0) -> np.ndarray:
-    """Local S-joint centres (4, 3): R (cos psi, 0, sin psi), psi = pi/2+g, pi/2-g, -pi/2+g, -pi/2-g (reference B1)."""
+    """Local S-joint centres (4, 3): R (cos psi, 0, sin psi), psi = pi/2+g, pi/2-g, -pi/2+g, -pi/2-g
+    (README, "Conventions and geometry")."""
     s, c = math.sin(gamma), math.cos(gamma)
     return R * np.array([[-s, 0.0, c], [s, 0.0, c], [s, 0.0, -c], [-s, 0.0, -c]])
 
@@ -91,7 +96,7 @@ def gauss_newton(
     max_iter: int = 50,
     what: str = "FPP",
 ) -> tuple[np.ndarray, int]:
-    """Gauss-Newton u <- u - lstsq(J, r) until |r|_inf <= tol (seed l.147). Raises SolverError with the residual."""
+    """Gauss-Newton u <- u - lstsq(J, r) until |r|_inf <= tol (Sect. 2.2). Raises SolverError with the residual."""
     u = np.array(u0, dtype=float)
     r = fun(u)
     for it in range(max_iter):
@@ -119,6 +124,7 @@ class SinglePose:
 
     @property
     def phi_b(self) -> float:
+        """Output angle phi_b [rad] (first FPP unknown)."""
         return float(self.u[0])
 
 
@@ -256,6 +262,7 @@ def continuation(step: Callable[[float, np.ndarray], np.ndarray], u0: np.ndarray
 
 @dataclass
 class SingleRevolution:
+    """Single-coupler FPP over one revolution: phi_a (n,) and u (n, 4) = (phi_b, x_b, y_b, z_b)."""
     phi_a: np.ndarray
     u: np.ndarray  # (n, 4): phi_b, x_b, y_b, z_b
     alpha_bx: float
@@ -310,13 +317,13 @@ EQ15 = np.array([
     [0, 0, 0, 0],
     [0, 0, 0, 0],
     [-0.8829, 0.8829, -0.8829, 0.8829],
-])  # seed l.245, printed 6 x 4 (one column per link)
+])  # Eq (15), printed 6 x 4 (one column per link)
 
 
 def paper_eq15_layout(J: np.ndarray) -> np.ndarray:
     """Our 4 x 6 J (columns v_x, v_y, v_z, w_x, w_y, w_z; rows = links 1..4) in the paper's printed layout: the 6 x 4
     transpose with Eq (13)'s moment sign ((o - b) x l = -our moment) and rows (x, z, -y | m_x, m_z, -m_y), i.e. a proper
-    frame (x, z, -y) whose third axis is the shaft (reference B1)."""
+    frame (x, z, -y) whose third axis is the shaft (README, "Conventions and geometry")."""
     Jp = np.vstack([J[:, :3].T, -J[:, 3:].T])  # 6 x 4, Eq (13) sign
     rows = [0, 2, 1, 3, 5, 4]
     sign = np.array([1, 1, -1, 1, 1, -1])[:, None]
@@ -338,6 +345,7 @@ class Screw:
     magnitude: float
 
     def as_dict(self) -> dict:
+        """The screw as a dict (axis, point, pitch, magnitude)."""
         return {"axis": self.axis, "point": self.point, "pitch": self.pitch, "magnitude": self.magnitude}
 
 
@@ -351,6 +359,8 @@ SINGLE_UNKNOWNS = ("phi_b", "x_b", "y_b", "z_b")  # single-coupler FPP unknowns 
 
 
 def twist_to_screw(t: np.ndarray, o: np.ndarray, eps: float = 1e-12) -> Screw:
+    """Screw of the twist t = (v at o, omega): axis omega/|omega|, point o + omega x v/|omega|^2, pitch
+    omega.v/|omega|^2; a pure translation (|omega| ~ 0) has infinite pitch and axis v/|v| through o."""
     v, w = t[:3], t[3:]
     nw = float(np.linalg.norm(w))
     if nw <= eps * max(1.0, float(np.linalg.norm(v))):
@@ -361,6 +371,7 @@ def twist_to_screw(t: np.ndarray, o: np.ndarray, eps: float = 1e-12) -> Screw:
 
 @dataclass
 class JacobianAnalysis:
+    """SVD analysis of a mechanism Jacobian: singular values, rank, condition number, null space as screws."""
     J: np.ndarray
     singular_values: np.ndarray
     rank: int
@@ -398,7 +409,7 @@ def principal_twists(N: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 def analyse_jacobian(J: np.ndarray, o: np.ndarray, rtol: float = RANK_RTOL) -> JacobianAnalysis:
     """Rank (SVD, relative tolerance rtol), condition number sigma_max/sigma_min of the 4 singular values (Eq 14;
-    inf when sigma_min == 0), null space -> free motions of the platform as screws (seed Sect. 2.3)."""
+    inf when sigma_min == 0), null space -> free motions of the platform as screws (Sect. 2.3)."""
     _, s, Vt = np.linalg.svd(J)
     rank = int(np.sum(s > rtol * s[0]))
     smin = s[min(J.shape) - 1]
@@ -441,7 +452,7 @@ def pitch_of_mixed_basis(s1: Screw, s2: Screw, theta: float) -> tuple[float, flo
 
 
 # ------------------------------------------------------------------------------------------------------ double coupler
-DOUBLE_UNKNOWNS = ("phi_c", "y_c", "x_b", "y_b", "z_b", "phi_b", "alpha_bx", "alpha_bz")  # Table 1 (errata l.90)
+DOUBLE_UNKNOWNS = ("phi_c", "y_c", "x_b", "y_b", "z_b", "phi_b", "alpha_bx", "alpha_bz")  # Table 1 (README erratum 2)
 DOUBLE_INPUTS = ("phi_a", "alpha_cx", "alpha_cz", "x_c", "z_c")
 
 
@@ -535,6 +546,7 @@ def _ramp_double(p: CouplerParams, inp: np.ndarray, n: int = 8) -> np.ndarray:
 
 @dataclass
 class DoubleRevolution:
+    """Double-coupler FPP over one revolution: phi_a (n,), u (n, 8) in DOUBLE_UNKNOWNS order, the inputs."""
     phi_a: np.ndarray
     u: np.ndarray  # (n, 8) ordered as DOUBLE_UNKNOWNS
     inputs: np.ndarray  # (alpha_cx, alpha_cz, x_c, z_c)
@@ -737,6 +749,7 @@ def solve_double_wrapped_batch(p: CouplerParams, phi_a: np.ndarray, rest: np.nda
 
 
 def double_output_angle(p: CouplerParams, inp: np.ndarray, guess: np.ndarray | None = None) -> float:
+    """Output angle phi_c [rad] of the double coupler at inputs (phi_a, alpha_cx, alpha_cz, x_c, z_c)."""
     return float(solve_double(p, inp, guess)[0])
 
 

@@ -21,6 +21,7 @@ def branch_angle(mechanism: str, q: np.ndarray) -> np.ndarray:
 
 
 def run(scene: Scene) -> SimResult:
+    """Time simulation of the scene's IFToMM mechanism (MuJoCo or the Pinocchio reference) as a SimResult."""
     p = scene.build_params()
     mech = scene.effects["mechanism"]
     rate = float(scene.input.get("rate", 0.0))  # the scene loader fills in the declared default (0: at rest)

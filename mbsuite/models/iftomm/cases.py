@@ -90,6 +90,8 @@ def _iftomm_drift_100s(ck: Checker) -> None:
 
 
 class FourbarStudy(Study):
+    """Work-precision study of the four-bar: MuJoCo integrators x timesteps and Pinocchio (scipy methods x
+    rtol) against the closed form on the parallelogram branch, psi'' = -(6/5) g cos psi."""
     MJ_INTEGRATORS = ("euler", "implicitfast", "rk4")
     MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4)
     PIN = {"DOP853": (1e-4, 1e-6, 1e-8, 1e-10), "LSODA": (1e-4, 1e-6, 1e-8), "Radau": (1e-4, 1e-6, 1e-8)}
@@ -109,6 +111,7 @@ class FourbarStudy(Study):
         self.g = float(scene.build_params().gravity)
 
     def settings(self) -> list[Setting]:
+        """The settings of the study: MuJoCo integrators x timesteps, Pinocchio methods x tolerances."""
         out = []
         for i in (("rk4",) if self.quick else self.MJ_INTEGRATORS):
             for h in ((1e-3,) if self.quick else self.MJ_STEPS):
@@ -121,6 +124,7 @@ class FourbarStudy(Study):
         return out
 
     def reference(self):
+        """The closed-form reference on the parallelogram branch (DOP853, rtol 1e-13)."""
         from scipy.integrate import solve_ivp
 
         t = np.arange(0.0, self.base.solver.duration + 5e-3, 1e-2)
@@ -132,9 +136,11 @@ class FourbarStudy(Study):
             "reference": "closed form on the parallelogram branch, psi'' = -(6/5) g cos(psi), DOP853 rtol 1e-13"}
 
     def state_error(self, res, ref) -> float:
+        """max_t |crank angle - reference| [rad]."""
         return float(np.max(np.abs(np.interp(ref["t"], res.t, res["input_angle"]) - ref["angle"])))
 
     def physics_error(self, res, ref):
+        """Physics error of one setting and its parts (the class's `physics_doc`)."""
         turns = (res["input_angle"][-1] - res["input_angle"][0]) / (2 * math.pi)
         turns_ref = (ref["angle"][-1] - ref["angle"][0]) / (2 * math.pi)
         det = {"turns_rel": _rel(turns, turns_ref), "closure_residual": res.stats["closure_residual_max"],
@@ -164,6 +170,7 @@ HARD_CASES: tuple[HardCase, ...] = (
 
 
 def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    """The IFToMM work-precision study (the four-bar; the Bricard has no closed form)."""
     return FourbarStudy(scene, quick=quick)
 
 

@@ -52,6 +52,7 @@ class Closure:
 
 @dataclass
 class Trajectory:
+    """A simulated trajectory: samples t, q, v, energy [J] and closure error [m], plus solver statistics."""
     t: np.ndarray
     q: np.ndarray  # (N, nq)
     v: np.ndarray  # (N, nv)
@@ -250,6 +251,7 @@ class PinocchioMechanism:
         return np.concatenate(r), np.vstack(J)
 
     def closure(self, q: np.ndarray) -> np.ndarray:
+        """Closure errors (stacked point gaps [m]) at q."""
         return self._points(q)[0]
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -280,11 +282,14 @@ class PinocchioMechanism:
         return np.concatenate([v, a])
 
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
+        """Kinetic plus potential energy [J] at (q, v) (Pinocchio)."""
         return float(pin.computeKineticEnergy(self.model, self.data, q, v)
                      + pin.computePotentialEnergy(self.model, self.data, q))
 
     def simulate(self, v0: np.ndarray, duration: float, sample_dt: float, method: str = "DOP853",
                  rtol: float = 1e-10, atol: float = 1e-12, max_step: float = 0.0) -> Trajectory:
+        """Integrate from the initial pose with velocity v0 for `duration` s (scipy `method`), sampled every
+        `sample_dt`; on the four-bar the reduced branch dynamics, else the penalty formulation (`rhs`)."""
         nq = self.model.nq
         if self.branch is not None:
             s0 = np.linalg.lstsq(self.branch, v0, rcond=None)[0]

@@ -1,9 +1,10 @@
-"""Wall and CPU time of one EN 50318 reference run (shipped scene: 0.5 m elements, dt 2e-4 s) and of the finer
-settings, median of --repeats runs, with the cost per step and of the banded solve alone; with --eppinger also one
-passage of the Eppinger pantograph on each engine path (0.5 m, dt 1e-4 s: the eppinger_lab scene's setting), with the
-cost per pantograph trial step.
+"""CPU time of one EN 50318 reference run (shipped scene: 0.5 m elements, dt 2e-4 s), the readable Python path and
+the compiled step core side by side (median of --repeats, alternating), with the cost per step, the banded solve
+alone (LAPACK dpbtrs and the core's block sweeps), and the catenary alone against the catenary with the 2-mass
+pantograph in the core (same steps, no contact point vs one); with --eppinger also one passage of the Eppinger
+pantograph on each engine path (0.5 m, dt 1e-4 s). Run it on one core: `taskset -c 0`.
 
-    .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
+    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
 """
 
 from __future__ import annotations
@@ -16,46 +17,88 @@ import numpy as np
 
 from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.fe import assemble
+from mbsuite.models.catenary.native_core import NativeCore
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams
-from mbsuite.models.catenary.sim import CoupledSimulation
+from mbsuite.models.catenary.sim import CHECK_EVERY, CoupledSimulation
 from mbsuite.results import format_table
+
+STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
+
+
+def _panto(p: CatenaryParams) -> TwoMassPantograph:
+    return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
+
+
+def core_loop_cpu(p: CatenaryParams, speed_kmh: float, dt: float, with_pantograph: bool) -> float:
+    """CPU seconds of the core's step loop over a whole passage, with the 2-mass pantograph or with no contact point
+    (the catenary alone, from the same static state)."""
+    fe = assemble(p)
+    sim = CoupledSimulation(fe, _panto(p), speed_kmh / 3.6, dt)
+    ps = sim.start(p.x_start, p.x_end)
+    core = NativeCore(sim, 1, np.array([p.x_start]), np.array([p.x_end]))
+    core.u[:], core.q[:], core.p[:] = ps.u, ps.q, ps.p
+    core.place(0, p.x_start)
+    if with_pantograph:
+        core.present[0], core.active[0] = 1, 1
+        core.set_force(0, ps.force)
+        core.head[0] = ps.head
+        sim.panto.pack(core.pm[0:16], dt)
+    c0 = time.process_time()
+    code = core.run(0, ps.nsteps, CHECK_EVERY)
+    cpu = time.process_time() - c0
+    if code:
+        raise RuntimeError(f"core loop failed with code {code}")
+    return cpu
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--speeds", type=float, nargs="+", default=[250.0, 300.0])
-    ap.add_argument("--settings", nargs="+", default=["0.5,2e-4", "0.5,1e-4", "0.25,1e-4"])
+    ap.add_argument("--element-length", type=float, default=0.5)
+    ap.add_argument("--timestep", type=float, default=2e-4)
     ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
     a = ap.parse_args()
-    rows = []
-    for setting in a.settings:
-        h, dt = (float(v) for v in setting.split(","))
-        p = CatenaryParams(element_length=h)
-        fe = assemble(p)
-        sim = CoupledSimulation(fe, TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0), 70.0, dt)
-        b = np.random.default_rng(0).random(fe.n)
-        t0 = time.perf_counter()
-        for _ in range(2000):
-            sim.lu.solve(b)
-        solve_us = (time.perf_counter() - t0) / 2000 * 1e6
-        for v in a.speeds:
-            walls, cpus, steps = [], [], 0
-            for _ in range(a.repeats):
-                w0, c0 = time.perf_counter(), time.process_time()
-                run = simulate(p, v, dt)
-                walls.append(time.perf_counter() - w0)
-                cpus.append(time.process_time() - c0)
+    p = CatenaryParams(element_length=a.element_length)
+    dt = a.timestep
+    fe = assemble(p)
+    sim = CoupledSimulation(fe, _panto(p), 70.0, dt)
+    core = NativeCore(sim, 1, np.array([0.0]), np.array([p.x_end]))
+    b = np.random.default_rng(0).random(fe.n)
+    c0 = time.process_time()
+    for _ in range(2000):
+        sim.lu.solve(b)
+    lapack_us = (time.process_time() - c0) / 2000 * 1e6
+    c0 = time.process_time()
+    for _ in range(2000):
+        core.solve(b)
+    core_us = (time.process_time() - c0) / 2000 * 1e6
+    print(f"banded solve ({fe.n} DOFs, half-bandwidth {sim.lu.bandwidth}): LAPACK dpbtrs {lapack_us:.1f} us, "
+          f"core block sweeps {core_us:.1f} us (blocked = {core.blocked})")
+    rows, diffs = [], []
+    for v in a.speeds:
+        cpu = {False: [], True: []}
+        stats = {}
+        for _ in range(a.repeats):
+            for native in (False, True):
+                c0 = time.process_time()
+                run = simulate(p, v, dt, native=native)
+                cpu[native].append(time.process_time() - c0)
+                stats[native] = run.stats
                 steps = run.timing["steps"]
-            wall, cpu = statistics.median(walls), statistics.median(cpus)
-            rows.append([h, dt, v, fe.n, steps, f"{wall:.2f}", f"{cpu:.2f}", f"{1e6 * cpu / steps:.0f}",
-                         f"{solve_us:.0f}"])
-    print(format_table(["h (m)", "dt (s)", "km/h", "DOFs", "steps", "wall (s)", "CPU (s)", "CPU us/step",
-                        "solve us"], rows))
+        py, c = statistics.median(cpu[False]), statistics.median(cpu[True])
+        d = max(abs(stats[True][k] - stats[False][k]) for k in STATS)
+        diffs.append(d)
+        alone = statistics.median(core_loop_cpu(p, v, dt, False) for _ in range(a.repeats))
+        coupled = statistics.median(core_loop_cpu(p, v, dt, True) for _ in range(a.repeats))
+        rows.append([v, steps, f"{py:.2f}", f"{c:.2f}", f"{py / c:.2f}", f"{1e6 * py / steps:.0f}",
+                     f"{1e6 * c / steps:.0f}", f"{alone:.2f}", f"{coupled:.2f}", f"{coupled / alone:.2f}",
+                     f"{d:.1e}"])
+    print(format_table(["km/h", "steps", "Python CPU (s)", "core CPU (s)", "speed-up", "Python us/step",
+                        "core us/step", "catenary alone (s)", "with 2-mass (s)", "ratio", "max |stat diff|"], rows))
     if a.eppinger:
         rows = []
-        p = CatenaryParams(element_length=0.5)
         for engine in ("reference", "mujoco"):
             for v in a.speeds:
                 walls, cpus = [], []
@@ -65,9 +108,9 @@ def main() -> None:
                     walls.append(time.perf_counter() - w0)
                     cpus.append(time.process_time() - c0)
                 steps, trials = run.timing["steps"], run.result.stats["local_solves"]
-                cpu = statistics.median(cpus)
-                rows.append([engine, v, steps, trials, f"{statistics.median(walls):.2f}", f"{cpu:.2f}",
-                             f"{1e6 * cpu / steps:.0f}"])
+                cpu_ = statistics.median(cpus)
+                rows.append([engine, v, steps, trials, f"{statistics.median(walls):.2f}", f"{cpu_:.2f}",
+                             f"{1e6 * cpu_ / steps:.0f}"])
         print()
         print(format_table(["Eppinger path", "km/h", "steps", "trial steps", "wall (s)", "CPU (s)", "CPU us/step"],
                            rows))

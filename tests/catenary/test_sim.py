@@ -177,7 +177,7 @@ def test_passage_is_a_step_object_and_run_its_driver():
     assert ps.n == ps.nsteps == 1440 and ps.x == 50.0 and ps.t == pytest.approx(1440 * 2e-4)
     with pytest.raises(RuntimeError, match="finished"):
         ps.step()
-    res = CoupledSimulation(fe, _panto(p), 250 / 3.6, 2e-4, "slack").run(30.0, 50.0)
+    res = CoupledSimulation(fe, _panto(p), 250 / 3.6, 2e-4, "slack").run(30.0, 50.0, native=False)  # the twin
     assert np.array_equal(res.force, forces) and np.array_equal(res.head, heads)
     start = sim.start(30.0, 50.0)
     sup = fe.full_to_free[NDOF_NODE * fe.supports + CW_W]

@@ -10,6 +10,8 @@ from ...limits import Limit
 from ...registry import Effect, ModelSpec
 from .pantographs import validate_section
 from .params import CatenaryParams
+from .quality import validate_section as validate_quality
+from .train import validate_section as validate_train
 
 
 def _run(scene, engine: str | None = None, **kw):
@@ -19,6 +21,10 @@ def _run(scene, engine: str | None = None, **kw):
 
     if engine:
         scene = scene.replace(solver={"engine": engine})
+    if "train" in scene.sections:
+        from .train import run_train_scene, train_to_simresult
+
+        return train_to_simresult(run_train_scene(scene, **kw), scene)
     return to_simresult(run_scene(scene, **kw), scene)
 
 
@@ -46,7 +52,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="en50318",
     run=_run,
-    sections={"pantograph": validate_section},
+    sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train},
     cases="mbsuite.models.catenary.cases",
     extra={"solver_defaults": {"engine": "reference", "timestep": 1e-4, "duration": 6.1}},
 )

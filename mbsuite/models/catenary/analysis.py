@@ -22,6 +22,9 @@ from .fe import CatenaryFE, assemble
 from .pantographs import Pantograph
 from .pantographs import build as build_pantograph
 from .params import MAX_ELEMENT_STEPS, CatenaryParams
+from .quality import QualityCriteria, assess, criteria_from
+from .quality import plot as quality_plot
+from .quality import table_rows as quality_table_rows
 from .sim import CoupledResult, CoupledSimulation
 from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
 
@@ -91,9 +94,15 @@ def check_size(p: CatenaryParams, speed_ms: float, dt: float, max_steps: float |
 def health(run: CatenaryRun) -> list[Figure]:
     """Health figures of a passage: the train speed against the contact wire's wave speed (bound: the near-critical
     ratio, above which the model's own results depend on mesh and step; see `speed_regime`)."""
-    return [Figure("speed_ratio", float(run.regime["speed_ratio"]), NEAR_CRITICAL_RATIO, "",
+    return health_of_regime(run.speed_kmh / 3.6, run.params)
+
+
+def health_of_regime(speed_ms: float, p: CatenaryParams) -> list[Figure]:
+    """`health` from the speed (m/s) and the catenary parameters (used by single and train passages)."""
+    c = p.cw_wave_speed
+    return [Figure("speed_ratio", float(speed_ms / c), NEAR_CRITICAL_RATIO, "",
                    "train speed / contact wire wave speed sqrt(T/rho)",
-                   f"lower input.speed below {3.6 * NEAR_CRITICAL_RATIO * run.regime['cw_wave_speed_ms']:.1f} km/h "
+                   f"lower input.speed below {3.6 * NEAR_CRITICAL_RATIO * c:.1f} km/h "
                    "or raise cw_tension; a near-critical passage needs its own mesh and step convergence study")]
 
 
@@ -123,12 +132,13 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
              pantograph: str | Pantograph = "reference2mass", contact: str = "unilateral",
              progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
              engine: str = "reference", pantograph_section: dict[str, Any] | None = None,
-             max_steps: float | None = None) -> CatenaryRun:
+             max_steps: float | None = None, native: bool | None = None) -> CatenaryRun:
     """Build, run and analyse one pantograph passage (the EN 50318 procedure). `pantograph` is a name
     (the scene's `pantograph` effect, built on the engine path `engine` with the `[pantograph]` section
     `pantograph_section`; see `pantographs.build`) or an object of the pantograph protocol. The speed and the size of
     the job (`check_size`: elements x steps against `p.max_element_steps`, steps against `max_steps`) are checked
-    before anything is built or integrated."""
+    before anything is built or integrated. `native`: the compiled step core (None: whenever it applies, see
+    `CoupledSimulation.run`; False: the readable Python path)."""
     if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
         raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
@@ -144,7 +154,7 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
         panto = pantograph
     sim = CoupledSimulation(fe, panto, V, dt, dropper_law=dropper_law, contact=contact)
     t1 = time.perf_counter()
-    res = sim.run(p.x_start, p.x_end, progress=progress)
+    res = sim.run(p.x_start, p.x_end, progress=progress, native=native)
     t2 = time.perf_counter()
     stats, ff = en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p)
     t3, c3 = time.perf_counter(), time.process_time()
@@ -162,8 +172,11 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
               "cpu_s": c3 - c0,
               "steps": res.stats["steps"], "dofs": res.stats["dofs"],
               "us_per_step": 1e6 * (t2 - t1) / max(res.stats["steps"], 1),
-              "method": "trapezoidal rule (Newmark beta=1/4), banded Cholesky (LAPACK dpbtrf/dpbtrs) factorised once, "
-                        "exact per-step contact/slack-dropper active set on precomputed influence columns"}
+              "native": bool(res.stats.get("native", False)),
+              "method": "trapezoidal rule (Newmark beta=1/4), banded Cholesky factorised once, "
+                        + ("compiled step core (native/catenary.c: block sweeps, fused mat-vec and recursions)"
+                           if res.stats.get("native") else "LAPACK dpbtrs per step (Python path)")
+                        + ", exact per-step contact/slack-dropper active set on precomputed influence columns"}
     name = pantograph if isinstance(pantograph, str) else getattr(pantograph, "name", "custom")
     eng_warn = panto.engine_warnings() if hasattr(panto, "engine_warnings") else {}
     if eng_warn:
@@ -201,13 +214,18 @@ def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides)
 def to_simresult(run: CatenaryRun, scene) -> SimResult:
     """The run as a SimResult (`results.assemble`: the scene's output signals with the declared units). The declared
     signal `uplift` stands for one column per support, `uplift_<x>m` (x = the support's position), in its unit.
-    `stats`: timings, the eight EN 50318 statistics, the static contact force and the pantograph engine's warnings;
+    `stats`: timings, the eight EN 50318 statistics, the static contact force, the pantograph engine's warnings and
+    the quality verdicts (`quality_pass`, `quality_<criterion>_pass`, `quality_nq_pct`; limits from the scene's
+    `[quality]` section, else the AC defaults);
     `events`: the contact losses in the window."""
     r = run.result
     signals = {"contact_force": r.force, "contact_force_filtered": run.filtered, "position": r.x,
                "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
+    q = quality_of(run, criteria_from(scene.sections.get("quality")))
     stats = {**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
-             "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings)}
+             "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings),
+             "quality_pass": q["pass"], **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
+             "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
     res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats,
                           health=health(run))
     if "uplift" in scene.outputs:
@@ -222,9 +240,22 @@ def _scalar_stats(run: CatenaryRun) -> dict:
     return {k: run.stats[k] for k in STAT_NAMES}
 
 
-def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[CatenaryRun] | None = None) -> Report:
+def window_time(stats: dict, dt: float) -> float:
+    """Time (s) the pantograph spent in the statistics window (its window samples times dt)."""
+    return float(stats["n_samples_window"]) * dt
+
+
+def quality_of(run: CatenaryRun, criteria: QualityCriteria) -> dict:
+    """The current-collection quality assessment of a run (`quality.assess`, the one function for every pantograph
+    under the wire)."""
+    return assess(run.stats, run.speed_kmh, criteria, window_time(run.stats, run.dt))
+
+
+def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[CatenaryRun] | None = None,
+           quality: QualityCriteria | None = None) -> Report:
     """Human table + JSON data + writer (CSV of filtered/unfiltered force, PNG plots) for one run (and optional
-    companion runs shown beside it, e.g. the linear-dropper scene)."""
+    companion runs shown beside it, e.g. the linear-dropper scene). `quality`: add the current-collection quality
+    report of every run (table, JSON `quality`, plot `quality_<pantograph>_<speed>kmh.png`)."""
     runs = [run] + list(extra_runs or [])
     key = int(round(run.speed_kmh))
     rng = ACCEPTED_RANGES.get(key) if (abs(run.speed_kmh - key) < 1e-9 and run.ranges is not None) else None
@@ -264,9 +295,22 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
                                      "static_contact_force": r.static_force, "timing": r.timing} for r in runs}}
     if rng:
         data["all_inside_ranges"] = all(v["inside"] for v in run.ranges.values())
+    assessments = []
+    if quality is not None:
+        for r in runs:
+            q = quality_of(r, quality)
+            assessments.append((f"{r.pantograph} ({r.dropper_law} droppers)", q))
+            data["runs"][r.dropper_law]["quality"] = q
+            lines.append(f"current-collection quality [{r.dropper_law} droppers], {quality.system} criteria, "
+                         f"{r.speed_kmh:g} km/h: {'PASS' if q['pass'] else 'FAIL'}")
+            lines.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
+        data["quality_pass"] = all(q["pass"] for _, q in assessments)
 
     def write(out: Path) -> list[Path]:
-        return write_run_files(runs, out)
+        files = write_run_files(runs, out)
+        if assessments:
+            files.append(quality_plot(assessments, Path(out) / f"quality_{run.pantograph}_{run.speed_kmh:g}kmh.png"))
+        return files
 
     return Report(data=data, table="\n".join(lines), write=write)
 

@@ -1,6 +1,8 @@
-"""The catenary's suite declarations: its hard case and the random admissible inputs of the random-input test
-(collected by `mbsuite.hardcases` and the suite's tests through `SPEC.cases`). The catenary declares no work-precision
-study: its accuracy evidence is the mesh/time-step convergence of the EN 50318 statistics (README, slow tests)."""
+"""The catenary's suite declarations: its hard cases (one pantograph near the wave speed; two pantographs: the
+trailing one near the warning limit, contact loss on both, slack droppers under both, a steady-arm start) and the
+random admissible inputs of the random-input test (collected by `mbsuite.hardcases` and the suite's tests through
+`SPEC.cases`). The catenary declares no work-precision study: its accuracy evidence is the mesh/time-step convergence
+of the EN 50318 statistics (README, slow tests)."""
 
 from __future__ import annotations
 
@@ -32,11 +34,126 @@ def _catenary_critical_speed(ck: Checker) -> None:
     ck.true("50 % of c: no warning, subcritical", not w and info["regime"] == "subcritical")
 
 
+#: a shortened two-pantograph line (6 spans): the leading pantograph ends at 180 + 120 = 300 m <= 360 m
+def _p6(**kw):
+    from .params import CatenaryParams
+
+    return CatenaryParams(element_length=0.5, n_spans=6, x_end=180.0, window_start=90.0, window_end=150.0, **kw)
+
+
+def _contact_law(ck: Checker, run, label: str) -> None:
+    """f = k_c max(head - wire, 0) at every step of every pantograph's record (end-of-step states)."""
+    kc = run.params.k_contact
+    for k, r in enumerate(run.results):
+        err = float(np.max(np.abs(r.force - kc * np.maximum(r.head - r.wire, 0.0))))
+        ck.le(f"{label}: pantograph {k + 1} contact law at every step (N, relative to its peak force)",
+              err / max(float(np.max(r.force)), 1.0), 1e-8)
+
+
+def _trailing_near_warning_speed(ck: Checker) -> None:
+    from .analysis import CriticalSpeedWarning
+    from .train import simulate_train
+
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        run = simulate_train(_p6(), 310.0, 2e-4, ["reference2mass", "reference2mass"], [120.0])
+    ck.true("310 km/h (70.7 % of c): CriticalSpeedWarning", any(issubclass(x.category, CriticalSpeedWarning)
+                                                               for x in w))
+    for k, r in enumerate(run.results):
+        ck.finite(f"pantograph {k + 1} record", r.force, r.head, r.wire, r.uplift)
+    _contact_law(ck, run, "310 km/h")
+    lead, trail = run.stats
+    ck.ge("the trailing pantograph, in the leading one's wave, varies more: sigma_trail / sigma_lead",
+          trail["sigma"] / lead["sigma"], 1.2)
+    ck.ge("the trailing pantograph loses contact (%)", trail["loss_pct"], 0.1)
+    ck.le("largest wire and head excursion (m; small-displacement model)",
+          max(float(np.max(np.abs(r.wire))) + float(np.max(np.abs(r.head))) for r in run.results), 0.3)
+    ck.measured.update({"sigma_lead": lead["sigma"], "sigma_trail": trail["sigma"], "loss_trail": trail["loss_pct"]})
+
+
+def _loss_on_both(ck: Checker) -> None:
+    from .train import simulate_train
+
+    run = simulate_train(_p6(F0=40.0), 300.0, 2e-4, ["reference2mass", "reference2mass"], [120.0])
+    for k, s in enumerate(run.stats):
+        ck.ge(f"pantograph {k + 1}: contact-loss events in the window", len(s["loss_events"]), 1)
+        ck.true(f"pantograph {k + 1}: loss percentage = share of window samples with force <= 0",
+                abs(s["loss_pct"] - 100 * np.mean(run.results[k].force[(run.results[k].x >= 90.0)
+                                                                         & (run.results[k].x <= 150.0)] <= 0))
+                < 1e-12, s["loss_pct"])
+        ck.finite(f"pantograph {k + 1} record", run.results[k].force, run.results[k].head)
+    _contact_law(ck, run, "F0 = 40 N, 300 km/h")
+
+
+def _slack_under_both(ck: Checker) -> None:
+    from .fe import assemble
+    from .train import simulate_train
+
+    p = _p6(F0=70.0)
+    run = simulate_train(p, 300.0, 2e-4, ["reference2mass", "reference2mass"], [120.0], record_droppers=True)
+    dx = assemble(p).x[assemble(p).droppers]
+    for k in range(2):
+        near = np.abs(run.x[:, k][:, None] - dx[None, :]) <= 10.0
+        ck.ge(f"slack dropper-steps within 10 m of pantograph {k + 1}", int((run.dropper_slack & near).sum()), 100)
+    tol = 1e-8 * p.k_dropper
+    de, ds = run.dropper_elastic[1:], run.dropper_slack[1:]
+    ck.le("slack droppers carry no elastic tension: max (T0 + k delta) of a slack dropper (N)",
+          float(np.max(de[ds])), tol)
+    ck.ge("taut droppers are in tension: min (T0 + k delta) of a taut dropper (N)", float(np.min(de[~ds])), -tol)
+    _contact_law(ck, run, "F0 = 70 N")
+
+
+def _trailing_starts_on_a_steady_arm(ck: Checker) -> None:
+    from .analysis import simulate
+    from .train import simulate_train
+
+    p = _p6()
+    run = simulate_train(p, 250.0, 2e-4, ["reference2mass", "reference2mass"], [120.0])
+    single = simulate(p, 250.0, 2e-4)
+    r = run.results[1]
+    n_entry = int(round(120.0 / (250 / 3.6) / 2e-4))
+    ck.true("at its entry step the trailing pantograph is at the pinned support x = 0 and the leading one on the "
+            "steady arm at 120 m", r.x[0] == 0.0 and run.x[n_entry, 1] == 0.0 and abs(run.x[n_entry, 0] - 120.0)
+            < 1e-9, (float(run.x[n_entry, 1]), float(run.x[n_entry, 0])))
+    ck.le("its start state is the single pantograph's: |static force - single's| (N)",
+          abs(run.static_forces[1] - single.static_force), 1e-9)
+    ck.finite("both records", run.results[0].force, r.force, r.uplift)
+    # each steady arm's uplift is charged to the pantograph within 30 m of it only
+    sx = r.support_x
+    for k, rr in enumerate(run.results):
+        j = int(np.argmin(np.abs(sx - 120.0)))
+        near = np.abs(rr.x - 120.0) <= 30.0
+        ck.le(f"pantograph {k + 1}: uplift at 120 m is its own (mm, recomputed minus reported)",
+              abs(1000 * float(np.max(rr.uplift[near, j])) - run.stats[k]["uplift_at_supports_mm"]["120"]), 1e-9)
+    _contact_law(ck, run, "spacing 120 m")
+
+
 HARD_CASES: tuple[HardCase, ...] = (
     HardCase("catenary_critical_speed", "catenary",
              "train speed approaching the contact wire's wave speed: no steady solution",
              "catenary speed regime at 50 %, 95 %, 100 % of sqrt(T/rho)",
              "ParameterError at c; CriticalSpeedWarning near c; nothing at 50 %", _catenary_critical_speed),
+    HardCase("catenary_trailing_near_wave_speed_limit", "catenary",
+             "the trailing pantograph rides the leading one's wave just above 70 % of the wave speed",
+             "two 2-mass pantographs 120 m apart at 310 km/h (6 spans, window 90-150 m)",
+             "CriticalSpeedWarning; finite records; contact law exact every step; trailing sigma >= 1.2 x leading's "
+             "and contact loss; excursions < 0.3 m", _trailing_near_warning_speed),
+    HardCase("catenary_contact_loss_on_both", "catenary",
+             "both pantographs leave and regain the wire (unilateral contact, active set every step)",
+             "two 2-mass pantographs 120 m apart, F0 = 40 N, 300 km/h",
+             ">= 1 loss event for each; loss % equals the share of samples with f <= 0; contact law exact",
+             _loss_on_both),
+    HardCase("catenary_slack_droppers_under_both", "catenary",
+             "droppers go slack under both pantographs at once: one local problem with both contacts and the "
+             "slack set", "two 2-mass pantographs 120 m apart, F0 = 70 N, 300 km/h, dropper diagnostics",
+             "slack droppers near each pantograph; slack <=> elastic tension <= 0 at every step (1e-8 k); contact "
+             "law exact", _slack_under_both),
+    HardCase("catenary_trailing_starts_on_steady_arm", "catenary",
+             "a spacing of two spans: the trailing pantograph enters at the support while the leading one is on a "
+             "steady arm, both pass steady arms together all the way",
+             "two 2-mass pantographs 120 m apart, 250 km/h",
+             "entry at x = 0 with the single pantograph's static force (1e-9 N); each steady arm's uplift charged "
+             "to the pantograph within 30 m only; finite; contact law exact", _trailing_starts_on_a_steady_arm),
 )
 
 

@@ -130,6 +130,20 @@ class TwoMassPantograph:
     def signals(self) -> dict[str, float]:
         return {"head_displacement": float(self.x[0]), "frame_displacement": float(self.x[1])}
 
+    def pack(self, out: np.ndarray, dt: float) -> None:
+        """The state and step constants into the native core's 16 doubles (x1 x2 v1 v2, S^-1 row-major, m1 m2,
+        k11 k12 k22, F0): `native/catenary.c` advances this pantograph by the same rule."""
+        if dt != self._dt:
+            self._prepare(dt)
+        (m1, m2), (k11, k12, k22), S = self._m, self._k, self._S
+        out[:14] = (self.x[0], self.x[1], self.v[0], self.v[1], S[0][0], S[0][1], S[1][0], S[1][1], m1, m2, k11,
+                    k12, k22, self.F0)
+
+    def unpack(self, src: np.ndarray) -> None:
+        """The state back from the native core (`pack`)."""
+        self.x = np.array([src[0], src[1]], dtype=float)
+        self.v = np.array([src[2], src[3]], dtype=float)
+
     def energy(self) -> float:
         """Kinetic + spring energy (J) minus the potential of F0."""
         return float(0.5 * self.v @ self.Mm @ self.v + 0.5 * self.x @ self.Km @ self.x - self.F0 * self.x[1])

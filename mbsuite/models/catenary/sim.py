@@ -111,8 +111,9 @@ class CoupledSimulation:
         h = self.h = dt / 2
         self.alpha, self.beta = p.rayleigh()
         self.K = (fe.K0 + fe.Kd).tocsr()
-        S = (1 + h * self.alpha) * fe.M + (h * self.beta + h * h) * fe.K0 + h * h * fe.Kd
+        S = self.S = ((1 + h * self.alpha) * fe.M + (h * self.beta + h * h) * fe.K0 + h * h * fe.Kd).tocsr()
         self.lu = BandedSPD(S)
+        self.max_displacement = MAX_DISPLACEMENT
         self.mw, self.cw = fe.dropper_mw, fe.dropper_cw
         self.kd = p.k_dropper
         nd = fe.T0.size
@@ -236,12 +237,25 @@ class CoupledSimulation:
         """A passage from x_start to x_end, at its coupled static equilibrium, ready to `step()`."""
         return Passage(self, x_start, x_end)
 
+    def native_ok(self, record_every: int = 1, record_droppers: bool = False, record_energy: bool = False) -> bool:
+        """Whether `run` can step this passage in the compiled core: an affine 2-mass pantograph, every step
+        recorded, no dropper or energy diagnostics (those stay on the readable Python path)."""
+        return (record_every == 1 and not record_droppers and not record_energy
+                and hasattr(self.panto, "pack") and hasattr(self.panto, "unpack"))
+
     def run(self, x_start: float, x_end: float, progress=None, record_every: int = 1,
-            record_droppers: bool = False, record_energy: bool = False) -> CoupledResult:
+            record_droppers: bool = False, record_energy: bool = False, native: bool | None = None) -> CoupledResult:
         """Integrate the passage from x_start to x_end (`start`, then `Passage.step()` until it is finished),
         recording every `record_every` steps. `record_droppers` adds the droppers' elastic tensions and slack status;
         `record_energy` adds, at every recorded step, the energy terms of `Passage.energy_terms()`. `progress(n,
-        nsteps)` is called every CHECK_EVERY steps and at the end."""
+        nsteps)` is called every CHECK_EVERY steps and at the end. `native`: step in the compiled core
+        (`native_core`, same scheme, equal to rounding); None = whenever `native_ok`, False = the Python path."""
+        use_native = self.native_ok(record_every, record_droppers, record_energy) if native is None else native
+        if use_native:
+            if not self.native_ok(record_every, record_droppers, record_energy):
+                raise SolverError("the native core steps an affine 2-mass pantograph and records every step without "
+                                  "dropper/energy diagnostics; use native=False for this run")
+            return self._run_native(x_start, x_end, progress)
         passage = self.start(x_start, x_end)
         rec = _Recorder(passage, record_every, record_droppers, record_energy)
         t0 = time.perf_counter()
@@ -254,6 +268,47 @@ class CoupledSimulation:
         wall = time.perf_counter() - t0
         return rec.result({"steps": passage.nsteps, "wall_time_loop_s": wall, "dofs": self.fe.n,
                            "half_bandwidth": self.lu.bandwidth, "local_solves": passage.n_local})
+
+    def _run_native(self, x_start: float, x_end: float, progress=None) -> CoupledResult:
+        """`run` in the compiled core: the static start from `start` (Python), then C steps in chunks (progress
+        between chunks); records as `_Recorder`."""
+        from .native_core import NativeCore
+
+        passage = self.start(x_start, x_end)
+        fe, panto = self.fe, self.panto
+        core = NativeCore(self, 1, np.array([x_start]), np.array([x_end]))
+        core.u[:], core.q[:], core.p[:] = passage.u, passage.q, passage.p
+        core.present[0], core.active[0] = 1, int(passage.in_contact)
+        core.place(0, x_start)
+        core.set_force(0, passage.force)
+        core.head[0] = passage.head
+        panto.pack(core.pm[0:16], self.dt)
+        nsteps = passage.nsteps
+        nrec = nsteps + 1
+        T, X, F, H, W, FR = (np.zeros(nrec) for _ in range(6))
+        U = np.zeros((nrec, fe.supports.size))
+        NS = np.zeros(nrec, dtype=np.int32)
+        core.set_records(t=T, x=X, f=F, head=H, wire=W, frame=FR, up=U, ns=NS)
+        core.record(0, 0.0)
+        t0 = time.perf_counter()
+        chunk = CHECK_EVERY * 25
+        n = 0
+        while n < nsteps:
+            n1 = min(n + chunk, nsteps)
+            code = core.run(n, n1, CHECK_EVERY)
+            if code:
+                raise SolverError(_native_error(core, code, passage.static_force))
+            n = n1
+            if progress is not None:
+                progress(n, nsteps)
+        wall = time.perf_counter() - t0
+        panto.unpack(core.pm[0:16])
+        return CoupledResult(t=T, x=X, force=F, head=H, wire=W, uplift=U, n_slack=NS,
+                             panto={"head_displacement": H.copy(), "frame_displacement": FR},
+                             support_x=fe.x[fe.supports],
+                             stats={"steps": nsteps, "wall_time_loop_s": wall, "dofs": fe.n,
+                                    "half_bandwidth": self.lu.bandwidth, "local_solves": core.n_local,
+                                    "native": True})
 
     def _locate(self, xp: float, e: int) -> tuple[int, float]:
         x = self.fe.x
@@ -280,6 +335,25 @@ class CoupledSimulation:
         if getattr(self, "_Mfac", None) is None:
             self._Mfac = BandedSPD(self.fe.M)
         return self._Mfac
+
+
+def _native_error(core, code: int, static_force: float) -> str:
+    """The message of a failed native step, in the words of `Passage._check`."""
+    j = core.job
+    k = max(int(j.err_con), 0)
+    xp, yh = float(core.xc[k]), float(core.head[k])
+    if code == 4:
+        t = float(j.err_value)
+        return (f"contact/dropper active set did not settle in {int(j.max_iter)} iterations at t = {t:.6f} s "
+                f"(time step {float(j.dt)} s); reduce solver.timestep")
+    if code == 1:
+        return f"non-finite state at x = {xp:.2f} m"
+    if code == 3:
+        return (f"the pantograph lost the wire and moved {yh:+.3g} m away from it (x = {xp:.2f} m; static contact "
+                f"force {static_force:.4g} N): it cannot hold the wire")
+    return (f"catenary/pantograph displacement {abs(float(j.err_value)):.3g} m exceeds {float(j.max_disp):g} m at "
+            f"x = {xp:.2f} m: outside the small-displacement model (speed too close to the wave speed, or a "
+            "diverging pantograph)")
 
 
 class Passage:
@@ -479,17 +553,18 @@ class Passage:
 
     def _check(self) -> None:
         """Finite state, the pantograph still near the wire, displacements inside the small-displacement model."""
+        lim = self.sim.max_displacement
         umax = float(np.max(np.abs(self.u)))
         f, yh, t, xp = self.force, self.head, self.t, self.x
         if not (math.isfinite(umax) and math.isfinite(f) and math.isfinite(yh)):
             raise SolverError(f"non-finite state at t = {t:.4f} s (x = {xp:.2f} m)")
-        if abs(yh) > MAX_DISPLACEMENT and f == 0.0:
+        if abs(yh) > lim and f == 0.0:
             raise SolverError(
                 f"the pantograph lost the wire and moved {yh:+.3g} m away from it at t = {t:.4f} s "
                 f"(x = {xp:.2f} m; static contact force {self.static_force:.4g} N): it cannot hold the wire")
-        if umax > MAX_DISPLACEMENT or abs(yh) > MAX_DISPLACEMENT:
+        if umax > lim or abs(yh) > lim:
             raise SolverError(
-                f"catenary/pantograph displacement {max(umax, abs(yh)):.3g} m exceeds {MAX_DISPLACEMENT} m at "
+                f"catenary/pantograph displacement {max(umax, abs(yh)):.3g} m exceeds {lim} m at "
                 f"t = {t:.4f} s (x = {xp:.2f} m): outside the small-displacement model (speed too close "
                 "to the wave speed, or a diverging pantograph)")
 

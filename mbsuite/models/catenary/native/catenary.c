@@ -1,0 +1,688 @@
+/* The per-step core of the FE catenary under N moving contact points (mbsuite.models.catenary.native).
+ *
+ * The C twin of `sim.Passage.step` (the readable Python path; a test holds the two equal to rounding). One step of
+ * the trapezoidal rule in its midpoint form (h = dt/2, S = M + hC + h^2 K, G = h^2 S^-1):
+ *   predict:  R = q_n + h/2 g_n,  vb* = S^-1 R  (one banded Cholesky solve, S factorised once here);
+ *   contacts: per contact k its element, Hermite shape functions N_k, the wire height a_k without new local forces,
+ *             the compliances C_kl = N_k . G N_l, the influence bz_kj of contact k on dropper j, the elongations
+ *             dstar_j of the droppers;
+ *   local:    the contact forces f_k = k_c max(y_head,k - y_wire,k, 0) (unilateral) and the slack droppers' tension-
+ *             cancelling corrections s_j >= 0, solved exactly by a primal-dual active-set iteration on this
+ *             piecewise-linear problem, with each pantograph's head map y_head,k = P_k - gp_k f_k;
+ *   advance:  vb = vb* + (sum_k f_k G N_k - sum_j s_j G B_j) / (2h), u += 2h vb, and the momentum recursions
+ *             q' = 2(M - h^2 K) vb - p, p' = 2(M + h^2 K) vb - q with M vb from S vb = R (g_{n+1} included).
+ * `mbs_cat_run` loops these stages over a range of steps for affine 2-mass pantographs (EN 50318 reference
+ * pantograph, trapezoidal rule: its head map is exactly affine), recording every step; a nonlinear pantograph is
+ * coupled from Python by calling the stages one by one. No allocation: every array belongs to the caller (numpy). */
+#include <math.h>
+#include <string.h>
+
+#define CAT_ABI 1
+
+typedef struct {
+  /* sizes and switches */
+  int n, bw, nd, nsup, ncon, nnode, nnz;
+  int slack, unilateral, max_iter;
+  /* scalars of the scheme */
+  double h, hh2, c_ab, inv_1ha, c_kd, two_hh, kc, kd, V, dt, max_disp;
+  /* matrices (caller's arrays) */
+  double *L;     /* n*(bw+1): on entry the lower band of S (L[i*(bw+1)+k] = S[i][i-k]), factorised in place */
+  double *invd;  /* n: 1 / diagonal of the Cholesky factor */
+  int *Kp, *Ki;  /* CSR of K = K0 + Kd */
+  double *Kx;
+  int *mw, *cw;  /* nd: free index of the MW / CW w DOF of each dropper */
+  double *T0;    /* nd static dropper tensions */
+  double *Zg;    /* nd*n: row j = G B_j */
+  double *D;     /* nd*nd: B^T G B */
+  double *xnode; /* nnode node positions */
+  int *cwdof;    /* 2*nnode: free index of the CW (w, theta) of each node, -1 when pinned */
+  double *w0cw;  /* 2*nnode: static CW (w, theta) of each node */
+  int *supidx;   /* nsup: free index of the CW w at each support, -1 when pinned */
+  /* catenary state and work */
+  double *u, *q, *p, *R, *vbs, *vb; /* n each */
+  int *slk;      /* nd: the slack set (sorted) */
+  int nslack;
+  double *sS;    /* nd: corrections of the slack set */
+  /* contacts */
+  int *present;  /* ncon: 1 while the pantograph is on the line */
+  int *active;   /* ncon: in contact (unilateral state) */
+  int *elem;     /* ncon: current element, -1 = none cached */
+  double *xc;    /* ncon: current positions */
+  double *xs;    /* ncon: position at t = 0 (x_k = xs_k + V t) */
+  double *xend;  /* ncon: end of each run */
+  double *Nl;    /* 4*ncon shape functions (0 on pinned DOFs) */
+  int *dofs;     /* 4*ncon free DOFs of the element (pinned -> 0) */
+  double *w0d;   /* 4*ncon static CW DOFs of the element */
+  double *cols;  /* ncon*4*n: G e_d for the element's 4 CW DOFs (0 for a pinned DOF) */
+  double *f;     /* ncon contact forces at the end of the last step */
+  double *gv;    /* 4*ncon: N_k f_k of the last step (the local force g_n) */
+  double *a, *Cm, *bz, *dstar; /* ncon, ncon*ncon, ncon*nd, nd */
+  double *P, *gp; /* ncon head maps */
+  double *head;  /* ncon */
+  double *work;  /* (ncon+nd)*(ncon+nd+1) + (ncon+nd) */
+  int *iwork;    /* 2*(ncon+nd) */
+  /* 2-mass pantographs: per contact 16 doubles x1 x2 v1 v2 S00 S01 S10 S11 m1 m2 k11 k12 k22 F0 (2 spare) */
+  double *pm;
+  /* records (row = step index), may be NULL */
+  double *rec_t, *rec_x, *rec_f, *rec_head, *rec_wire, *rec_frame, *rec_up; /* nrec, nrec*ncon x4, nrec*nsup */
+  int *rec_ns;
+  /* block form of the factor (4 DOFs per node; see mbs_cat_factor) */
+  int blocked;   /* 1 when the block form is in use */
+  int *fidx;     /* n: padded index (4 * node + local DOF) of each free DOF */
+  double *blk;   /* nnode*64: per node Di = D^-1, F = D^-1 E, Dt = D^-T, G = D^-T E_next^T (row-major 4x4 each) */
+  double *pw;    /* 4*nnode padded work vector */
+  /* diagnostics */
+  long n_local;
+  int err;       /* 0 ok; 1 non-finite; 2 displacement too large; 3 lost the wire; 4 active set; 5 not SPD */
+  int err_con;
+  double err_value;
+} cat_job;
+
+int mbs_cat_abi(void) { return CAT_ABI; }
+int mbs_cat_job_size(void) { return (int)sizeof(cat_job); }
+
+/* ------------------------------------------------------------------------------------- banded Cholesky */
+/* The factor L of S (band form) seen node by node: padded with an identity row/column for each pinned DOF, L is
+ * block lower bidiagonal with 4x4 blocks (a node couples only to its neighbours, and Cholesky fills nothing outside
+ * that profile), L = [D_I on the diagonal, E_I below it]. The sweeps then run block by block,
+ *   forward  y_I = D_I^-1 b_I - (D_I^-1 E_I) y_{I-1},   backward  x_I = D_I^-T y_I - (D_I^-T E_{I+1}^T) x_{I+1},
+ * whose dependency chain is one 4x4 product per node instead of one multiply-subtract per DOF: the row sweeps of a
+ * narrow band are bound by that chain's latency, the block sweeps by arithmetic. If L has an entry outside the
+ * block profile the band sweeps are kept (blocked = 0). */
+static void inv_lower4(const double* D, double* X) {
+  memset(X, 0, sizeof(double) * 16);
+  for (int c = 0; c < 4; c++) {
+    for (int r = c; r < 4; r++) {
+      double s = (r == c) ? 1.0 : 0.0;
+      for (int k = c; k < r; k++) s -= D[r * 4 + k] * X[k * 4 + c];
+      X[r * 4 + c] = s / D[r * 4 + r];
+    }
+  }
+}
+
+static int build_blocks(cat_job* J) {
+  const int n = J->n, bw = J->bw, w = bw + 1, nn = J->nnode;
+  J->blocked = 0;
+  if (!J->blk || !J->pw || !J->fidx) return 0;
+  double* Dm = J->blk; /* reuse the storage: first D_I and E_I, then the products */
+  /* D (16) and E (16) of each node in blk[I*64 + 0..31] */
+  memset(J->blk, 0, sizeof(double) * 64 * (size_t)nn);
+  for (int I = 0; I < nn; I++) {
+    for (int r = 0; r < 4; r++) Dm[I * 64 + r * 5] = 1.0; /* identity for pinned DOFs */
+  }
+  for (int i = 0; i < n; i++) {
+    const int pi = J->fidx[i], I = pi / 4, r = pi % 4;
+    Dm[I * 64 + r * 4 + r] = J->L[(long)i * w];
+    for (int m = 1; m <= bw && m <= i; m++) {
+      const double v = J->L[(long)i * w + m];
+      const int pj = J->fidx[i - m], Jn = pj / 4, c = pj % 4;
+      if (Jn == I) {
+        Dm[I * 64 + r * 4 + c] = v;
+      } else if (Jn == I - 1) {
+        Dm[I * 64 + 16 + r * 4 + c] = v;
+      } else if (v != 0.0) {
+        return 0; /* outside the block profile: keep the band sweeps */
+      }
+    }
+  }
+  double Di[16], Ei[16], X[16];
+  /* pass 1: Di and F = Di E into slots 0 and 16 (E of node I is consumed here; keep E^T of node I for G of I-1) */
+  for (int I = nn - 1; I >= 0; I--) {
+    double* b = J->blk + (long)I * 64;
+    memcpy(Ei, b + 16, sizeof Ei);
+    inv_lower4(b, Di);
+    /* G of node I-1 needs Dt of I-1 and E_I^T: stash E_I in slot 48 of node I-1 */
+    if (I > 0) memcpy(J->blk + (long)(I - 1) * 64 + 48, Ei, sizeof Ei);
+    for (int r = 0; r < 4; r++)
+      for (int c = 0; c < 4; c++) {
+        double s = 0.0;
+        for (int k = 0; k < 4; k++) s += Di[r * 4 + k] * Ei[k * 4 + c];
+        X[r * 4 + c] = s;
+      }
+    memcpy(b, Di, sizeof Di);
+    memcpy(b + 16, X, sizeof X);
+    for (int r = 0; r < 4; r++)
+      for (int c = 0; c < 4; c++) b[32 + r * 4 + c] = Di[c * 4 + r]; /* Dt = Di^T */
+  }
+  /* pass 2: G_I = Dt_I E_{I+1}^T (E_{I+1} stashed in slot 48 of node I) */
+  for (int I = 0; I < nn; I++) {
+    double* b = J->blk + (long)I * 64;
+    if (I == nn - 1) {
+      memset(b + 48, 0, sizeof(double) * 16);
+      continue;
+    }
+    memcpy(Ei, b + 48, sizeof Ei);
+    for (int r = 0; r < 4; r++)
+      for (int c = 0; c < 4; c++) {
+        double s = 0.0;
+        for (int k = 0; k < 4; k++) s += b[32 + r * 4 + k] * Ei[c * 4 + k];
+        X[r * 4 + c] = s;
+      }
+    memcpy(b + 48, X, sizeof X);
+  }
+  J->blocked = 1;
+  return 0;
+}
+
+static void block_solve(const cat_job* J, double* x) {
+  const int n = J->n, nn = J->nnode;
+  double* y = J->pw;
+  const int* fi = J->fidx;
+  memset(y, 0, sizeof(double) * 4 * (size_t)nn);
+  for (int i = 0; i < n; i++) y[fi[i]] = x[i];
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+  for (int I = 0; I < nn; I++) {
+    const double* D = J->blk + (long)I * 64;
+    const double* F = D + 16;
+    double* v = y + 4 * I;
+    const double t0 = D[0] * v[0];
+    const double t1 = D[4] * v[0] + D[5] * v[1];
+    const double t2 = D[8] * v[0] + D[9] * v[1] + D[10] * v[2];
+    const double t3 = D[12] * v[0] + D[13] * v[1] + D[14] * v[2] + D[15] * v[3];
+    const double y0 = t0 - ((F[0] * a0 + F[1] * a1) + (F[2] * a2 + F[3] * a3));
+    const double y1 = t1 - ((F[4] * a0 + F[5] * a1) + (F[6] * a2 + F[7] * a3));
+    const double y2 = t2 - ((F[8] * a0 + F[9] * a1) + (F[10] * a2 + F[11] * a3));
+    const double y3 = t3 - ((F[12] * a0 + F[13] * a1) + (F[14] * a2 + F[15] * a3));
+    v[0] = a0 = y0;
+    v[1] = a1 = y1;
+    v[2] = a2 = y2;
+    v[3] = a3 = y3;
+  }
+  a0 = a1 = a2 = a3 = 0.0;
+  for (int I = nn - 1; I >= 0; I--) {
+    const double* T = J->blk + (long)I * 64 + 32;
+    const double* G = T + 16;
+    double* v = y + 4 * I;
+    const double t0 = T[0] * v[0] + T[1] * v[1] + T[2] * v[2] + T[3] * v[3];
+    const double t1 = T[5] * v[1] + T[6] * v[2] + T[7] * v[3];
+    const double t2 = T[10] * v[2] + T[11] * v[3];
+    const double t3 = T[15] * v[3];
+    const double x0 = t0 - ((G[0] * a0 + G[1] * a1) + (G[2] * a2 + G[3] * a3));
+    const double x1 = t1 - ((G[4] * a0 + G[5] * a1) + (G[6] * a2 + G[7] * a3));
+    const double x2 = t2 - ((G[8] * a0 + G[9] * a1) + (G[10] * a2 + G[11] * a3));
+    const double x3 = t3 - ((G[12] * a0 + G[13] * a1) + (G[14] * a2 + G[15] * a3));
+    v[0] = a0 = x0;
+    v[1] = a1 = x1;
+    v[2] = a2 = x2;
+    v[3] = a3 = x3;
+  }
+  for (int i = 0; i < n; i++) x[i] = y[fi[i]];
+}
+
+int mbs_cat_factor(cat_job* J) {
+  const int n = J->n, bw = J->bw, w = bw + 1;
+  double* L = J->L;
+  for (int i = 0; i < n; i++) {
+    for (int k = (i < bw ? i : bw); k >= 1; k--) {
+      const int j = i - k;
+      double s = L[i * w + k];
+      for (int m = k + 1; m <= bw && m <= i; m++) s -= L[i * w + m] * L[j * w + (m - k)];
+      L[i * w + k] = s * J->invd[j];
+    }
+    double d = L[i * w];
+    for (int m = 1; m <= bw && m <= i; m++) d -= L[i * w + m] * L[i * w + m];
+    if (!(d > 0.0)) {
+      J->err = 5;
+      J->err_value = (double)i;
+      return 5;
+    }
+    L[i * w] = sqrt(d);
+    J->invd[i] = 1.0 / L[i * w];
+  }
+  return build_blocks(J);
+}
+
+/* x <- S^-1 x; the forward sweep starts at `first` (entries before it are zero) */
+static void band_solve(const cat_job* J, double* x, int first) {
+  if (J->blocked) {
+    block_solve(J, x);
+    return;
+  }
+  const int n = J->n, bw = J->bw, w = bw + 1;
+  const double* L = J->L;
+  const double* invd = J->invd;
+  for (int i = first; i < n; i++) {
+    double s = x[i];
+    const int mmax = (i - first < bw ? i - first : bw);
+    const double* Li = L + (long)i * w;
+    for (int m = 1; m <= mmax; m++) s -= Li[m] * x[i - m];
+    x[i] = s * invd[i];
+  }
+  for (int i = n - 1; i >= 0; i--) {
+    double s = x[i];
+    const int mmax = (n - 1 - i < bw ? n - 1 - i : bw);
+    for (int m = 1; m <= mmax; m++) s -= L[(long)(i + m) * w + m] * x[i + m];
+    x[i] = s * invd[i];
+  }
+}
+
+void mbs_cat_solve(cat_job* J, double* x) { band_solve(J, x, 0); }
+
+/* ----------------------------------------------------------------------------------------- contacts */
+/* G e_d into col (n), zero for a pinned DOF */
+static void unit_column(const cat_job* J, int d, double* col) {
+  memset(col, 0, sizeof(double) * J->n);
+  if (d < 0) return;
+  col[d] = 1.0;
+  band_solve(J, col, d);
+  const double hh = J->h * J->h;
+  for (int i = 0; i < J->n; i++) col[i] *= hh;
+}
+
+static void set_element(cat_job* J, int k, int e) {
+  const int n = J->n;
+  double* cols = J->cols + (long)k * 4 * n;
+  const int old = J->elem[k];
+  if (old == e) return;
+  if (old >= 0 && e == old + 1) {
+    memmove(cols, cols + 2 * (long)n, sizeof(double) * 2 * n);
+  } else {
+    unit_column(J, J->cwdof[2 * e], cols);
+    unit_column(J, J->cwdof[2 * e + 1], cols + n);
+  }
+  unit_column(J, J->cwdof[2 * (e + 1)], cols + 2 * (long)n);
+  unit_column(J, J->cwdof[2 * (e + 1) + 1], cols + 3 * (long)n);
+  for (int m = 0; m < 4; m++) {
+    const int d = J->cwdof[2 * e + m];
+    J->dofs[4 * k + m] = d >= 0 ? d : 0;
+    J->w0d[4 * k + m] = J->w0cw[2 * e + m];
+  }
+  J->elem[k] = e;
+}
+
+static int locate(const cat_job* J, double xp, int e) {
+  const double* x = J->xnode;
+  const int last = J->nnode - 2;
+  if (e < 0) e = 0;
+  while (e < last && xp > x[e + 1]) e++;
+  while (e > 0 && xp < x[e]) e--;
+  return e;
+}
+
+/* element, shape functions and geometry of contact k at position xp */
+void mbs_cat_place(cat_job* J, int k, double xp) {
+  const int e = locate(J, xp, J->elem[k]);
+  set_element(J, k, e);
+  const double he = J->xnode[e + 1] - J->xnode[e];
+  const double xi = (xp - J->xnode[e]) / he;
+  const double x2 = xi * xi, x3 = x2 * xi;
+  const double N[4] = {1 - 3 * x2 + 2 * x3, he * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, he * (x3 - x2)};
+  for (int m = 0; m < 4; m++) J->Nl[4 * k + m] = J->cwdof[2 * e + m] >= 0 ? N[m] : 0.0;
+  J->xc[k] = xp;
+}
+
+/* CW height at contact k from the current u (static sag included) */
+double mbs_cat_wire(const cat_job* J, int k) {
+  double s = 0.0;
+  for (int m = 0; m < 4; m++) s += J->Nl[4 * k + m] * (J->w0d[4 * k + m] + J->u[J->dofs[4 * k + m]]);
+  return s;
+}
+
+/* ------------------------------------------------------------------------------------------ stages */
+/* R = q + h/2 g_n and vb* = S^-1 R; contact quantities a, Cm, bz and the dropper elongations dstar */
+void mbs_cat_predict(cat_job* J, double t_new) {
+  const int n = J->n, nc = J->ncon, nd = J->nd;
+  const double hh2 = J->hh2, h2 = 2 * J->h;
+  double *R = J->R, *vbs = J->vbs, *u = J->u;
+  memcpy(R, J->q, sizeof(double) * n);
+  for (int k = 0; k < nc; k++) {
+    for (int m = 0; m < 4; m++) {
+      const double g = J->gv[4 * k + m];
+      if (g != 0.0) R[J->dofs[4 * k + m]] += hh2 * g;
+    }
+  }
+  for (int a = 0; a < J->nslack; a++) {
+    const int j = J->slk[a];
+    R[J->mw[j]] -= hh2 * J->sS[a];
+    R[J->cw[j]] += hh2 * J->sS[a];
+  }
+  memcpy(vbs, R, sizeof(double) * n);
+  band_solve(J, vbs, 0);
+  for (int k = 0; k < nc; k++) {
+    if (!J->present[k]) continue;
+    double xp = J->xs[k] + J->V * t_new;
+    if (xp > J->xend[k]) xp = J->xend[k];
+    mbs_cat_place(J, k, xp);
+    const double* N = J->Nl + 4 * k;
+    const int* dk = J->dofs + 4 * k;
+    double s = 0.0, s0 = 0.0;
+    for (int m = 0; m < 4; m++) {
+      s += N[m] * (u[dk[m]] + h2 * vbs[dk[m]]);
+      s0 += N[m] * J->w0d[4 * k + m];
+    }
+    J->a[k] = s + s0;
+  }
+  for (int k = 0; k < nc; k++) {
+    if (!J->present[k]) continue;
+    const double* N = J->Nl + 4 * k;
+    const int* dk = J->dofs + 4 * k;
+    for (int l = 0; l < nc; l++) {
+      if (!J->present[l]) {
+        J->Cm[k * nc + l] = 0.0;
+        continue;
+      }
+      const double* cl = J->cols + (long)l * 4 * n;
+      const double* Nl = J->Nl + 4 * l;
+      double c = 0.0;
+      for (int m = 0; m < 4; m++) {
+        double z = 0.0;
+        for (int r = 0; r < 4; r++) z += cl[(long)r * n + dk[m]] * Nl[r];
+        c += N[m] * z;
+      }
+      J->Cm[k * nc + l] = c;
+    }
+    if (J->slack) {
+      const double* ck = J->cols + (long)k * 4 * n;
+      for (int j = 0; j < nd; j++) {
+        const int im = J->mw[j], ic = J->cw[j];
+        double z = 0.0;
+        for (int r = 0; r < 4; r++) z += (ck[(long)r * n + im] - ck[(long)r * n + ic]) * N[r];
+        J->bz[k * nd + j] = z;
+      }
+    }
+  }
+  if (J->slack) {
+    for (int j = 0; j < nd; j++) {
+      const int im = J->mw[j], ic = J->cw[j];
+      J->dstar[j] = (u[im] - u[ic]) + h2 * (vbs[im] - vbs[ic]);
+    }
+  }
+}
+
+/* dense solve A x = r (m x m, row-major, partial pivoting); A and r are overwritten, x in r */
+static int dense_solve(double* A, double* r, int m) {
+  for (int c = 0; c < m; c++) {
+    int piv = c;
+    double best = fabs(A[c * m + c]);
+    for (int i = c + 1; i < m; i++) {
+      if (fabs(A[i * m + c]) > best) {
+        best = fabs(A[i * m + c]);
+        piv = i;
+      }
+    }
+    if (best == 0.0) return 1;
+    if (piv != c) {
+      for (int j = 0; j < m; j++) {
+        double tmp = A[c * m + j];
+        A[c * m + j] = A[piv * m + j];
+        A[piv * m + j] = tmp;
+      }
+      double tmp = r[c];
+      r[c] = r[piv];
+      r[piv] = tmp;
+    }
+    const double inv = 1.0 / A[c * m + c];
+    for (int i = c + 1; i < m; i++) {
+      const double fct = A[i * m + c] * inv;
+      if (fct == 0.0) continue;
+      for (int j = c + 1; j < m; j++) A[i * m + j] -= fct * A[c * m + j];
+      r[i] -= fct * r[c];
+    }
+  }
+  for (int c = m - 1; c >= 0; c--) {
+    double s = r[c];
+    for (int j = c + 1; j < m; j++) s -= A[c * m + j] * r[j];
+    r[c] = s / A[c * m + c];
+  }
+  return 0;
+}
+
+/* the local problem: contact forces f (present contacts) and the slack set with its corrections, given the head
+ * maps P - gp f of the pantographs (active-set iteration, see the file's comment and sim.Passage.solve_local) */
+int mbs_cat_local(cat_job* J) {
+  const int nc = J->ncon, nd = J->nd;
+  const double kc = J->kc, kd = J->kd;
+  int* act_idx = J->iwork;        /* active contacts */
+  int* in_s = J->iwork + nc + nd; /* membership of the slack set (nd) */
+  double* f = J->f;
+  double* s = J->sS;
+  int* S = J->slk;
+  for (int it = 0; it < J->max_iter; it++) {
+    int na = 0;
+    for (int k = 0; k < nc; k++) {
+      if (J->present[k] && J->active[k]) act_idx[na++] = k;
+    }
+    const int ms = J->nslack, m = na + ms;
+    double* A = J->work;
+    double* r = J->work + (long)m * m;
+    for (int i = 0; i < na; i++) {
+      const int k = act_idx[i];
+      for (int j = 0; j < na; j++) A[i * m + j] = kc * J->Cm[k * nc + act_idx[j]];
+      A[i * m + i] += 1.0 + kc * J->gp[k];
+      for (int b = 0; b < ms; b++) A[i * m + na + b] = -kc * J->bz[k * nd + S[b]];
+      r[i] = kc * (J->P[k] - J->a[k]);
+    }
+    for (int b = 0; b < ms; b++) {
+      const int j = S[b], row = na + b;
+      for (int i = 0; i < na; i++) A[row * m + i] = kd * J->bz[act_idx[i] * nd + j];
+      for (int c = 0; c < ms; c++) A[row * m + na + c] = (b == c ? 1.0 : 0.0) - kd * J->D[j * nd + S[c]];
+      r[row] = -J->T0[j] - kd * J->dstar[j];
+    }
+    if (m > 0 && dense_solve(A, r, m)) {
+      J->err = 4;
+      return 4;
+    }
+    for (int k = 0; k < nc; k++) f[k] = 0.0;
+    for (int i = 0; i < na; i++) f[act_idx[i]] = r[i];
+    for (int b = 0; b < ms; b++) s[b] = r[na + b];
+    int changed = 0;
+    if (J->unilateral) {
+      for (int k = 0; k < nc; k++) {
+        if (!J->present[k]) continue;
+        if (J->active[k]) {
+          if (f[k] < 0) {
+            J->active[k] = 0;
+            changed = 1;
+          }
+        } else {
+          double gap = J->P[k] - J->a[k];
+          for (int l = 0; l < nc; l++) gap -= J->Cm[k * nc + l] * f[l];
+          for (int b = 0; b < ms; b++) gap += J->bz[k * nd + S[b]] * s[b];
+          if (gap > 0) {
+            J->active[k] = 1;
+            changed = 1;
+          }
+        }
+      }
+    }
+    if (J->slack) {
+      for (int j = 0; j < nd; j++) in_s[j] = 0;
+      for (int b = 0; b < ms; b++) in_s[S[b]] = 1;
+      int setchange = 0;
+      for (int b = 0; b < ms; b++) {
+        if (s[b] < 0) {
+          in_s[S[b]] = 0;
+          setchange = 1;
+        }
+      }
+      for (int j = 0; j < nd; j++) {
+        double d = J->dstar[j];
+        for (int k = 0; k < nc; k++) d += J->bz[k * nd + j] * f[k];
+        for (int b = 0; b < ms; b++) d -= J->D[j * nd + S[b]] * s[b];
+        const double tension = J->T0[j] + kd * d;
+        int was = 0;
+        for (int b = 0; b < ms; b++) was |= (S[b] == j);
+        if (tension < 0 && !was) {
+          in_s[j] = 1;
+          setchange = 1;
+        }
+      }
+      if (setchange) {
+        int c = 0;
+        for (int j = 0; j < nd; j++) {
+          if (in_s[j]) S[c++] = j;
+        }
+        J->nslack = c;
+        changed = 1;
+      }
+    }
+    if (!changed) return 0;
+  }
+  J->err = 4;
+  return 4;
+}
+
+/* the end-of-step state from f and the slack corrections; the new local forces g_{n+1} */
+void mbs_cat_advance(cat_job* J) {
+  const int n = J->n, nc = J->ncon, nd = J->nd;
+  const double inv2h = 1.0 / (2 * J->h), h2 = 2 * J->h, hh2 = J->hh2;
+  double *vb = J->vb, *R = J->R, *u = J->u, *q = J->q, *p = J->p;
+  memcpy(vb, J->vbs, sizeof(double) * n);
+  for (int k = 0; k < nc; k++) {
+    if (!J->present[k] || J->f[k] == 0.0) continue;
+    const double* ck = J->cols + (long)k * 4 * n;
+    const double* N = J->Nl + 4 * k;
+    const double w0 = N[0] * J->f[k] * inv2h, w1 = N[1] * J->f[k] * inv2h, w2 = N[2] * J->f[k] * inv2h,
+                 w3 = N[3] * J->f[k] * inv2h;
+    for (int i = 0; i < n; i++) vb[i] += ck[i] * w0 + ck[n + i] * w1 + ck[2 * n + i] * w2 + ck[3 * n + i] * w3;
+  }
+  for (int b = 0; b < J->nslack; b++) {
+    const double* z = J->Zg + (long)J->slk[b] * n;
+    const double c = J->sS[b] * inv2h;
+    for (int i = 0; i < n; i++) vb[i] -= z[i] * c;
+  }
+  for (int i = 0; i < n; i++) u[i] += h2 * vb[i];
+  for (int k = 0; k < nc; k++) {
+    for (int m = 0; m < 4; m++) {
+      const double g = J->present[k] ? J->Nl[4 * k + m] * J->f[k] : 0.0;
+      J->gv[4 * k + m] = g;
+      if (g != 0.0) R[J->dofs[4 * k + m]] += hh2 * g;
+    }
+  }
+  for (int b = 0; b < J->nslack; b++) {
+    const int j = J->slk[b];
+    R[J->mw[j]] -= hh2 * J->sS[b];
+    R[J->cw[j]] += hh2 * J->sS[b];
+  }
+  const double c_ab = J->c_ab, inv = J->inv_1ha, thh = J->two_hh;
+  const int *Kp = J->Kp, *Ki = J->Ki;
+  const double* Kx = J->Kx;
+  for (int i = 0; i < n; i++) {
+    double kv = 0.0;
+    for (int a = Kp[i]; a < Kp[i + 1]; a++) kv += Kx[a] * vb[Ki[a]];
+    const double A2 = 2.0 * ((R[i] - c_ab * kv) * inv);
+    const double B2 = thh * kv;
+    const double qn = A2 - B2 - p[i];
+    p[i] = A2 + B2 - q[i];
+    q[i] = qn;
+  }
+  const double ckd = 2.0 * J->kd * J->c_kd;
+  for (int j = 0; j < nd; j++) {
+    const int im = J->mw[j], ic = J->cw[j];
+    const double dv = ckd * (vb[im] - vb[ic]);
+    q[im] += dv;
+    p[im] += dv;
+    q[ic] -= dv;
+    p[ic] -= dv;
+  }
+}
+
+/* finite state, displacements inside the small-displacement model, a pantograph not flying away */
+int mbs_cat_check(cat_job* J) {
+  double umax = 0.0;
+  for (int i = 0; i < J->n; i++) {
+    const double a = fabs(J->u[i]);
+    if (!(a <= umax)) umax = a; /* NaN propagates */
+  }
+  for (int k = 0; k < J->ncon; k++) {
+    if (!J->present[k]) continue;
+    const double y = J->head[k], f = J->f[k];
+    if (!(isfinite(umax) && isfinite(y) && isfinite(f))) {
+      J->err = 1, J->err_con = k, J->err_value = umax;
+      return 1;
+    }
+    if (fabs(y) > J->max_disp && f == 0.0) {
+      J->err = 3, J->err_con = k, J->err_value = y;
+      return 3;
+    }
+    if (fabs(y) > J->max_disp) {
+      J->err = 2, J->err_con = k, J->err_value = y;
+      return 2;
+    }
+  }
+  if (!isfinite(umax)) {
+    J->err = 1, J->err_con = -1, J->err_value = umax;
+    return 1;
+  }
+  if (umax > J->max_disp) {
+    J->err = 2, J->err_con = -1, J->err_value = umax;
+    return 2;
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------- 2-mass pantographs */
+/* head map of pantograph k over a step with force f0 -> f1: P - gp f1 (exact: the trapezoidal rule is linear) */
+static void twomass_map(cat_job* J, int k) {
+  const double* s = J->pm + 16 * k;
+  const double h = J->h, f0 = J->f[k];
+  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + 0.0) / 2;
+  const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
+  J->P[k] = s[0] + 2 * h * (s[4] * r1 + s[5] * r2);
+  J->gp[k] = h * h * s[4];
+}
+
+static void twomass_commit(cat_job* J, int k, double f0, double f1) {
+  double* s = J->pm + 16 * k;
+  const double h = J->h;
+  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + f1) / 2;
+  const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
+  const double vb1 = s[4] * r1 + s[5] * r2;
+  const double vb2 = s[6] * r1 + s[7] * r2;
+  s[0] = s[0] + 2 * h * vb1;
+  s[1] = s[1] + 2 * h * vb2;
+  s[2] = 2 * vb1 - s[2];
+  s[3] = 2 * vb2 - s[3];
+  J->head[k] = s[0];
+}
+
+static void record(cat_job* J, long row, double t) {
+  const int nc = J->ncon;
+  if (J->rec_t) J->rec_t[row] = t;
+  for (int k = 0; k < nc; k++) {
+    if (J->rec_x) J->rec_x[row * nc + k] = J->xc[k];
+    if (J->rec_f) J->rec_f[row * nc + k] = J->present[k] ? J->f[k] : 0.0;
+    if (J->rec_head) J->rec_head[row * nc + k] = J->head[k];
+    if (J->rec_wire) J->rec_wire[row * nc + k] = J->present[k] ? mbs_cat_wire(J, k) : 0.0;
+    if (J->rec_frame) J->rec_frame[row * nc + k] = J->pm ? J->pm[16 * k + 1] : 0.0;
+  }
+  if (J->rec_up) {
+    for (int j = 0; j < J->nsup; j++) {
+      const int d = J->supidx[j];
+      J->rec_up[row * J->nsup + j] = d >= 0 ? J->u[d] : 0.0;
+    }
+  }
+  if (J->rec_ns) J->rec_ns[row] = J->nslack;
+}
+
+/* steps n0+1 .. n1 with every present contact a 2-mass pantograph; records row n after step n; checks every
+ * `check_every` steps and at n1. Returns 0 or the error code (J->err; the step in J->err_value for code 4). */
+int mbs_cat_run(cat_job* J, long n0, long n1, int check_every) {
+  const int nc = J->ncon;
+  double fprev[64];
+  if (nc > 64) return 6;
+  for (long n = n0 + 1; n <= n1; n++) {
+    const double t_new = (double)n * J->dt;
+    mbs_cat_predict(J, t_new);
+    for (int k = 0; k < nc; k++) {
+      fprev[k] = J->f[k];
+      if (J->present[k]) twomass_map(J, k);
+    }
+    if (mbs_cat_local(J)) {
+      J->err_value = t_new;
+      return J->err;
+    }
+    J->n_local++;
+    for (int k = 0; k < nc; k++) {
+      if (J->present[k]) twomass_commit(J, k, fprev[k], J->f[k]);
+    }
+    mbs_cat_advance(J);
+    record(J, n, t_new);
+    if ((check_every > 0 && n % check_every == 0) || n == n1) {
+      if (mbs_cat_check(J)) return J->err;
+    }
+  }
+  return 0;
+}
+
+void mbs_cat_record(cat_job* J, long row, double t) { record(J, row, t); }

@@ -1,0 +1,191 @@
+"""Current-collection quality of a pantograph passage, in the shape of EN 50367 / the TSI Energy assessment.
+
+One function, `assess(stats, speed_kmh, criteria)`, used by every pantograph-under-the-wire run (single and
+several pantographs, `mbsuite catenary SCENE --quality`), judges one pantograph's window statistics against:
+
+1. the mean contact force Fm against the target curve Fm(v) = a v^2 + b (v in km/h): inside [lower, upper] with the
+   upper curve a v^2 + b and the lower curve a v^2 + b_lower;
+2. the standard deviation sigma <= sigma_ratio_max * Fm (0.3: EN 50367 / TSI);
+3. the statistical minimum Fm - 3 sigma > stat_min_floor (0 N: the pantograph must not statistically leave the wire);
+4. the percentage of contact loss (unfiltered force <= 0 in the window) <= loss_max_pct;
+5. the arcing measure NQ = (sum of the durations of the losses that last at least arc_min_duration) / (time in the
+   window) x 100 % <= nq_max_pct;
+6. the largest uplift at the steady arms in the window <= uplift_max.
+
+Defaults and their sources. The target curves are those of Commission Regulation (EU) No 1301/2014 (TSI Energy),
+4.2.11, and EN 50367:2012 (Railway applications - Current collection systems - Technical criteria for the
+interaction between pantograph and overhead line): AC Fm = 0.00047 v^2 + 90 N (upper) with the lower curve
+0.00047 v^2 + 60 N; DC 3 kV 0.00097 v^2 + 110 N; DC 1.5 kV 0.00228 v^2 + 90 N (the DC lower curves are 30 N below
+the upper ones here, like the AC band). The DC coefficients differ between editions and sources, which is why every
+coefficient is an input. sigma <= 0.3 Fm, Fm - 3 sigma > 0 and NQ <= 0.2 % (AC) / 0.1 % (DC) are the TSI Energy's
+and EN 50367's figures. In a simulation an arc is a contact loss; arc_min_duration = 0 counts every loss (a stated
+choice: measured NQ counts the arcs a detector sees). The uplift limit is a line design input (the free space at the
+steady arm; the TSI asks for 2 S0 of the design uplift S0): default 0.12 m, i.e. room for S0 = 60 mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ...errors import ParameterError
+from ...limits import check_fields, param
+
+#: target curve coefficients per system: (a N/(km/h)^2, upper b N, lower b N), NQ limit (%)
+SYSTEMS: dict[str, dict[str, float]] = {
+    "AC": {"fm_a": 0.00047, "fm_b": 90.0, "fm_b_lower": 60.0, "nq_max_pct": 0.2},
+    "DC3kV": {"fm_a": 0.00097, "fm_b": 110.0, "fm_b_lower": 80.0, "nq_max_pct": 0.1},
+    "DC1.5kV": {"fm_a": 0.00228, "fm_b": 90.0, "fm_b_lower": 60.0, "nq_max_pct": 0.1},
+}
+
+CRITERIA = ("mean_force", "sigma", "stat_min", "contact_loss", "arcing_nq", "uplift")
+
+
+@dataclass(frozen=True)
+class QualityCriteria:
+    """Limits of the current-collection quality assessment (module docstring; SI units, speeds in km/h)."""
+
+    system: str = param("AC", kind=str, choices=tuple(SYSTEMS), doc="electrification system (label of the defaults)")
+    fm_a: float = param(0.00047, lo=0.0, hi=1.0, unit="N/(km/h)^2", doc="target curve Fm(v) = fm_a v^2 + fm_b")
+    fm_b: float = param(90.0, lo=0.0, lo_open=True, hi=1e4, unit="N", doc="upper target curve: constant term")
+    fm_b_lower: float = param(60.0, lo=0.0, hi=1e4, unit="N", doc="lower target curve: constant term")
+    sigma_ratio_max: float = param(0.3, lo=0.0, lo_open=True, hi=10.0, unit="-", doc="sigma <= ratio * Fm")
+    stat_min_floor: float = param(0.0, lo=-1e4, hi=1e4, unit="N", doc="Fm - 3 sigma must exceed this")
+    loss_max_pct: float = param(0.2, lo=0.0, hi=100.0, unit="%", doc="largest percentage of contact loss")
+    nq_max_pct: float = param(0.2, lo=0.0, hi=100.0, unit="%", doc="largest arcing measure NQ")
+    arc_min_duration: float = param(0.0, lo=0.0, hi=10.0, unit="s", doc="shortest loss counted as an arc in NQ")
+    uplift_max: float = param(0.12, lo=0.0, lo_open=True, hi=10.0, unit="m", doc="uplift limit at the steady arms")
+
+    def __post_init__(self) -> None:
+        check_fields(self, "quality criterion")
+        if not self.fm_b_lower < self.fm_b:
+            raise ParameterError(f"quality criterion fm_b_lower = {self.fm_b_lower!r} N must lie below fm_b = "
+                                 f"{self.fm_b!r} N (the lower target curve under the upper one)")
+
+    @classmethod
+    def for_system(cls, system: str = "AC", **overrides: Any) -> QualityCriteria:
+        """The defaults of `system` (SYSTEMS) with `overrides`."""
+        if system not in SYSTEMS:
+            raise ParameterError(f"quality criterion system = {system!r}; valid: {list(SYSTEMS)}")
+        return cls(system=system, **{**SYSTEMS[system], **overrides})
+
+    def target(self, speed_kmh: float) -> tuple[float, float]:
+        """(lower, upper) target mean contact force at `speed_kmh` (N); a curve that is not positive is an error."""
+        v2 = float(speed_kmh) ** 2
+        lo, hi = self.fm_a * v2 + self.fm_b_lower, self.fm_a * v2 + self.fm_b
+        if not (math.isfinite(hi) and hi > 0 and lo >= 0):
+            raise ParameterError(f"target curve Fm({speed_kmh:g} km/h) = [{lo:g}, {hi:g}] N: the target contact "
+                                 "force must be positive (fm_a, fm_b, fm_b_lower)")
+        return lo, hi
+
+
+def validate_section(value: Any) -> dict[str, Any]:
+    """Validator of a scene's `[quality]` section: `system` plus any field of QualityCriteria (the system's defaults
+    fill the rest)."""
+    from ...errors import SceneError
+
+    if not isinstance(value, dict):
+        raise SceneError(f"[quality] must be a table of QualityCriteria fields, got {value!r}")
+    names = [f.name for f in dataclasses.fields(QualityCriteria)]
+    bad = sorted(set(value) - set(names))
+    if bad:
+        raise SceneError(f"unknown key(s) {bad} in [quality]; valid keys: {names}")
+    criteria_from(value)
+    return dict(value)
+
+
+def criteria_from(section: dict[str, Any] | None) -> QualityCriteria:
+    """QualityCriteria of a `[quality]` section (or the AC defaults)."""
+    sec = dict(section or {})
+    system = sec.pop("system", "AC")
+    return QualityCriteria.for_system(system, **sec)
+
+
+def nq(events: list[dict], window_time: float, min_duration: float) -> float:
+    """Arcing measure NQ (%): summed durations of the losses lasting at least `min_duration` over `window_time`."""
+    if not window_time > 0:
+        raise ParameterError(f"the statistics window lasts {window_time!r} s; NQ needs a positive time")
+    return 100.0 * sum(e["duration"] for e in events if e["duration"] >= min_duration) / window_time
+
+
+def assess(stats: dict, speed_kmh: float, criteria: QualityCriteria, window_time: float) -> dict[str, Any]:
+    """Each criterion with its value, limit and verdict for one pantograph's window statistics `stats` (the keys of
+    `stats.en50318_statistics`) at `speed_kmh`; `window_time` is the time the pantograph spent in the window (s)."""
+    lo, hi = criteria.target(speed_kmh)
+    fm, sd = float(stats["Fm"]), float(stats["sigma"])
+    nqv = nq(stats["loss_events"], window_time, criteria.arc_min_duration)
+    up = float(stats["uplift_mm"]) / 1000.0
+    rows = {
+        "mean_force": {"label": "mean contact force Fm (N)", "value": fm, "limit": f"{lo:.1f} .. {hi:.1f}",
+                       "low": lo, "high": hi, "pass": bool(lo <= fm <= hi)},
+        "sigma": {"label": "standard deviation sigma (N)", "value": sd,
+                  "limit": f"<= {criteria.sigma_ratio_max:g} Fm = {criteria.sigma_ratio_max * fm:.2f}",
+                  "high": criteria.sigma_ratio_max * fm, "pass": bool(sd <= criteria.sigma_ratio_max * fm)},
+        "stat_min": {"label": "statistical minimum Fm-3sigma (N)", "value": fm - 3 * sd,
+                     "limit": f"> {criteria.stat_min_floor:g}", "low": criteria.stat_min_floor,
+                     "pass": bool(fm - 3 * sd > criteria.stat_min_floor)},
+        "contact_loss": {"label": "contact loss (%)", "value": float(stats["loss_pct"]),
+                         "limit": f"<= {criteria.loss_max_pct:g}", "high": criteria.loss_max_pct,
+                         "pass": bool(stats["loss_pct"] <= criteria.loss_max_pct)},
+        "arcing_nq": {"label": f"arcing NQ (%, losses >= {1000 * criteria.arc_min_duration:g} ms)", "value": nqv,
+                      "limit": f"<= {criteria.nq_max_pct:g}", "high": criteria.nq_max_pct,
+                      "pass": bool(nqv <= criteria.nq_max_pct)},
+        "uplift": {"label": "max uplift at steady arms (mm)", "value": 1000 * up,
+                   "limit": f"<= {1000 * criteria.uplift_max:g}", "high": 1000 * criteria.uplift_max,
+                   "pass": bool(up <= criteria.uplift_max)},
+    }
+    return {"speed_kmh": float(speed_kmh), "system": criteria.system, "criteria": dataclasses.asdict(criteria),
+            "window_time_s": float(window_time), "rows": rows, "pass": all(r["pass"] for r in rows.values())}
+
+
+def table_rows(q: dict[str, Any]) -> list[list[str]]:
+    """Rows (criterion, value, limit, verdict) of an assessment for `results.format_table`."""
+    return [[r["label"], f"{r['value']:.2f}", r["limit"], "pass" if r["pass"] else "FAIL"] for r in q["rows"].values()]
+
+
+def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path) -> Path:
+    """One figure: the target band Fm(v) with each pantograph's Fm +- sigma at its speed (left), and each criterion's
+    value over its limit with the verdict (right)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
+    c = QualityCriteria(**assessments[0][1]["criteria"])
+    v = np.linspace(0.0, max(400.0, max(q["speed_kmh"] for _, q in assessments)), 200)
+    ax.fill_between(v, c.fm_a * v**2 + c.fm_b_lower, c.fm_a * v**2 + c.fm_b, color="0.85",
+                    label=f"target band ({c.system}): {c.fm_a:g} v^2 + [{c.fm_b_lower:g}, {c.fm_b:g}] N")
+    names = list(CRITERIA)
+    width = 0.8 / len(assessments)
+    for i, (name, q) in enumerate(assessments):
+        r = q["rows"]
+        ax.errorbar([q["speed_kmh"]], [r["mean_force"]["value"]], yerr=[r["sigma"]["value"]], fmt="o", capsize=4,
+                    label=f"{name}: Fm +- sigma ({'pass' if q['pass'] else 'FAIL'})")
+        ratios = []
+        for k in names:
+            row = r[k]
+            if k == "mean_force":
+                ratios.append(row["value"] / row["high"])
+            elif k == "stat_min":
+                ratios.append(1.0 - (row["value"] - row["low"]) / max(r["mean_force"]["value"], 1e-9))
+            else:
+                ratios.append(row["value"] / row["high"] if row["high"] > 0 else (0.0 if row["value"] <= 0 else 2.0))
+        colors = ["tab:green" if r[k]["pass"] else "tab:red" for k in names]
+        bx.bar(np.arange(len(names)) + i * width, ratios, width, color=colors, edgecolor="k", label=name)
+    bx.axhline(1.0, color="k", lw=1)
+    bx.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=20)
+    bx.set_ylabel("value / limit (green pass, red fail)")
+    ax.set_xlabel("speed (km/h)")
+    ax.set_ylabel("mean contact force (N)")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=7)
+    bx.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

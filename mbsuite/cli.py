@@ -99,12 +99,16 @@ def _sweeping(args: argparse.Namespace):
                          store=getattr(args, "store", None), max_points=getattr(args, "max_points", None))
 
 
+MAX_REPEATS = 100
+
+
 def _cmd_workprecision(args: argparse.Namespace) -> None:
     from .analysis.workprecision import workprecision
 
     scene = load_scene(args.scene)
-    if args.repeats < 1:
-        raise MbsuiteError(f"--repeats must be >= 1, got {args.repeats}")
+    if not 1 <= args.repeats <= MAX_REPEATS:
+        raise MbsuiteError(f"--repeats {args.repeats} is invalid; valid: integer in [1, {MAX_REPEATS}] (runs per "
+                           "setting; the wall time is their median)")
     progress = (lambda msg: print(msg, file=sys.stderr, flush=True)) if args.verbose else None
     report = workprecision(scene, repeats=args.repeats, quick=args.quick, progress=progress)
     _emit(report, args, scene.to_dict())
@@ -163,6 +167,8 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
     from .results import write_csv
 
     scene = _load(args)
+    if args.workers < 0:
+        raise MbsuiteError(f"--workers {args.workers} must be >= 0 (0: all cores)")
     axes = []
     for spec in args.vary or []:
         key, sep, vals = spec.partition("=")
@@ -347,12 +353,12 @@ def build_parser() -> argparse.ArgumentParser:
     """The `mbsuite` argument parser: the generic commands plus each model's own command group."""
     from . import __version__
 
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="mbsuite", description="Cross-checked multibody models of railway mechanisms on Pinocchio and MuJoCo: "
         "run scenes, sweeps, frequency responses, work-precision studies and hard cases; `mbsuite list` shows the "
         "models and what each offers.")
     ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
-    sub = ap.add_subparsers(dest="command", required=True)
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("list", help="models and their shipped scenes")
     _common(p)
@@ -427,6 +433,17 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+class _UsageError(Exception):
+    """A command line argparse refuses (unknown command or option, a value of the wrong type)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: `mbsuite: error: <what>` naming the argument, and where to read the usage."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise _UsageError(f"{message} (usage: {self.prog} --help)")
+
+
 def _fail(message: str, as_json: bool, kind: str) -> int:
     """One line on stderr (and, under --json, a JSON object on stdout); exit status 2."""
     message = " ".join(message.split())  # messages quoting a solver's text may hold line breaks
@@ -465,9 +482,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line. Exit status: 0 success, 2 any error (one line naming the input; under --json also a JSON
     object `{"error": {...}}` on stdout), 130 interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
     ap = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = ap.parse_args(argv)
-    except SystemExit as exc:  # argparse: usage errors exit 2, --help / --version exit 0
+    except _UsageError as exc:
+        return _fail(str(exc), "--json" in argv, "UsageError")
+    except SystemExit as exc:  # --help / --version
         return int(exc.code or 0)
     as_json = bool(getattr(args, "json", False))
     try:

@@ -56,6 +56,9 @@ class ModelSpec:
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     - `mujoco_model(scene) -> (MjModel, MjData)`: the MuJoCo model of exactly the scene's effects, in its initial state
       (what `mbsuite view` shows; None: the model has no MuJoCo model).
+    - `file_checks`: model-file stem -> `check(path, engine, model)` run by the engines' loaders on a file of that
+      name (engine "mujoco" with an MjModel, "pinocchio" or "urdf" with a pin.Model); raises ModelFileError naming
+      the file, the body and the residual (e.g. a loop that cannot close at the stated link lengths).
     """
 
     name: str
@@ -76,6 +79,7 @@ class ModelSpec:
     cases: str | None = None
     under_wire: Callable[..., Any] | None = None
     mujoco_model: Callable[..., Any] | None = None
+    file_checks: Mapping[str, Callable[..., None]] = field(default_factory=dict)
 
     def suite(self) -> Any:
         """The model's suite module (`cases`), or None if it declares none."""

@@ -90,6 +90,11 @@ class SolverSettings:
         if self.timestep >= self.duration:
             raise SceneError(f"solver.timestep ({self.timestep} s) must be shorter than solver.duration "
                              f"({self.duration} s)")
+        if self.engine == "reference" and self.max_step > 0 and self.duration / self.max_step > self.max_steps:
+            raise SceneError(
+                f"solver.duration / solver.max_step = {self.duration:g} s / {self.max_step:g} s = "
+                f"{self.duration / self.max_step:.3g} steps exceeds solver.max_steps = {self.max_steps:.3g}; enlarge "
+                "solver.max_step or raise solver.max_steps (CLI: --max-steps) if you mean it")
         steps = self.duration / self.timestep
         if steps > self.max_steps:
             raise SceneError(
@@ -290,6 +295,9 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
 def load_scene(ref: str | Path) -> Scene:
     """Load a scene from a TOML path, a model name (its default scene) or `model/scene` (a shipped scene)."""
     p = Path(ref)
+    if p.is_dir():
+        raise SceneError(f"scene {p} is a directory, not a scene file (give a .toml file, a model name or "
+                         "model/scene)")
     if p.suffix == ".toml" or p.is_file():
         if not p.is_file():
             raise SceneError(f"scene file not found: {p}")
@@ -307,6 +315,8 @@ def load_scene(ref: str | Path) -> Scene:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise SceneError(f"scene file {p} is not valid TOML: {exc}") from exc
+        except RecursionError as exc:
+            raise SceneError(f"scene file {p} nests arrays or tables too deeply to be a scene") from exc
         data.setdefault("name", p.stem)
         return scene_from_dict(data, source=str(p))
     text = str(ref)

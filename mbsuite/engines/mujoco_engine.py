@@ -37,24 +37,69 @@ _CALLBACK_SETTERS = {
 _active: dict[str, Callable] = {}
 
 
+def read_model_text(path: Path) -> str:
+    """The text of a model file, refused (ModelFileError naming the file) if it is not UTF-8 or declares XML entities
+    (a DTD: entity expansion is a denial-of-service vector and no model file needs one)."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ModelFileError(f"cannot read model file {path}: {exc.strerror or exc}") from exc
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ModelFileError(f"model file {path} is not UTF-8 text (byte {exc.start})") from exc
+    if "<!DOCTYPE" in text or "<!ENTITY" in text:
+        raise ModelFileError(f"model file {path} declares a DTD or XML entities; model files may not")
+    return text
+
+
+def one_line(text: object) -> str:
+    """A parser's message on one line (MuJoCo and Pinocchio report over several)."""
+    return " ".join(str(text).split())
+
+
+def check_compiled(model: mujoco.MjModel, name: str) -> None:
+    """Checks of a compiled model that MuJoCo's compiler leaves to the user: a positive, finite timestep."""
+    h = float(model.opt.timestep)
+    if not (np.isfinite(h) and h > 0):
+        raise ModelFileError(f"{name}: option timestep = {h!r} must be a positive finite number")
+
+
 def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False) -> mujoco.MjModel:
     """Compile an MJCF file/string/MjSpec (mbsuite's engine plugins registered first); any parse or compile error is
-    re-raised as ModelFileError naming the source."""
+    re-raised as ModelFileError naming the source, on one line. A file of a model that declares checks for it
+    (`ModelSpec.file_checks`, e.g. loop closures against the stated link lengths) is checked too."""
     native.load()
+    name = "<string>" if from_string else ("<MjSpec>" if isinstance(source, mujoco.MjSpec) else str(source))
     try:
         if isinstance(source, mujoco.MjSpec):
-            return source.compile()
-        if from_string:
-            return mujoco.MjModel.from_xml_string(str(source))
-        p = Path(source)
-        if not p.is_file():
-            raise ModelFileError(f"MJCF file not found: {p}")
-        return mujoco.MjModel.from_xml_path(str(p))
+            m = source.compile()
+        elif from_string:
+            m = mujoco.MjModel.from_xml_string(str(source))
+        else:
+            p = Path(source)
+            if not p.is_file():
+                raise ModelFileError(f"MJCF file not found: {p}")
+            read_model_text(p)
+            m = mujoco.MjModel.from_xml_path(str(p))
     except ModelFileError:
         raise
     except Exception as exc:  # mujoco raises ValueError with the parser message
-        name = "<string>" if from_string else str(source)
-        raise ModelFileError(f"MuJoCo cannot load {name}: {exc}") from exc
+        raise ModelFileError(f"MuJoCo cannot load {name}: {one_line(exc)}") from exc
+    check_compiled(m, name)
+    if not from_string and not isinstance(source, mujoco.MjSpec):
+        run_file_checks(Path(source), "mujoco", m)
+    return m
+
+
+def run_file_checks(path: Path, engine: str, model: object) -> None:
+    """Run the checks a model declares for a file of that name (`ModelSpec.file_checks[stem]`), if any."""
+    from ..registry import models
+
+    for spec in models().values():
+        check = spec.file_checks.get(path.stem)
+        if check is not None:
+            check(path, engine, model)
 
 
 def set_integrator(model: mujoco.MjModel, integrator: str, timestep: float) -> None:

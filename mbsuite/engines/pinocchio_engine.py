@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -10,23 +15,61 @@ import pinocchio as pin
 from ..errors import ModelFileError
 
 
+@contextlib.contextmanager
+def _native_stderr() -> Iterator[list[str]]:
+    """Capture what C++ code writes to file descriptor 2 during the block (urdfdom reports parse errors there and
+    carries on); the captured lines are appended to the yielded list."""
+    lines: list[str] = []
+    try:
+        fd = sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):
+        yield lines
+        return
+    sys.stderr.flush()
+    saved = os.dup(fd)
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), fd)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, fd)
+            os.close(saved)
+            tmp.seek(0)
+            lines += [x for x in tmp.read().decode("utf-8", "replace").splitlines() if x.strip()]
+
+
 def _load(builder, kind: str, path: str | Path) -> pin.Model:
     p = Path(path)
     if not p.is_file():
         raise ModelFileError(f"{kind} file not found: {p}")
+    from .mujoco_engine import one_line, read_model_text, run_file_checks
+
+    read_model_text(p)
+    if kind == "MJCF":  # MuJoCo's parser is strict (types, ranges); Pinocchio's ignores what it does not read
+        from .mujoco_engine import load_model
+
+        load_model(p)
     try:
-        return builder(str(p))
+        with _native_stderr() as said:
+            model = builder(str(p))
     except Exception as exc:
-        raise ModelFileError(f"Pinocchio cannot load {kind} {p}: {exc}") from exc
+        raise ModelFileError(f"Pinocchio cannot load {kind} {p}: {one_line(exc)}") from exc
+    errors = [x for x in said if "error" in x.lower()]
+    if errors:
+        raise ModelFileError(f"Pinocchio reports errors reading {kind} {p}: {one_line('; '.join(errors))}")
+    run_file_checks(p, "urdf" if kind == "URDF" else "pinocchio", model)
+    return model
 
 
 def load_urdf(path: str | Path) -> pin.Model:
-    """Build a Pinocchio model from a URDF file; parse errors become ModelFileError naming the file."""
+    """Build a Pinocchio model from a URDF file; parse errors (also those urdfdom only prints) become
+    ModelFileError naming the file."""
     return _load(pin.buildModelFromUrdf, "URDF", path)
 
 
 def load_mjcf(path: str | Path) -> pin.Model:
-    """Build a Pinocchio model from an MJCF file (only the first top-level body of <worldbody> is kept by Pinocchio)."""
+    """Build a Pinocchio model from an MJCF file (only the first top-level body of <worldbody> is kept by Pinocchio);
+    the file is compiled by MuJoCo first, whose parser refuses what Pinocchio's would skip."""
     return _load(pin.buildModelFromMJCF, "MJCF", path)
 
 

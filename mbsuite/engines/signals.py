@@ -152,6 +152,8 @@ class Pulse(Signal):
     def __post_init__(self) -> None:
         _finite("pulse", amplitude=self.amplitude, width=self.width, period=self.period, offset=self.offset,
                 t0=self.t0)
+        if isinstance(self.n, bool) or not isinstance(self.n, int | float) or self.n != int(self.n):
+            raise ParameterError(f"pulse signal: n (number of periods) must be a whole number >= 0, got {self.n!r}")
         if not (0.0 <= self.width <= 1.0 and self.period > 0 and self.n >= 0):
             raise ParameterError(f"pulse signal: need 0 <= width <= 1, period > 0, n >= 0; got {self}")
 
@@ -178,7 +180,10 @@ class Table(Signal):
     kind = 5
 
     def __post_init__(self) -> None:
-        ts, ys = np.asarray(self.times, float), np.asarray(self.points, float)
+        try:
+            ts, ys = np.asarray(self.times, float), np.asarray(self.points, float)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"table signal: times and values must be numbers ({exc})") from exc
         if ts.ndim != 1 or ts.size < 1 or ts.shape != ys.shape or not np.all(np.isfinite(ts)) or \
                 not np.all(np.isfinite(ys)) or np.any(np.diff(ts) < 0):
             raise ParameterError("table signal: times and values must be equal-length finite sequences with "

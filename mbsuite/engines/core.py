@@ -135,6 +135,9 @@ def rows_for(nstep: int, every: int) -> int:
     return nstep // every + 1 + (1 if nstep % every else 0)
 
 
+INTERRUPT_STEPS = 50_000  # steps per C call of a run with no Python step between (Ctrl-C latency: ~0.05-0.5 s)
+
+
 class Stepper:
     """A model and its data, stepped by the native core (module docstring).
 
@@ -245,7 +248,9 @@ class Stepper:
         job.rec_row = 0
         t0 = float(self.data.time)
         steps = 0
-        chunk = nstep if between is None else max(1, int(period))
+        # without a Python step between calls, run in pieces of INTERRUPT_STEPS so that Ctrl-C (handled by Python
+        # between C calls) stops a long run within a fraction of a second; the pieces continue one run exactly
+        chunk = min(max(nstep, 1), INTERRUPT_STEPS) if between is None else max(1, int(period))
         k = 0
         while True:
             n = min(chunk, nstep - k)

@@ -265,3 +265,19 @@ def test_recorded_times_are_exactly_the_step_grid():
     tr = Stepper(m, d, [Channel("q", "qpos")]).run(20_000)
     assert np.array_equal(tr.t, np.arange(20_001) * m.opt.timestep)
     assert np.sum(tr.t >= 40.0) == 1 and np.sum(tr.t >= 20.0) == 10_001  # h = 2 ms
+
+
+def test_a_run_longer_than_one_c_call_is_one_run(monkeypatch):
+    """A long run is stepped in pieces (so Ctrl-C is honoured between C calls); the pieces make exactly the run of
+    one call: same rows, same times, bitwise."""
+    from mbsuite.engines import core
+
+    m = _lab()
+    n = 1000
+    u = _ram(n, m.opt.timestep)
+    chans = [Channel("q", "qpos", 0, 3), Channel("P", "act", 0, 1)]
+    whole = Stepper(m, _start(m), chans, every=7).run(n, ctrl=u, ctrl_idx=[0])
+    monkeypatch.setattr(core, "INTERRUPT_STEPS", 97)  # 11 pieces, none aligned with the recording period
+    pieces = Stepper(m, _start(m), chans, every=7).run(n, ctrl=u, ctrl_idx=[0])
+    assert np.array_equal(whole.t, pieces.t) and np.array_equal(whole["q"], pieces["q"])
+    assert np.array_equal(whole["P"], pieces["P"]) and whole.steps == pieces.steps == n

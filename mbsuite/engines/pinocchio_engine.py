@@ -20,13 +20,13 @@ def _native_stderr() -> Iterator[list[str]]:
     """Capture what C++ code writes to file descriptor 2 during the block (urdfdom reports parse errors there and
     carries on); the captured lines are appended to the yielded list."""
     lines: list[str] = []
+    fd = 2  # the process's standard error, whatever Python's sys.stderr is wrapped in
     try:
-        fd = sys.stderr.fileno()
+        sys.stderr.flush()
+        saved = os.dup(fd)
     except (AttributeError, OSError, ValueError):
         yield lines
         return
-    sys.stderr.flush()
-    saved = os.dup(fd)
     with tempfile.TemporaryFile() as tmp:
         os.dup2(tmp.fileno(), fd)
         try:

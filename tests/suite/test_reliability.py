@@ -375,3 +375,90 @@ def test_view_without_a_display_is_a_clear_error(monkeypatch, capsys):
     for name in sorted(set(MODELS) - set(viewable)):
         rc, _, err = _run_cli(["view", name], capsys)
         assert rc == 2 and "no MuJoCo model" in err, (name, err)
+
+
+# --- findings of the hostile corpus (scripts/robustness_corpus.py) ---------------------------------------------------
+
+@pytest.mark.parametrize("argv, named", [
+    ([], "command"),
+    (["frobnicate"], "frobnicate"),
+    (["run"], "scene"),
+    (["run", "pantograph", "--engine", "bullet"], "--engine"),
+    (["run", "pantograph", "--max-steps", "abc"], "--max-steps"),
+    (["sweep", "pantograph", "--vary", "input.frequency=4", "--workers", "-1"], "--workers"),
+    (["workprecision", "pantograph", "--quick", "--repeats", "1000000000"], "--repeats"),
+])
+def test_usage_errors_are_one_line(capsys, argv, named):
+    rc, out, err = _run_cli(argv, capsys)
+    assert rc == 2 and err.count("\n") == 1 and named in err and err.startswith("mbsuite: error: "), err
+
+
+def test_usage_error_under_json_is_an_object(capsys):
+    rc, out, _ = _run_cli(["run", "--json"], capsys)
+    assert rc == 2 and json.loads(out)["error"]["type"] == "UsageError"
+
+
+def test_directory_and_over_nested_scene_files(tmp_path, capsys):
+    rc, _, err = _run_cli(["run", str(tmp_path)], capsys)
+    assert rc == 2 and "is a directory" in err
+    deep = "[" * 5000 + "]" * 5000
+    rc, _, err = _run_cli(["run", _write(tmp_path, f'model = "pantograph"\n[params]\nm1 = {deep}\n')], capsys)
+    assert rc == 2 and "internal error" not in err and ("too deeply" in err or "m1" in err), err
+
+
+def test_reference_max_step_is_size_guarded():
+    with pytest.raises(SceneError, match="solver.max_step"):
+        load_scene("pantograph").replace(solver={"engine": "reference", "max_step": 1e-9})
+
+
+def test_models_dir_that_holds_nothing_is_an_error(tmp_path, monkeypatch):
+    from mbsuite.errors import ModelFileError
+
+    monkeypatch.setenv("MBSUITE_MODELS_DIR", str(tmp_path / "nowhere"))
+    with pytest.raises(ModelFileError, match="MBSUITE_MODELS_DIR"):
+        mbsuite.model_file("pantograph")
+
+
+def _copy_with(tmp_path: Path, name: str, kind: str, old: bytes, new: bytes) -> Path:
+    src = mbsuite.model_file(name, kind)
+    raw = src.read_bytes()
+    assert raw.count(old) >= 1, (name, old)
+    dst = tmp_path / src.name
+    dst.write_bytes(raw.replace(old, new, 1))
+    return dst
+
+
+def test_loaders_refuse_what_their_parsers_let_through(tmp_path):
+    from mbsuite.engines import mujoco_engine, pinocchio_engine
+    from mbsuite.errors import ModelFileError
+
+    bad_timestep = _copy_with(tmp_path, "iftomm_fourbar", "mjcf", b"<mujoco", b'<mujoco><option timestep="-1"/')
+    bad_timestep.write_bytes(bad_timestep.read_bytes().replace(b'/ model=', b' model=', 1))
+    with pytest.raises(ModelFileError):
+        mujoco_engine.load_model(bad_timestep)
+    latin = tmp_path / "latin.xml"
+    latin.write_bytes(mbsuite.model_file("iftomm_fourbar").read_bytes() + "<!-- K\xf6ln -->".encode("latin-1"))
+    with pytest.raises(ModelFileError, match="not UTF-8"):
+        mujoco_engine.load_model(latin)
+    bomb = tmp_path / "bomb.xml"
+    bomb.write_text('<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;">]><mujoco/>')
+    with pytest.raises(ModelFileError, match="DTD"):
+        mujoco_engine.load_model(bomb)
+    mass = _copy_with(tmp_path, "pantograph", "urdf", b'<mass value="', b'<mass value="abc')
+    with pytest.raises(ModelFileError, match="Pinocchio reports errors"):
+        pinocchio_engine.load_urdf(mass)
+    garbage = tmp_path / "garbage.xml"
+    garbage.write_text("<mujoco><body")
+    with pytest.raises(ModelFileError) as exc:
+        mujoco_engine.load_model(garbage)
+    assert "\n" not in str(exc.value)
+
+
+def test_signal_parameters_are_checked():
+    from mbsuite.engines.signals import Pulse, Table
+    from mbsuite.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="whole number"):
+        Pulse(n=1.5)
+    with pytest.raises(ParameterError, match="table signal"):
+        Table(("a",), (1.0,))

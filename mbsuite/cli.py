@@ -338,6 +338,8 @@ def _hook_command(hook: str):
         if fn is None:
             raise MbsuiteError(f"model '{scene.model}' does not support '{hook}'")
         kwargs = _freq_args(args) if hook == "freqresp" else {}
+        if hook == "modes" and getattr(args, "height", None) is not None:
+            kwargs = {"height": args.height}
         if hook == "run":
             fn = run_scene  # judges the run's health figures
         with _sweeping(args):
@@ -375,6 +377,9 @@ def build_parser() -> argparse.ArgumentParser:
         _common(p)
         if hook in ("run", "freqresp"):
             _scene_opts(p)
+        if hook == "modes":
+            p.add_argument("--height", type=float,
+                           help="ram height (m) to linearise at (default: the mean of the scene's input)")
         if hook == "run":
             p.add_argument("--engine", choices=["mujoco", "reference"], help="override the scene's engine")
         if hook == "freqresp":

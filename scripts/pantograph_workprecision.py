@@ -5,7 +5,9 @@ MuJoCo timestep x integrator (euler, implicitfast, implicit, rk4, discrete) and 
 methods x rtol, against Radau at rtol 1e-12 (checked against DOP853 at 1e-12); state error max |F1, F2, HD, y_d - ref|/A
 and the physics metric (amplitude/phase of F1 and HD at the forcing frequency, contact-force statistics); wall time
 median of N runs with min-max. Coulomb friction is off in the study (MuJoCo's frictionloss and the reference's
-event-exact stick/slip are different models; their 0.4 % difference would be an error floor).
+event-exact stick/slip are different models; their 0.4 % difference would be an error floor). The study measures
+every setting, also those the health figures refuse (`allow_inaccurate`). The cost of the nonlinear cylinder's laminar
+band (stiffness, steps, time per band width) is the companion study `scripts/pantograph_orifice_band.py`.
 
     python scripts/pantograph_workprecision.py [--scene pantograph/lab] [--repeats 5] [--out out/pantograph_wp]
 """

@@ -5,10 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from mbsuite import ModelFileError, SceneError, SolverError, load_scene, run
+from mbsuite import AccuracyError, ModelFileError, SceneError, SolverError, load_scene, run
 from mbsuite.analysis.harmonic import fundamental
 from mbsuite.engines.mujoco_engine import load_model
 from mbsuite.engines.pinocchio_engine import load_mjcf, load_urdf
+from mbsuite.health import InaccurateResultWarning
 from mbsuite.models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.reference import PantographConfig, PantographODE, simulate
@@ -31,15 +32,14 @@ def test_stick_slip_2hz_bounded_work_both_paths(lab_scene):
 
 def test_nonlinear_cylinder_from_supply_pressure_no_stall(lab_scene):
     """P = Ps at the start: the uncorrected law has an unbounded slope there; the laminar band keeps the RHS Lipschitz.
-    No stall, no NaN, and the band width does not change the result (0.999 vs 0.9999: < 1e-4 relative)."""
+    No stall, no NaN, the pressure stays positive (that the band width does not change the result:
+    test_orifice_band.py)."""
     sc = load_scene("pantograph/nonlinear_cylinder").replace(solver={"engine": "reference", "duration": 4.0,
                                                                      "t_settle": 2.0})
-    amps = []
-    for rl in (0.999, 0.9999):
-        r = run(sc.replace(params={"r_laminar": rl}))
-        assert r.stats["nfev"] < 100_000
-        amps.append(abs(fundamental(r.t, r["F1"], 4.25, 2.0)))
-    assert amps[1] / amps[0] == pytest.approx(1.0, abs=1e-4)
+    r = run(sc)
+    assert r.stats["nfev"] < 100_000
+    assert all(np.all(np.isfinite(v)) for v in r.signals.values())
+    assert np.min(r["cylinder_state"]) > 0.0
 
 
 def test_orifice_law_branches():
@@ -99,14 +99,20 @@ def test_energy_drift_without_damping_and_friction():
 
 @pytest.mark.parametrize("integrator", ["euler", "implicitfast"])
 def test_over_large_timestep_is_a_clear_error(lab_scene, integrator):
+    """h = 0.02 s: refused before stepping (AccuracyError, stability_margin); with inaccuracy allowed the run diverges
+    and the core stops it with a SolverError telling to reduce the step (never garbage)."""
     sc = lab_scene.replace(solver={"timestep": 0.02, "integrator": integrator, "duration": 2.0, "t_settle": 1.0})
-    with pytest.raises(SolverError, match="reduce solver.timestep"):
+    with pytest.raises(AccuracyError, match="stability_margin"):
         run(sc)
+    with pytest.raises(SolverError, match="reduce solver.timestep"):
+        run(sc.replace(solver={"allow_inaccurate": True}))
 
 
 def test_over_large_timestep_rk4_stays_finite(lab_scene):
-    sc = lab_scene.replace(solver={"timestep": 0.02, "integrator": "rk4", "duration": 2.0, "t_settle": 1.0})
-    res = run(sc)
+    sc = lab_scene.replace(solver={"timestep": 0.02, "integrator": "rk4", "duration": 2.0, "t_settle": 1.0,
+                                   "allow_inaccurate": True})
+    with pytest.warns(InaccurateResultWarning):
+        res = run(sc)
     assert all(np.all(np.isfinite(v)) for v in res.signals.values())
 
 

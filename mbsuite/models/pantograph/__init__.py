@@ -36,12 +36,7 @@ SPEC = ModelSpec(
                           "joint Coulomb friction: event-exact stick/slip (reference) / frictionloss (MuJoCo)"),
         "contact": Effect(("bilateral", "unilateral"), "bilateral", "ram attached (both ways) or push-only wire"),
     },
-    inputs={
-        "sine": {"amplitude": "half peak-to-peak (m); y_w = y_op + A (1 - cos 2 pi f t)", "frequency": "Hz",
-                 "initial": "'equilibrium' (default) or 'fortran' (thesis IC)"},
-        "static": {"initial": "'equilibrium' or 'fortran'"},
-        "step": {"height": "step of the ram height (m)", "t_step": "time of the step (s)", "initial": "..."},
-    },
+    inputs=analysis.INPUTS,
     outputs=analysis.UNITS,
     engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).parent / "scenes",

@@ -8,6 +8,7 @@ input's fundamental (degrees, negative = lag).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +18,8 @@ import numpy as np
 from ...analysis.harmonic import fundamental
 from ...analysis.sweep import run_sweep
 from ...errors import SceneError
+from ...health import Figure, judge, nyquist_ratio, stability_margin
+from ...limits import Limit
 from ...results import Report, SimResult, assemble, format_table, write_csv
 from ...scenes import Scene, scene_from_dict
 from .elbow import theta_e_array
@@ -33,6 +36,25 @@ FR_SIGNALS = ("F1", "F2", "HD", "y_d")
 THESIS_RESONANCES_SIM = (4.25, 8.75, 19.5)
 THESIS_RESONANCES_MEAS = (4.0, 8.25)
 MODES_TIMESTEP = 1e-4  # MuJoCo's discrete-time linearisation is mapped to continuous time by log(mu)/h
+
+_INITIAL = Limit(kind=str, choices=("equilibrium", "fortran"), default="equilibrium",
+                 doc="'equilibrium' (static equilibrium at y_w(0)) or 'fortran' (the thesis' start: no equilibrium)")
+#: the scene input keys of each input type, with their valid ranges and defaults (`ModelSpec.inputs`)
+INPUTS: dict[str, dict[str, Limit]] = {
+    "sine": {
+        "amplitude": Limit(lo=0.0, hi=0.2, unit="m", default=1.85e-3,
+                           doc="half peak-to-peak A of y_w = y_op + A (1 - cos 2 pi f t); thesis 1.85 mm"),
+        "frequency": Limit(lo=0.0, lo_open=True, hi=100.0, unit="Hz", default=2.0,
+                           doc="ram frequency; the thesis sweeps 1-30 Hz, its rigid links are not valid far above"),
+        "initial": _INITIAL,
+    },
+    "static": {"initial": _INITIAL},
+    "step": {
+        "height": Limit(lo=-0.5, hi=0.5, unit="m", default=1e-3, doc="step of the ram height at t_step"),
+        "t_step": Limit(lo=0.0, unit="s", default=0.1, doc="time of the step"),
+        "initial": _INITIAL,
+    },
+}
 
 
 def config_of(scene: Scene) -> PantographConfig:
@@ -62,16 +84,28 @@ class InputSignal:
 
 
 def input_of(scene: Scene, p: PantographParams) -> InputSignal:
+    """The scene's ram input; its keys were checked against `INPUTS` by the scene loader (defaults filled in)."""
     inp = scene.input
     kind = inp.get("type", "sine")
     if kind == "sine":
-        A, f = float(inp.get("amplitude", 1.85e-3)), float(inp.get("frequency", 2.0))
-        if A < 0 or f <= 0:
-            raise SceneError(f"sine input needs amplitude >= 0 and frequency > 0 (got {A}, {f})")
-        return InputSignal("sine", p.y_op, A, f)
+        d = INPUTS["sine"]
+        return InputSignal("sine", p.y_op, float(inp.get("amplitude", d["amplitude"].default)),
+                           float(inp.get("frequency", d["frequency"].default)))
     if kind == "step":
-        return InputSignal("step", p.y_op, float(inp.get("height", 1e-3)), 0.0, float(inp.get("t_step", 0.1)))
+        d = INPUTS["step"]
+        return InputSignal("step", p.y_op, float(inp.get("height", d["height"].default)), 0.0,
+                           float(inp.get("t_step", d["t_step"].default)))
     return InputSignal("static", p.y_op)
+
+
+def operating_height(scene: Scene, p: PantographParams) -> float:
+    """The ram height the motion takes place about, where `freqresp` and `modes` linearise: the mean of the input.
+    Sine y_op + A (1 - cos wt): y_op + A; step: its final level y_op + height; static: y_op. (Linearising at y_op
+    instead shifts the 8.5 Hz HD ratio by -2.7 % at A = 1.85 mm: the operating point moves with A.)"""
+    u = input_of(scene, p)
+    if u.kind in ("sine", "step"):
+        return p.y_op + u.amplitude
+    return p.y_op
 
 
 def initial_theta(scene: Scene, ode: PantographODE, u: InputSignal) -> np.ndarray:
@@ -127,16 +161,57 @@ def _contact_losses(t: np.ndarray, fc: np.ndarray) -> list[dict]:
     return ev
 
 
+#: bound on h * omega_max per MuJoCo integrator as a fraction of its stability limit (`mbsuite.health`): rk4 1.4,
+#: the Euler family 0.1, discrete 0.01. Chosen from the error measured against the reference (lab scene, Coulomb off,
+#: 2 / 4.25 / 8.5 Hz; README "Health figures"): near each bound the physics error is about 1 % (rk4 0.61-0.78 % at
+#: h omega = 1.22, 2.4-27 % at 1.46-2.44; Euler family ~0.1 h omega: 0.61-0.89 % at 0.061, 4.4 % at 0.49; discrete
+#: ~1.4 h omega: 0.99-1.2 % at 0.0098, 5.9-7.4 % at 0.061). First-order methods damp or detune the fastest mode by
+#: O(h omega), hence their tighter bounds.
+STABILITY_FRACTION = {"rk4": 0.5, "euler": 0.05, "implicit": 0.1, "implicitfast": 0.1, "discrete": 0.005}
+#: the geometric working range of the absolute link angles (the range `PantographODE.equilibrium` accepts)
+WORKING_RANGE = ((0.0, 0.5 * math.pi), (0.0, 0.5 * math.pi), (-0.5 * math.pi, 0.5 * math.pi))
+
+
+def step_figures(scene: Scene, p: PantographParams, cfg: PantographConfig, u: InputSignal) -> list[Figure]:
+    """The health figures of a MuJoCo run known before it steps: `stability_margin` (h times the highest natural
+    frequency of the linearisation at the operating height) and, for a sine ram, `nyquist_ratio`."""
+    s = scene.solver
+    w = omega_max(p, cfg, operating_height(scene, p))
+    figs = [stability_margin(s.timestep, w, s.integrator, fraction=STABILITY_FRACTION.get(s.integrator, 0.5))]
+    if u.kind == "sine":
+        figs.append(nyquist_ratio(s.timestep, u.frequency))
+    return figs
+
+
+def excursion(theta: np.ndarray, theta0: np.ndarray) -> Figure:
+    """Plausibility: the largest excursion of a link angle from the equilibrium, relative to the distance from the
+    equilibrium to the edge of the working range (0 < theta_1, theta_2 < pi/2, |theta_h| < pi/2). Above 1 the linkage
+    has folded or passed the vertical: the result is not a pantograph's motion."""
+    val = 0.0
+    for i, (lo, hi) in enumerate(WORKING_RANGE):
+        room = min(theta0[i] - lo, hi - theta0[i])
+        dev = np.abs(theta[:, i] - theta0[i])
+        val = max(val, float(np.max(dev)) / room if np.all(np.isfinite(dev)) else math.inf)
+    return Figure("excursion", val, 1.0, "", "largest link-angle excursion / room to the edge of the working range",
+                  "reduce the input amplitude or solver.timestep; check the parameters")
+
+
 def run(scene: Scene) -> SimResult:
     """The `run` hook: time simulation with the scene's engine ("mujoco" or "reference") under the ram of the
     thesis' lab (input sine/step/static). Under a finite-element catenary the pantograph runs as a catenary scene
-    (`under_wire.py` implements the catenary's protocol)."""
+    (`under_wire.py` implements the catenary's protocol).
+
+    Health figures (`mbsuite.health`): MuJoCo runs report `stability_margin`, `nyquist_ratio` (sine input) and
+    `excursion`, the reference path `excursion`. Figures known before stepping are judged first: a setting past its
+    bound raises `AccuracyError` without running, unless `solver.allow_inaccurate`."""
     p = scene.build_params()
     cfg = config_of(scene)
     ode = PantographODE(p, cfg)
     u = input_of(scene, p)
     s = scene.solver
     x0 = initial_theta(scene, ode, u)
+    at_rest = scene.input.get("initial", "equilibrium") == "equilibrium"
+    th0 = ode.theta((x0 if at_rest else ode.equilibrium(u(0.0)))[: ode.nq])  # the excursion's origin
     if s.engine == "reference":
         dt_out = s.sample_dt or s.timestep
         t_eval = np.arange(0.0, s.duration + 0.5 * dt_out, dt_out)
@@ -146,19 +221,24 @@ def run(scene: Scene) -> SimResult:
         th = np.array([ode.theta(sol.x[: ode.nq, k]) for k in range(sol.t.size)])
         P = sol.x[-1] if ode.has_P else None
         return assemble(scene, sol.t, signals(ode, th, u(sol.t), P), engine="reference", events=sol.events,
-                        stats={"nfev": sol.nfev, "segments": sol.nsegments, "method": s.method, "rtol": s.rtol})
+                        stats={"nfev": sol.nfev, "segments": sol.nsegments, "method": s.method, "rtol": s.rtol},
+                        health=[excursion(th, th0)])
     else:
+        what = f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)"
+        pre = step_figures(scene, p, cfg, u)
+        if not s.allow_inaccurate:
+            judge(pre, what=what)  # raises AccuracyError before any step is taken
         mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
         q0 = None if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
         every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
-        tr = mp.simulate(u, s.duration, q0, every=every, what=f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)",
-                         guess=theta_to_q(ode.theta(x0[:ode.nq])))
+        tr = mp.simulate(u, s.duration, q0, every=every, what=what, guess=theta_to_q(ode.theta(x0[:ode.nq])))
         P = tr["act"].reshape(tr.t.size, -1)[:, 0] if mp.model.na else None
-        sig = signals(ode, thetas(tr["qpos"]), u(tr.t), P)
+        th = thetas(tr["qpos"])
+        sig = signals(ode, th, u(tr.t), P)
         ev = _contact_losses(tr.t, sig["contact_force"]) if cfg.contact == "unilateral" else []
         return assemble(scene, tr.t, sig, engine="mujoco", events=ev,
                         stats={"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep,
-                               "warnings": tr.warnings})
+                               "warnings": tr.warnings}, health=[*pre, excursion(th, th0)])
 
 
 # ------------------------------------------------------------------------------------------------ linearisation
@@ -187,6 +267,42 @@ def linearize(ode: PantographODE, x0: np.ndarray, y_w0: float) -> tuple[np.ndarr
     return A, B, C
 
 
+def _linear_config(cfg: PantographConfig) -> PantographConfig:
+    """The effects the linearisation keeps (Coulomb friction excluded, contact closed): one cache entry for all."""
+    return PantographConfig(**{**cfg.__dict__, "coulomb": False, "contact": "bilateral"})
+
+
+@functools.lru_cache(maxsize=256)
+def _linear_cached(p: PantographParams, cfg: PantographConfig, y_w: float) -> tuple[np.ndarray, ...]:
+    ode = PantographODE(p, cfg)
+    x0 = ode.equilibrium(y_w)
+    A, B, C = linearize(ode, x0, y_w)
+    lam = np.linalg.eigvals(A)
+    for a in (x0, A, B, C, lam):
+        a.flags.writeable = False
+    return x0, A, B, C, lam
+
+
+def linear_model(p: PantographParams, cfg: PantographConfig, y_w: float) -> tuple[np.ndarray, ...]:
+    """(x0, A, B, C, eigenvalues of A) about the static equilibrium at ram height y_w; cached per parameter set,
+    effects and height (read-only arrays; one equilibrium and 2n + 2 right-hand sides, ~10 ms, on a miss)."""
+    return _linear_cached(p, _linear_config(cfg), float(y_w))
+
+
+def omega_max(p: PantographParams, cfg: PantographConfig, y_w: float) -> float:
+    """The largest |eigenvalue| of the linearised model (rad/s): the fastest mode a fixed step must resolve (lab
+    scene: the 19.4 Hz head mode, 121.9 rad/s; the nonlinear cylinder adds its real pole, 163 rad/s with the default
+    laminar band)."""
+    return float(np.max(np.abs(linear_model(p, cfg, y_w)[4])))
+
+
+def stiffest_pole(p: PantographParams, cfg: PantographConfig, y_w: float) -> float:
+    """The largest |real eigenvalue| of the linearised model (1/s): the cylinder's pole (0 if it has none)."""
+    lam = linear_model(p, cfg, y_w)[4]
+    real = np.abs(lam[np.abs(lam.imag) <= 1e-9 * np.maximum(np.abs(lam), 1.0)])
+    return float(np.max(real)) if real.size else 0.0
+
+
 def modes_from_eigs(lam: np.ndarray) -> list[dict]:
     """Natural frequency (Hz) and damping ratio of each complex pair; time constant of each real pole."""
     out = []
@@ -208,8 +324,9 @@ def linear_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, freqs: np.ndarr
     return np.array([C @ np.linalg.solve(1j * 2 * math.pi * f * np.eye(n) - A, B) for f in freqs])
 
 
-def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
-    """Modes from MuJoCo's own finite-difference linearisation (mjd_transitionFD), mapped to continuous time."""
+def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray, y_w: float) -> list[dict]:
+    """Modes from MuJoCo's own finite-difference linearisation (mjd_transitionFD) at rest at joint positions q0 under
+    ram height y_w, mapped to continuous time."""
     import mujoco
 
     m, d = mp.model, mp.data  # the MujocoPantograph's own copy of the model: edited here, restored after
@@ -220,7 +337,7 @@ def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray) -> list[dict]:
     saved = m.dof_frictionloss.copy()
     m.dof_frictionloss[:] = 0.0  # Coulomb friction is not linearisable: excluded, as in the reference linearisation
     try:
-        mp.set_static(q0, mp.p.y_op)
+        mp.set_static(q0, y_w)
         mujoco.mjd_transitionFD(m, d, 1e-7, True, A, None, None, None)
     finally:
         m.dof_frictionloss[:] = saved
@@ -279,8 +396,12 @@ def mujoco_sweep(scene: Scene, freqs: np.ndarray, *, method: str = "mujoco", wor
     cfg = config_of(scene)
     ode = PantographODE(p, cfg)
     s = scene.solver
-    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
     base = input_of(scene.replace(input={"type": "sine"}), p)
+    if not s.allow_inaccurate:  # the health figures of the run at the highest frequency, before any step
+        judge(step_figures(scene.replace(input={"type": "sine"}), p, cfg,
+                           InputSignal("sine", p.y_op, base.amplitude, float(np.max(freqs)))),
+              what=f"pantograph frequency sweep up to {float(np.max(freqs)):g} Hz (MuJoCo)")
+    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
     x0 = initial_theta(scene, ode, base)
     q0 = mp.equilibrium(base(0.0), theta_to_q(ode.theta(x0[:ode.nq]))) \
         if scene.input.get("initial", "equilibrium") == "equilibrium" else theta_to_q(x0[:3])
@@ -323,11 +444,11 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
     if not (0 < f_min <= f_max and df > 0):
         raise SceneError(f"need 0 < f_min <= f_max and df > 0 (got {f_min}, {f_max}, {df})")
     freqs = np.round(np.arange(f_min, f_max + 0.5 * df, df), 10)
+    scene = scene.replace(input={"type": "sine"})
     p = scene.build_params()
     cfg = config_of(scene)
-    ode = PantographODE(p, cfg)
-    x0 = ode.equilibrium()
-    A, B, C = linearize(ode, x0, p.y_op)
+    y_lin = operating_height(scene, p)
+    _, A, B, C, _ = linear_model(p, cfg, y_lin)
     curves: dict[str, dict[str, np.ndarray]] = {}
     if "linear" in methods:
         H = linear_response(A, B, C, freqs)
@@ -350,7 +471,8 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
     res_peaks = {m: {s: peaks(freqs, np.abs(c[s])) for s in ("F1", "HD")} for m, c in curves.items()}
     data = {
         "frequencies_hz": freqs,
-        "amplitude_input_m": input_of(scene.replace(input={"type": "sine"}), p).amplitude,
+        "amplitude_input_m": input_of(scene, p).amplitude,
+        "linearised_at_height_m": y_lin,
         "modes_linear": modes,
         "peaks_hz": res_peaks,
         "thesis_resonances_simulated_hz": THESIS_RESONANCES_SIM,
@@ -367,7 +489,9 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
             row += [abs(curves[m]["F1"][i]), abs(curves[m]["HD"][i])]
         rows.append(row)
     headers = ["f (Hz)"] + [f"{m} {s}" for m in curves for s in ("|F1|/A", "|HD|/A")]
-    lines = [format_table(headers, rows, ".4g"), "", "linearised modes (Coulomb friction excluded):"]
+    lines = [format_table(headers, rows, ".4g"), "",
+             "linearised modes (Coulomb friction excluded) about the static equilibrium at "
+             f"y_w = y_op + A = {y_lin:.6g} m (the mean of the input):"]
     for md in modes:
         lines.append(f"  {md['kind']:12s} f_n = {md['f_n']:8.4f} Hz  zeta = {md['zeta']:.4f}")
     for m, pk in res_peaks.items():
@@ -457,23 +581,28 @@ def equilibrium_report(scene: Scene) -> Report:
     return Report(data, table)
 
 
-def modes_report(scene: Scene) -> Report:
+def modes_report(scene: Scene, height: float | None = None) -> Report:
+    """Linearised modes about the static equilibrium at `height` (m; default: the mean of the scene's input,
+    `operating_height`), from the hand-derived equations and from MuJoCo's own linearisation."""
     p = scene.build_params()
     cfg = config_of(scene)
-    ode = PantographODE(p, cfg)
-    x0 = ode.equilibrium()
-    A, _, _ = linearize(ode, x0, p.y_op)
-    ref = modes_from_eigs(np.linalg.eigvals(A))
+    if height is None:
+        y_lin = operating_height(scene, p)
+    else:
+        reach = p.l1 + p.l2
+        y_lin = Limit(lo=0.0, hi=reach, lo_open=True, hi_open=True, unit="m").check("height", height, SceneError)
+    ref = modes_from_eigs(linear_model(p, cfg, y_lin)[4])
     mp = MujocoPantograph(p, cfg, "implicit", MODES_TIMESTEP)  # mjd_transitionFD: no RK4; small h for log(mu)/h
-    mj = mujoco_modes(mp, mp.equilibrium())
+    mj = mujoco_modes(mp, mp.equilibrium(y_lin), y_lin)
     rows = []
     for i, md in enumerate(ref):
         m2 = mj[i] if i < len(mj) else {"f_n": float("nan"), "zeta": float("nan")}
         rows.append([md["kind"], md["f_n"], md["zeta"], m2["f_n"], m2["zeta"]])
     table = format_table(["mode", "f_n ref (Hz)", "zeta ref", "f_n MuJoCo (Hz)", "zeta MuJoCo"], rows, ".5g")
-    table += ("\nreference: central-difference Jacobian of the hand-derived ODE; MuJoCo: mjd_transitionFD at "
-              f"timestep {MODES_TIMESTEP:g} s (implicit), log(mu)/h. "
-              "Coulomb friction excluded.")
-    return Report({"reference": ref, "mujoco": mj}, table)
+    table += (f"\nlinearised about the static equilibrium at ram height {y_lin:.6g} m"
+              + (" (the mean of the scene's input)" if height is None else "")
+              + "; reference: central-difference Jacobian of the hand-derived ODE; MuJoCo: mjd_transitionFD at "
+              f"timestep {MODES_TIMESTEP:g} s (implicit), log(mu)/h. Coulomb friction excluded.")
+    return Report({"linearised_at_height_m": y_lin, "reference": ref, "mujoco": mj}, table)
 
 

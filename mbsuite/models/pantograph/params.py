@@ -11,76 +11,78 @@ import math
 from dataclasses import dataclass
 
 from ...errors import ParameterError
+from ...limits import check_fields, param
+
+#: critical pressure ratio (2/(gamma+1))^(gamma/(gamma-1)) for gamma = 1.4, as in Eq 3.17
+CHOKED_RATIO = 0.528
+#: default laminar band of the orifice: Pd/Pu > R_LAMINAR (band 1e-5), from the convergence study in the README
+R_LAMINAR = 0.99999
+
+
+def _pos(default: float, unit: str, doc: str, hi: float | None = None) -> float:
+    """A parameter > 0 (optionally <= hi)."""
+    return param(default, lo=0.0, lo_open=True, hi=hi, unit=unit, doc=doc)
+
+
+def _nonneg(default: float, unit: str, doc: str, hi: float | None = None) -> float:
+    """A parameter >= 0 (optionally <= hi)."""
+    return param(default, lo=0.0, hi=hi, unit=unit, doc=doc)
 
 
 @dataclass(frozen=True)
 class PantographParams:
-    """Table 3-I (seed 000, l.560-600). Every field in SI units."""
+    """Table 3-I (seed 000, l.560-600). Every field in SI units, declared with its valid range
+    (`mbsuite.limits.param`); `__post_init__` checks them, then the geometry across fields."""
 
-    l1: float = 1.95  #: lower link length (m)
-    l2: float = 1.95  #: upper link length (m)
-    lh: float = 0.40  #: head link length, knuckle-to-contact (m)
-    m1: float = 31.5  #: lower link mass (kg)
-    m2: float = 25.2  #: upper link mass (kg)
-    mh: float = 13.5  #: head mass (kg)
-    I1: float = 11.7  #: lower link moment of inertia about its centre of mass (kg m^2)
-    I2: float = 8.10  #: upper link moment of inertia (kg m^2)
-    Ih: float = 0.432  #: head moment of inertia (kg m^2)
-    d1: float = 1.10  #: base pivot to lower link mass centre (m)
-    d2: float = 0.80  #: elbow to upper link mass centre (m)
-    dh: float = 0.35  #: knuckle to head mass centre (m)
-    ks: float = 180000.0  #: input (catenary/shoe) spring constant (N/m)
-    kh: float = 2250.0  #: head spring constant, to the datum (N m/rad)
-    ke: float = 44640.0  #: elbow stiffness (N m/rad)
-    be: float = 0.0  #: elbow viscous damping (N m s/rad); not in Table 3-I nor EQSIM, hence 0
-    b1: float = 36.0  #: base viscous damping (N m s/rad)
-    b2: float = 157.5  #: knuckle viscous damping (N m s/rad)
-    bh: float = 10.8  #: head viscous damping (N m s/rad)
-    c1: float = 0.9  #: base Coulomb friction (N m)
-    c2: float = 0.45  #: knuckle Coulomb friction (N m)
-    ch: float = 0.45  #: head Coulomb friction (N m)
-    xf: float = 0.120  #: x-coordinate of the base link of the elbow chain (m)
-    yf: float = 0.170  #: y-coordinate (below the pivot) of the base link (m)
-    le: float = 0.082  #: elbow link length = pinion radius (m)
-    theta_e0: float = -0.164  #: theta_e at theta_1 = 0 (rad)
-    lb: float = 0.235  #: cylinder moment arm (m)
-    alpha: float = 1.82  #: angle between lower link and moment arm (rad)
-    Ap: float = 0.0123  #: piston area (m^2)
-    Ao: float = 3.14e-6  #: orifice area (m^2)
-    V0: float = 0.000996  #: cylinder volume when alpha - theta_1 = pi/2 (m^3)
-    Pg: float = 710185.0  #: supply gauge pressure (Pa)
-    R_gas: float = 287.0  #: specific gas constant of air (J/(kg K)); "universal" in Table 3-I is erratum 19
-    gamma: float = 1.40  #: specific heat ratio (-)
-    cd: float = 0.60  #: orifice discharge coefficient (-)
-    Pa: float = 101000.0  #: atmospheric pressure (Pa)
-    T: float = 293.0  #: cylinder temperature (K)
-    kc: float = 162000.0  #: linear cylinder spring (N/m)
-    bc: float = 90000.0  #: linear cylinder damper (N s/m)
-    g: float = 9.80665  #: gravitational acceleration (m/s^2)
-    y_op: float = 1.58  #: static operating (wire/ram) height above the base pivot (m), Chapter 5
-    r_laminar: float = 0.999  #: pressure ratio above which the orifice flow is linearised in dp (laminar band)
-    omega_s: float = 1e-3  #: velocity scale of the optional smooth Coulomb law tanh(w/omega_s) (rad/s)
+    l1: float = _pos(1.95, "m", "lower link length")
+    l2: float = _pos(1.95, "m", "upper link length")
+    lh: float = _pos(0.40, "m", "head link length, knuckle-to-contact")
+    m1: float = _pos(31.5, "kg", "lower link mass")
+    m2: float = _pos(25.2, "kg", "upper link mass")
+    mh: float = _pos(13.5, "kg", "head mass")
+    I1: float = _pos(11.7, "kg m^2", "lower link moment of inertia about its centre of mass")
+    I2: float = _pos(8.10, "kg m^2", "upper link moment of inertia about its centre of mass")
+    Ih: float = _pos(0.432, "kg m^2", "head moment of inertia about its centre of mass")
+    d1: float = _pos(1.10, "m", "base pivot to lower link mass centre (<= l1)")
+    d2: float = _pos(0.80, "m", "elbow to upper link mass centre (<= l2)")
+    dh: float = _pos(0.35, "m", "knuckle to head mass centre (<= lh)")
+    ks: float = _nonneg(180000.0, "N/m", "input (catenary/shoe) spring constant")
+    kh: float = _nonneg(2250.0, "N m/rad", "head spring constant, to the datum")
+    ke: float = _nonneg(44640.0, "N m/rad", "elbow stiffness")
+    be: float = _nonneg(0.0, "N m s/rad", "elbow viscous damping; not in Table 3-I nor EQSIM, hence 0")
+    b1: float = _nonneg(36.0, "N m s/rad", "base viscous damping")
+    b2: float = _nonneg(157.5, "N m s/rad", "knuckle viscous damping")
+    bh: float = _nonneg(10.8, "N m s/rad", "head viscous damping")
+    c1: float = _nonneg(0.9, "N m", "base Coulomb friction")
+    c2: float = _nonneg(0.45, "N m", "knuckle Coulomb friction")
+    ch: float = _nonneg(0.45, "N m", "head Coulomb friction")
+    xf: float = param(0.120, lo=-1.0, hi=1.0, unit="m", doc="x-coordinate of the base link of the elbow chain")
+    yf: float = param(0.170, lo=-1.0, hi=1.0, unit="m", doc="y-coordinate (below the pivot) of the base link")
+    le: float = _pos(0.082, "m", "elbow link length = pinion radius")
+    theta_e0: float = param(-0.164, lo=-math.pi, hi=math.pi, unit="rad", doc="theta_e at theta_1 = 0")
+    lb: float = _pos(0.235, "m", "cylinder moment arm")
+    alpha: float = param(1.82, lo=0.0, hi=math.pi, lo_open=True, hi_open=True, unit="rad",
+                         doc="angle between lower link and moment arm")
+    Ap: float = _pos(0.0123, "m^2", "piston area")
+    Ao: float = _pos(3.14e-6, "m^2", "orifice area")
+    V0: float = _pos(0.000996, "m^3", "cylinder volume when alpha - theta_1 = pi/2")
+    Pg: float = _pos(710185.0, "Pa", "supply gauge pressure")
+    R_gas: float = _pos(287.0, "J/(kg K)", "specific gas constant of air (\"universal\" in Table 3-I: erratum 19)")
+    gamma: float = param(1.40, lo=1.0, hi=2.0, lo_open=True, hi_open=True, unit="-", doc="specific heat ratio")
+    cd: float = param(0.60, lo=0.0, hi=1.0, lo_open=True, unit="-", doc="orifice discharge coefficient")
+    Pa: float = _pos(101000.0, "Pa", "atmospheric pressure")
+    T: float = _pos(293.0, "K", "cylinder temperature")
+    kc: float = _pos(162000.0, "N/m", "linear cylinder spring")
+    bc: float = _pos(90000.0, "N s/m", "linear cylinder damper")
+    g: float = _nonneg(9.80665, "m/s^2", "gravitational acceleration")
+    y_op: float = _pos(1.58, "m", "static operating (wire/ram) height above the base pivot, Chapter 5")
+    r_laminar: float = param(R_LAMINAR, lo=CHOKED_RATIO, hi=1.0, lo_open=True, hi_open=True, unit="-",
+                             doc="pressure ratio Pd/Pu above which the orifice flow is linear in dp (laminar band "
+                                 "1 - r_laminar, chosen by convergence: README)")
+    omega_s: float = _pos(1e-3, "rad/s", "velocity scale of the optional smooth Coulomb law tanh(w/omega_s)")
 
     def __post_init__(self) -> None:
-        positive = ("l1", "l2", "lh", "m1", "m2", "mh", "I1", "I2", "Ih", "d1", "d2", "dh", "le", "lb", "Ap", "Ao",
-                    "V0", "Pg", "R_gas", "Pa", "T", "kc", "bc", "y_op", "omega_s")
-        non_negative = ("ks", "kh", "ke", "be", "b1", "b2", "bh", "c1", "c2", "ch", "g")
-        for name in positive + non_negative:
-            v = getattr(self, name)
-            if not isinstance(v, int | float) or not math.isfinite(v):
-                raise ParameterError(f"pantograph parameter {name} must be a finite number, got {v!r}")
-        for name in positive:
-            if getattr(self, name) <= 0:
-                raise ParameterError(f"pantograph parameter {name} must be > 0, got {getattr(self, name)!r}")
-        for name in non_negative:
-            if getattr(self, name) < 0:
-                raise ParameterError(f"pantograph parameter {name} must be >= 0, got {getattr(self, name)!r}")
-        if not 1.0 < self.gamma < 2.0:
-            raise ParameterError(f"pantograph parameter gamma must be in (1, 2), got {self.gamma!r}")
-        if not 0.0 < self.cd <= 1.0:
-            raise ParameterError(f"pantograph parameter cd must be in (0, 1], got {self.cd!r}")
-        if not 0.5283 < self.r_laminar < 1.0:
-            raise ParameterError(f"pantograph parameter r_laminar must be in (0.5283, 1), got {self.r_laminar!r}")
+        check_fields(self, "pantograph parameter")
         for name, dist, length in (("d1", self.d1, self.l1), ("d2", self.d2, self.l2), ("dh", self.dh, self.lh)):
             if dist > length:
                 raise ParameterError(f"pantograph parameter {name} = {dist} lies beyond its link (length {length})")

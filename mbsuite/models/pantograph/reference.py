@@ -39,11 +39,10 @@ from scipy.optimize import fsolve
 
 from ...errors import GeometryError, SceneError, SolverError
 from .elbow import Elbow
-from .params import PantographParams
+from .params import CHOKED_RATIO, PantographParams  # CHOKED_RATIO: critical pressure ratio of Eq 3.17
 
 G_JOINTS = np.array([[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 1.0]])  # joint rates w = G theta' (A.15)
 JOINT_NAMES = ("base", "knuckle", "head")
-CHOKED_RATIO = 0.528  # critical pressure ratio (2/(gamma+1))^(gamma/(gamma-1)) for gamma = 1.4, as in 3.17
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
-/* The pantograph's effects as MuJoCo engine plugins (Eppinger 1984, "Dynamics of the Brecknell-Willis pantograph";
- * equations as in mbsuite/models/pantograph/reference.py, which stays the readable reference; a test holds the two
+/* The pantograph's effects as MuJoCo engine plugins (Eppinger 1984, "An experimental and analytical study of
+ * pantograph dynamics"; equations as in mbsuite/models/pantograph/reference.py, which stays the readable reference; a test holds the two
  * to 1e-12 on every scene).
  *
  * mbsuite.pantograph.cylinder (actuator plugin, one activation = the cylinder state, declared with actdim="1"):
@@ -70,7 +70,7 @@ static int cyl_init(const mjModel* m, mjData* d, int instance) {
   mbs_config_require(h, c->gamma > 1 && c->gamma < 2, "gamma", c->gamma);
   mbs_config_require(h, c->cd > 0 && c->cd <= 1, "cd", c->cd);
   mbs_config_require(h, c->Ao > 0, "Ao", c->Ao);
-  mbs_config_require(h, c->r_lam > 0.5283 && c->r_lam < 1, "r_laminar", c->r_lam);
+  mbs_config_require(h, c->r_lam > CHOKED_RATIO && c->r_lam < 1, "r_laminar", c->r_lam);
   c->actuator = -1;
   for (int i = 0; i < m->nu; i++) {
     if (m->actuator_plugin[i] == instance) c->actuator = i;

@@ -2,7 +2,7 @@
 
 Each mutation below is one plausible error in the physics code — a sign flipped in an equation of motion, an operating
 point shifted, a regularisation band widened, a loss term dropped, a bound scaled by 1 %, an event one step late, a
-Jacobian row swapped... It is applied, one at a time, to a scratch copy of the repository (the tracked files), and the
+Jacobian row swapped... It is applied, one at a time, to a scratch copy of the repository (its committed tree), and the
 default suite (`pytest -m "not slow"`) runs against it with `-x`, the mutated model's own tests first. A mutation is
 caught when a test fails; the report names the first failing test. Every mutation must be caught.
 
@@ -138,12 +138,9 @@ MUTATIONS: tuple[Mutation, ...] = (
 
 
 def _scratch_copy(dest: Path) -> None:
-    files = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
-    for f in files:
-        src = ROOT / f
-        if src.is_file():
-            (dest / f).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dest / f)
+    """The committed tree (HEAD) in `dest`: a stable snapshot, whatever is being edited in the checkout."""
+    archive = subprocess.run(["git", "archive", "--format=tar", "HEAD"], cwd=ROOT, capture_output=True, check=True)
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive.stdout, check=True)
 
 
 def _apply(root: Path, m: Mutation) -> str:
@@ -205,8 +202,8 @@ def main(argv: list[str] | None = None) -> int:
         root = Path(tmp)
         _scratch_copy(root)
         for m in chosen:  # every mutation must apply to the code as it is
-            _apply(root, m)
-            (root / m.path).write_text((ROOT / m.path).read_text())
+            original = _apply(root, m)
+            (root / m.path).write_text(original)
         if not args.no_baseline:
             base = _suite(root, "tests", sys.executable, args.timeout)
             if base.returncode != 0:

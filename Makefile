@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 export MPLBACKEND ?= Agg
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow lint bench mutants corpus docs clean
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -31,6 +31,12 @@ bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tes
 	$(BIN)/python scripts/bench_core.py
 	$(BIN)/python scripts/bench_paths.py
 	$(BIN)/python scripts/bench_sweep.py
+
+mutants: $(STAMP)  ## seeded physics defects, one at a time, against the default suite (tens of minutes)
+	$(BIN)/python scripts/mutants.py --json out/mutants.json
+
+corpus: $(STAMP)  ## the hostile robustness corpus: every outcome classified (about 15 minutes on 2 cores)
+	$(BIN)/python scripts/robustness_corpus.py --workers 2 --json-out out/robustness_corpus.json
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

@@ -136,7 +136,7 @@ def test_bad_speed_and_timestep():
     for bad in (0.0, -10.0, float("nan")):
         with pytest.raises(ParameterError, match="speed"):
             simulate(p, bad, 1e-4)
-    with pytest.raises(ParameterError, match="time step"):
+    with pytest.raises(ParameterError, match="solver.timestep"):
         simulate(p, 200.0, -1e-4)
 
 

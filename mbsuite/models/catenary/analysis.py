@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError, SceneError
-from ...health import Figure
+from ...health import Figure, judge
 from ...results import Report, SimResult, format_table, write_csv
 from ...results import assemble as assemble_result
 from .fe import CatenaryFE, assemble
@@ -91,19 +91,63 @@ def check_size(p: CatenaryParams, speed_ms: float, dt: float, max_steps: float |
                          "solver.max_steps (CLI: --max-steps) if you mean it")
 
 
+def wave_courant(p: CatenaryParams, dt: float) -> Figure:
+    """Health figure of the FE wave resolution: c dt / element_length, the elements a wire wave (c = the faster
+    wire's sqrt(T/rho)) crosses per step; bound 1. The mesh resolves waves one element long; a longer step skips
+    them (the trapezoidal rule stays stable but distorts them), and so does the pantograph, slower than the wave."""
+    c = max(p.cw_wave_speed, p.mw_wave_speed)
+    dt_max = p.element_length / c
+    return Figure("wave_courant", float(c * dt / p.element_length), 1.0, "",
+                  f"FE elements a wire wave (sqrt(T/rho) = {c:.1f} m/s) crosses per solver.timestep",
+                  f"solver.timestep (--timestep) {dt:g} s is outside its valid range (0, {dt_max:.4g}] s = "
+                  f"params.element_length / c = {p.element_length:g} m / {c:.1f} m/s: lower it, or enlarge "
+                  "params.element_length")
+
+
+def check_timestep(p: CatenaryParams, dt: float) -> None:
+    """The hard bound of the catenary's time step, checked before anything is built: a positive dt below
+    1 / (2 filter_cutoff) (the 20 Hz EN 50318 contact-force filter needs the record's Nyquist frequency above its
+    cut-off; past it the statistics do not exist). A `ParameterError` names `solver.timestep` (CLI `--timestep`), the
+    valid range and why; the accuracy bound (`wave_courant`) is `check_wave_resolution`'s."""
+    if not (isinstance(dt, int | float) and not isinstance(dt, bool) and math.isfinite(dt) and dt > 0):
+        raise ParameterError(f"solver.timestep (--timestep) must be a positive number of seconds, got {dt!r}")
+    c = max(p.cw_wave_speed, p.mw_wave_speed)
+    nyquist, courant = 1.0 / (2.0 * p.filter_cutoff), p.element_length / c
+    if not dt < nyquist:
+        raise ParameterError(
+            f"solver.timestep (--timestep) = {dt:g} s is outside its valid range (0, {nyquist:.4g}) s: the "
+            f"{p.filter_cutoff:g} Hz contact-force filter (params.filter_cutoff) needs the record's Nyquist frequency "
+            f"1/(2 dt) above its cut-off (and the FE wave resolution asks for at most params.element_length / c = "
+            f"{p.element_length:g} m / {c:.1f} m/s = {courant:.4g} s)")
+
+
+def check_wave_resolution(p: CatenaryParams, dt: float, allow_inaccurate: bool = False) -> list[str]:
+    """The FE wave resolution of a (valid) time step, judged before anything is built: `wave_courant` past its bound
+    is an `AccuracyError` naming `solver.timestep` and its valid range, unless `allow_inaccurate` (then its warning
+    is returned; the run's health figures carry it again)."""
+    fig = wave_courant(p, dt)
+    if fig.ok:
+        return []
+    if not allow_inaccurate:
+        judge([fig], what="catenary passage")  # raises AccuracyError naming the figure, its bound and the fix
+    return ["INACCURATE: " + fig.message("catenary passage")]
+
+
 def health(run: CatenaryRun) -> list[Figure]:
     """Health figures of a passage: the train speed against the contact wire's wave speed (bound: the near-critical
     ratio, above which the model's own results depend on mesh and step; see `speed_regime`)."""
-    return health_of_regime(run.speed_kmh / 3.6, run.params)
+    return health_of_regime(run.speed_kmh / 3.6, run.params, run.dt)
 
 
-def health_of_regime(speed_ms: float, p: CatenaryParams) -> list[Figure]:
-    """`health` from the speed (m/s) and the catenary parameters (used by single and train passages)."""
+def health_of_regime(speed_ms: float, p: CatenaryParams, dt: float | None = None) -> list[Figure]:
+    """`health` from the speed (m/s), the catenary parameters and the time step (s; adds `wave_courant`) (used by
+    single and train passages)."""
     c = p.cw_wave_speed
-    return [Figure("speed_ratio", float(speed_ms / c), NEAR_CRITICAL_RATIO, "",
+    figs = [Figure("speed_ratio", float(speed_ms / c), NEAR_CRITICAL_RATIO, "",
                    "train speed / contact wire wave speed sqrt(T/rho)",
                    f"lower input.speed below {3.6 * NEAR_CRITICAL_RATIO * c:.1f} km/h "
                    "or raise cw_tension; a near-critical passage needs its own mesh and step convergence study")]
+    return figs + ([wave_courant(p, dt)] if dt is not None else [])
 
 
 @dataclass
@@ -132,7 +176,8 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
              pantograph: str | Pantograph = "reference2mass", contact: str = "unilateral",
              progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
              engine: str = "reference", pantograph_section: dict[str, Any] | None = None,
-             max_steps: float | None = None, native: bool | None = None) -> CatenaryRun:
+             max_steps: float | None = None, native: bool | None = None,
+             allow_inaccurate: bool = False) -> CatenaryRun:
     """Build, run and analyse one pantograph passage (the EN 50318 procedure). `pantograph` is a name
     (the scene's `pantograph` effect, built on the engine path `engine` with the `[pantograph]` section
     `pantograph_section`; see `pantographs.build`) or an object of the pantograph protocol. The speed and the size of
@@ -141,11 +186,11 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     `CoupledSimulation.run`; False: the readable Python path)."""
     if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
         raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"time step must be positive, got {dt!r}")
+    check_timestep(p, dt)
     V = speed_kmh / 3.6
     regime = speed_regime(p, V)
     check_size(p, V, dt, max_steps)
+    step_warn = check_wave_resolution(p, dt, allow_inaccurate)
     t0, c0 = time.perf_counter(), time.process_time()
     fe = fe if fe is not None else assemble(p)
     if isinstance(pantograph, str):
@@ -158,7 +203,7 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     t2 = time.perf_counter()
     stats, ff = en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p)
     t3, c3 = time.perf_counter(), time.process_time()
-    warn = list(regime["warnings"])
+    warn = list(regime["warnings"]) + step_warn
     w = (res.x >= p.window_start) & (res.x <= p.window_end)
     if not np.any(res.force[w] > 0):
         msg = (f"the pantograph is off the wire for the whole window [{p.window_start}, {p.window_end}] m "
@@ -208,7 +253,7 @@ def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides)
     return simulate(p, scene_speed(scene, speed_kmh), scene.solver.timestep, dropper_law=scene.effects["droppers"],
                     pantograph=scene.effects["pantograph"], contact=scene.effects["contact"], progress=progress,
                     engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"),
-                    max_steps=scene.solver.max_steps)
+                    max_steps=scene.solver.max_steps, allow_inaccurate=scene.solver.allow_inaccurate)
 
 
 def to_simresult(run: CatenaryRun, scene) -> SimResult:

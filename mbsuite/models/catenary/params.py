@@ -93,13 +93,20 @@ class CatenaryParams:
         L = self.length
         if not 0.0 <= self.x_start < self.x_end <= L:
             raise ParameterError(
-                f"pantograph run must satisfy 0 <= x_start < x_end <= {L} m, got x_start={self.x_start}, "
-                f"x_end={self.x_end}"
+                f"params.x_start = {self.x_start} m, params.x_end = {self.x_end} m: the pantograph run must satisfy "
+                f"0 <= x_start < x_end <= {L:g} m (n_spans x span_length)"
             )
         if not self.x_start <= self.window_start < self.window_end <= self.x_end:
+            if not self.window_start < self.window_end:
+                culprit = (f"params.window_start = {self.window_start} m must be below params.window_end = "
+                           f"{self.window_end} m")
+            elif self.window_start < self.x_start:
+                culprit = f"params.window_start = {self.window_start} m lies before params.x_start = {self.x_start} m"
+            else:
+                culprit = f"params.window_end = {self.window_end} m lies beyond params.x_end = {self.x_end} m"
             raise ParameterError(
-                f"statistics window [{self.window_start}, {self.window_end}] m must lie inside the run "
-                f"[{self.x_start}, {self.x_end}] m and be non-empty"
+                f"{culprit}: the statistics window [window_start, window_end] must be non-empty and lie inside the "
+                f"run [x_start, x_end] = [{self.x_start}, {self.x_end}] m"
             )
 
     @property

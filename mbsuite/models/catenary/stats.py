@@ -38,7 +38,9 @@ def lowpass(force: np.ndarray, dt: float, cutoff: float, order: int) -> np.ndarr
         raise SolverError(f"filter cut-off {cutoff} Hz is not below the Nyquist frequency {fs / 2} Hz of the record")
     sos = butter(order, cutoff, fs=fs, output="sos")
     if force.size <= 3 * (2 * sos.shape[0] + 1):
-        raise SolverError(f"the force record ({force.size} samples) is too short to filter")
+        raise SolverError(f"the force record ({force.size} samples) is too short to filter (at least "
+                          f"{3 * (2 * sos.shape[0] + 1) + 1} samples); lengthen the run [params.x_start, "
+                          "params.x_end] or reduce solver.timestep")
     return sosfiltfilt(sos, force)
 
 
@@ -65,7 +67,9 @@ def en50318_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, uplift: 
     ff = lowpass(force, dt, p.filter_cutoff, p.filter_order)
     w = (x >= p.window_start) & (x <= p.window_end)
     if w.sum() < 2:
-        raise SolverError("the statistics window holds fewer than two samples")
+        raise SolverError(f"the statistics window [params.window_start, params.window_end] = [{p.window_start:g}, "
+                          f"{p.window_end:g}] m holds {int(w.sum())} sample(s) at solver.timestep = {dt:g} s; it "
+                          "needs at least two: widen the window or reduce the timestep")
     fw = ff[w]
     fm, sd = float(fw.mean()), float(fw.std())
     sup = (support_x >= p.window_start - 1e-9) & (support_x <= p.window_end + 1e-9)

@@ -100,28 +100,29 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
                    engine: str = "reference", pantograph_section: dict[str, Any] | None = None,
                    progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
                    record_energy: int = 0, stepwise: bool = False, head_width: float = HEAD_WIDTH,
-                   record_droppers: bool = False, max_steps: float | None = None) -> TrainRun:
+                   record_droppers: bool = False, max_steps: float | None = None,
+                   allow_inaccurate: bool = False) -> TrainRun:
     """Run a train of pantographs (leading first) at `speed_kmh` with `spacings` (m, between consecutive contact
     points). Names are built on `engine` (reference2mass always on its only path). `record_energy` > 0 records the
     energy terms every that many steps, `record_droppers` the droppers' elastic tensions T0 + k delta and slack status
     at every step (`TrainRun.dropper_elastic`, `dropper_slack`; both on the stage path). `stepwise` forces the
     Python-driven stage loop even for 2-mass pantographs (the path the nonlinear pantographs take; a test holds both
     equal)."""
-    from .analysis import check_size, speed_regime
+    from .analysis import check_size, check_timestep, check_wave_resolution, speed_regime
 
     if len(pantographs) != len(spacings) + 1:
         raise ParameterError(f"{len(pantographs)} pantographs need {len(pantographs) - 1} spacings, got "
                              f"{len(spacings)}")
     if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
         raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"time step must be positive, got {dt!r}")
+    check_timestep(p, dt)
     offsets = check_train(p, spacings, head_width)
     V = speed_kmh / 3.6
     regime = speed_regime(p, V)
     import dataclasses
 
     check_size(dataclasses.replace(p, x_end=p.x_end + offsets[-1]), V, dt, max_steps)  # the whole train's steps
+    step_warn = check_wave_resolution(p, dt, allow_inaccurate)
     t0, c0 = time.perf_counter(), time.process_time()
     fe = fe if fe is not None else assemble(p)
     pans, names, engines = [], [], []
@@ -258,7 +259,7 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
     return TrainRun(params=p, speed_kmh=float(speed_kmh), dt=float(dt), dropper_law=dropper_law, names=names,
                     offsets=offsets, engines=engines, results=results, stats=stats, filtered=filtered,
                     static_forces=static_forces, timing=timing, energy=energy,
-                    energy_t=None if energy is None else np.array(en_t), warnings=list(regime["warnings"]),
+                    energy_t=None if energy is None else np.array(en_t), warnings=list(regime["warnings"]) + step_warn,
                     dropper_elastic=DE, dropper_slack=DS, t=T, x=X)
 
 
@@ -425,7 +426,8 @@ def run_train_scene(scene, speed_kmh: float | None = None, progress=None, spacin
                           list(tr["spacings"] if spacings is None else spacings),
                           dropper_law=scene.effects["droppers"], contact=scene.effects["contact"],
                           engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"),
-                          progress=progress, max_steps=scene.solver.max_steps)
+                          progress=progress, max_steps=scene.solver.max_steps,
+                          allow_inaccurate=scene.solver.allow_inaccurate)
 
 
 # --- outputs ------------------------------------------------------------------------------------------------------
@@ -547,7 +549,7 @@ def train_to_simresult(run: TrainRun, scene):
         stats[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
     events = [{**e, "pantograph": k + 1} for k, s in enumerate(run.stats) for e in s["loss_events"]]
     res = assemble(scene, lead.t, signals, engine=run.engines[-1], events=events, stats=stats,
-                   health=health_of_regime(run.speed_kmh / 3.6, run.params))
+                   health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
     for k, r in enumerate(run.results):
         res.signals[f"contact_force_p{k + 1}"] = r.force
         res.units[f"contact_force_p{k + 1}"] = "N"

@@ -12,6 +12,14 @@ from ...registry import Effect, ModelSpec
 from .mujoco import INPUTS, OUTPUTS, run
 from .params import CouplerParams
 
+
+def _check_file(path: Path, engine: str, model: object) -> None:
+    """The loaders' check of a shipped coupler model file (closures at the stated lengths, inertias, names)."""
+    from .modelfiles import check_model_file
+
+    check_model_file(path, engine, model)
+
+
 SPEC = ModelSpec(
     name="coupler",
     summary="single/double 4-link SS couplers: kinematics (rank, screws, criteria) and double-coupler dynamics",
@@ -31,4 +39,5 @@ SPEC = ModelSpec(
     cases="mbsuite.models.coupler.cases",
     extra={"solver_defaults": {"integrator": "implicitfast", "timestep": 5e-4, "duration": 2.0, "t_settle": 0.5,
                                "sample_dt": 2e-3}},
+    file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
 )

@@ -8,7 +8,7 @@ import textwrap
 import warnings
 from pathlib import Path
 
-from ...errors import ParameterError
+from ...errors import ParameterError, SceneError
 from ...results import Report, format_table
 from ...scenes import load_scene
 from . import analysis
@@ -145,6 +145,9 @@ def dynamics_table(scene_input: dict, res) -> str:
 def _cmd_dynamics(emit):
     def run(args: argparse.Namespace) -> None:
         scene = load_scene(args.scene)
+        if scene.model != "coupler":
+            raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; coupler dynamics needs a coupler scene "
+                             "('coupler' or coupler/<scene>, e.g. coupler/double_friction)")
         if args.engine:
             scene = scene.replace(solver={"engine": args.engine})
         res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)

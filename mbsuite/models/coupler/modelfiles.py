@@ -448,6 +448,41 @@ def check_mjcf(m, path: str | Path, kind: str, stated: CouplerParams | None = No
     check_inertias_mujoco(m, path)
 
 
+#: file stem -> coupler kind of the coupler model files (`check_model_file`)
+FILE_STEMS = {"coupler_single": "single", "coupler_double": "double"}
+
+
+def check_model_file(path: Path, engine: str, model) -> None:
+    """The checks of a coupler model file (`coupler_single`, `coupler_double`) as a loader compiled it, for the
+    engines' loaders (`ModelSpec.file_checks`), reusing the model's checks at load:
+
+    - engine "mujoco", `model` an `mujoco.MjModel` of the MJCF: `check_mjcf` (names, each <connect> at the stated
+      link length and on its joint points at q = 0, inertias);
+    - engine "pinocchio", the MJCF read by Pinocchio: the file's <connect> anchors on Pinocchio's own frames
+      (`pinocchio.PinMjcfCoupler`; `buildModelFromMJCF` drops the <connect>s, so they are read from the file);
+    - engine "urdf", `model` a `pin.Model` of the URDF: its <mbsuite_closure> lengths against the frames at q = 0
+      and the shafts' inertias (`pinocchio.PinCoupler`).
+
+    Raises ModelFileError naming the file, the link (closure) and the residual."""
+    path = Path(path)
+    kind = FILE_STEMS.get(path.stem)
+    if kind is None:
+        raise ModelFileError(f"{path}: not a coupler model file; valid names: {sorted(FILE_STEMS)}")
+    if engine == "mujoco":
+        check_mjcf(model, path, kind)
+    elif engine == "pinocchio":
+        from .pinocchio import PinMjcfCoupler
+
+        PinMjcfCoupler(kind, path)
+    elif engine == "urdf":
+        from .pinocchio import PinCoupler
+
+        PinCoupler(kind, CouplerParams(), model, closures_from_urdf(path), str(path))
+    else:
+        raise ModelFileError(f"{path}: unknown engine {engine!r} for the coupler file checks; valid: "
+                             "['mujoco', 'pinocchio', 'urdf']")
+
+
 def load_checked_mjcf(kind: str, base: str | Path | None = None):
     """Compile the coupler MJCF `base` (default: the shipped file) as it is, check it (`check_mjcf`) and return
     (path, compiled model). A file that is not MJCF is a ModelFileError naming it."""

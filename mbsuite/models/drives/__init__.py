@@ -43,7 +43,8 @@ SPEC = ModelSpec(
         # `value` has no fixed default: without it (and without a profile) the parameter set's `ref` is the reference
         "reference": {"value": Limit(lo=-1e5, hi=1e5, unit="rad/s",
                                      doc="constant speed reference (default: the parameter set's ref)"),
-                      "profile": "[[t, r], ...] piecewise-linear reference (rad/s; t increasing, checked by the run)"},
+                      "profile": "[[t, r], ...] piecewise-linear reference (rad/s; finite, t strictly increasing, "
+                                 "abs(r) <= 1e5; checked by the run)"},
         "none": {},
     },
     outputs=SIGNALS,

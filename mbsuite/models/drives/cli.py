@@ -55,11 +55,24 @@ OPTION_LIMITS: dict[str, Limit] = {
 }
 
 
-def _floats(text: str) -> list[float]:
-    try:
-        return [float(x) for x in text.split(",") if x.strip()]
-    except ValueError as exc:
-        raise SceneError(f"expected a comma-separated list of numbers, got {text!r}") from exc
+def _floats(flag: str):
+    """argparse `type` of the comma-list option `flag`: a list of floats; a non-number is an ArgumentTypeError naming
+    the flag and the entry (ranges are checked after parsing by `_check_options`)."""
+
+    def conv(text: str) -> list[float]:
+        out = []
+        for x in text.split(","):
+            if not x.strip():
+                continue
+            try:
+                out.append(float(x))
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"{x.strip()!r} is not a number (expected a comma list of "
+                                                 "numbers)") from None
+        return out
+
+    conv.__name__ = f"{flag} comma list of numbers"
+    return conv
 
 
 def _check_options(a: argparse.Namespace, *flags: str) -> None:
@@ -77,6 +90,13 @@ def _check_options(a: argparse.Namespace, *flags: str) -> None:
                 lim.check(f"{flag} entry {i + 1}", x, MbsuiteError)
         else:
             lim.check(flag, v, MbsuiteError)
+
+
+def _check_speed_range(wmin: float, wmax: float) -> None:
+    """The load speed range of a design: --wmin must lie below --wmax."""
+    if not wmin < wmax:
+        raise MbsuiteError(f"--wmin {wmin:g} rad/s must be below --wmax {wmax:g} rad/s (the load speed range "
+                           "[w_min, w_max] of the design)")
 
 
 def _check_steps(flag: str, duration: float, dt: float) -> None:
@@ -140,16 +160,17 @@ def register(sub, add_common, emit) -> None:
 
     q = ds.add_parser("cadjs", help="CADJS: K, clutch torque, x_max, Sr_max per J_s (Eqs 5.9-5.13 corrected)")
     q.add_argument("--P", type=float, required=True)
-    q.add_argument("--srmin", type=_floats, required=True, help="comma list")
+    q.add_argument("--srmin", type=_floats("--srmin"), required=True, help="comma list")
     q.add_argument("--wmin", type=float, default=0.0)
     q.add_argument("--wmax", type=float, required=True)
     q.add_argument("--vm", type=float, required=True)
-    q.add_argument("--js", type=_floats, default=None, help="comma list (default 1e-5 ... 1e-4)")
+    q.add_argument("--js", type=_floats("--js"), default=None, help="comma list (default 1e-5 ... 1e-4)")
     q.add_argument("--tau-c", type=float, default=None, help="read the family at this clutch torque")
     add_common(q)
 
     def _cadjs(a):
         _check_options(a, "--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c")
+        _check_speed_range(a.wmin, a.wmax)
         rows, data = [], []
         for sr in a.srmin:
             ds_ = ([D.at_clutch_torque(a.P, sr, a.wmin, a.wmax, a.vm, a.tau_c)] if a.tau_c
@@ -257,7 +278,7 @@ def register(sub, add_common, emit) -> None:
 
     q = dsub.add_parser("efficiency", help="open-loop efficiency vs steady load speed over load torques")
     q.add_argument("scene")
-    q.add_argument("--loads", type=_floats, default=None, help="comma list of load torques (N m)")
+    q.add_argument("--loads", type=_floats("--loads"), default=None, help="comma list of load torques (N m)")
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
     add_common(q)

@@ -102,8 +102,10 @@ def design_point(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float
     """One CADJS point: K at (w_min, Sr_min) (5.11), Sr_max at w_max (5.13), x_max (5.9) and tau_c = K x_max (5.10)."""
     for nm, v in (("P", P), ("Sr_min", Sr_min), ("w_max", w_max), ("V_m", V_m), ("J_s", J_s)):
         _pos(nm, v)
-    if w_min < 0:
-        raise ParameterError(f"w_min must be >= 0, got {w_min!r}")
+    if not (isinstance(w_min, int | float) and math.isfinite(w_min) and w_min >= 0):
+        raise ParameterError(f"w_min must be a number >= 0, got {w_min!r}")
+    if not w_min < w_max:
+        raise ParameterError(f"w_min = {w_min:g} rad/s must be below w_max = {w_max:g} rad/s (the load speed range)")
     K = k_from_js(P, Sr_min, w_min, V_m, J_s)
     Sr = sr_from_kjs(P, w_max, V_m, K, J_s)
     x = x_f(P, Sr, w_max, V_m, K, J_s)

@@ -28,12 +28,37 @@ SIGNALS = {
 ENERGY_BOUND = {"reference": 1e-6, "mujoco": 1e-5}
 
 
+#: bound of a speed reference value (rad/s), as the scene's `input.value` Limit
+REF_BOUND = 1e5
+
+
+def check_profile(profile: Any) -> np.ndarray:
+    """`input.profile` as an (n, 2) float array: a non-empty list of [t, r] pairs of finite numbers (t in s, r in
+    rad/s with |r| <= 1e5), t strictly increasing. Anything else is a `SceneError` naming `input.profile`, the
+    offending row and the valid form."""
+    form = "a non-empty list of [t (s), r (rad/s)] pairs of finite numbers, t strictly increasing, |r| <= 1e5"
+    if not isinstance(profile, list | tuple) or not profile:
+        raise SceneError(f"input.profile = {profile!r} is not {form}")
+    for i, row in enumerate(profile):
+        if (not isinstance(row, list | tuple) or len(row) != 2
+                or any(isinstance(v, bool) or not isinstance(v, int | float) for v in row)):
+            raise SceneError(f"input.profile[{i}] = {row!r} is not a [t, r] pair of numbers; input.profile must be "
+                             f"{form}")
+        if not all(math.isfinite(v) for v in row):
+            raise SceneError(f"input.profile[{i}] = {row!r} is not finite; input.profile must be {form}")
+        if abs(row[1]) > REF_BOUND:
+            raise SceneError(f"input.profile[{i}] reference {row[1]!r} rad/s is outside [-1e5, 1e5] rad/s")
+        if i and not row[0] > profile[i - 1][0]:
+            raise SceneError(f"input.profile times must be strictly increasing; input.profile[{i}] t = {row[0]!r} "
+                             f"<= input.profile[{i - 1}] t = {profile[i - 1][0]!r}")
+    return np.asarray(profile, float)
+
+
 def reference_signal(inp: dict[str, Any], default: float):
-    """The speed reference: `value` (rad/s) or `profile` = [[t, r], ...] (piecewise linear, as App. J `ref_signal`)."""
+    """The speed reference: `value` (rad/s) or `profile` = [[t, r], ...] (piecewise linear, as App. J `ref_signal`;
+    checked by `check_profile`)."""
     if "profile" in inp:
-        prof = np.asarray(inp["profile"], float)
-        if prof.ndim != 2 or prof.shape[1] != 2 or prof.shape[0] < 1 or np.any(np.diff(prof[:, 0]) < 0):
-            raise SceneError(f"input.profile must be a list of [t, r] pairs with increasing t, got {inp['profile']!r}")
+        prof = check_profile(inp["profile"])
         return lambda t: float(np.interp(t, prof[:, 0], prof[:, 1]))
     return float(inp.get("value", default))
 

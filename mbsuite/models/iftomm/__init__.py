@@ -10,6 +10,14 @@ from ...registry import Effect, ModelSpec
 from .analysis import OUTPUTS, run
 from .params import IftommParams
 
+
+def _check_file(path: Path, engine: str, model: object) -> None:
+    """The loaders' check of a shipped iftomm model file (closures at the stated lengths, inertias, names)."""
+    from .mechanisms import check_model_file
+
+    check_model_file(path, engine, model)
+
+
 SPEC = ModelSpec(
     name="iftomm",
     summary="IFToMM benchmark gates: four-bar through singular positions (A02), over-constrained Bricard (A04)",
@@ -25,4 +33,5 @@ SPEC = ModelSpec(
     cases="mbsuite.models.iftomm.cases",
     extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3, "method": "DOP853",
                                "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "sample_dt": 1e-2}},
+    file_checks={"iftomm_fourbar": _check_file, "iftomm_bricard": _check_file},
 )

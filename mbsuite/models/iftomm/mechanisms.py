@@ -127,6 +127,59 @@ def check_mujoco_model(m: mujoco.MjModel, path, mechanism: str) -> None:
                                  "moving body needs mass > 0 and a positive definite inertia (triangle inequality)")
 
 
+def _pin_point(model: pin.Model, data: pin.Data, path, body: str, point) -> np.ndarray:
+    """World position (after forward kinematics) of a point fixed in MJCF body `body` ("world": the point itself)."""
+    if body == "world":
+        return np.asarray(point, float)
+    if not model.existFrame(body, pin.FrameType.BODY):
+        raise ModelFileError(f"{path}: Pinocchio finds no body {body!r} in the file")
+    f = model.frames[model.getFrameId(body, pin.FrameType.BODY)]
+    return data.oMi[f.parentJoint].act(f.placement.act(np.asarray(point, float)))
+
+
+def check_pinocchio_model(model: pin.Model, path, mechanism: str) -> None:
+    """Checks at load of an IFToMM file read by Pinocchio (DESIGN): every stated closure assembles at the neutral
+    pose q = 0 on Pinocchio's own frames, and the body of every joint has mass > 0 and a positive definite inertia.
+    Else ModelFileError naming the file, the body and the residual."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    for name, b1, a, b2, b in DESIGN[mechanism]["closures"]:
+        gap = float(np.linalg.norm(_pin_point(model, data, path, b1, a) - _pin_point(model, data, path, b2, b)))
+        if not gap <= CLOSURE_RTOL * BAR:
+            raise _closure_error(path, name, b2 if b2 != "world" else b1, gap, "Pinocchio")
+    for j in range(1, model.njoints):
+        inertia = model.inertias[j]
+        eig = np.linalg.eigvalsh(inertia.inertia)
+        if not (inertia.mass > 0 and eig[0] > 0):
+            raise ModelFileError(f"{path}: the body on joint {model.names[j]!r} has mass {inertia.mass:g} kg and "
+                                 f"inertia eigenvalues {eig.tolist()} kg m^2: a moving body needs mass > 0 and a "
+                                 "positive definite inertia")
+
+
+#: file stem -> mechanism of the IFToMM model files (`check_model_file`)
+FILE_STEMS = {f"iftomm_{m}": m for m in MECHANISMS}
+
+
+def check_model_file(path, engine: str, model) -> None:
+    """The checks of an IFToMM model file (`iftomm_fourbar`, `iftomm_bricard`) as a loader compiled it, for the
+    engines' loaders (`ModelSpec.file_checks`): engine "mujoco" with an `mujoco.MjModel` (`check_mujoco_model`),
+    "pinocchio" or "urdf" with a `pin.Model` (`check_pinocchio_model`). Raises ModelFileError naming the file, the
+    body/closure and the residual."""
+    from pathlib import Path
+
+    path = Path(path)
+    mechanism = FILE_STEMS.get(path.stem)
+    if mechanism is None:
+        raise ModelFileError(f"{path}: not an IFToMM model file; valid names: {sorted(FILE_STEMS)}")
+    if engine == "mujoco":
+        check_mujoco_model(model, path, mechanism)
+    elif engine in ("pinocchio", "urdf"):
+        check_pinocchio_model(model, path, mechanism)
+    else:
+        raise ModelFileError(f"{path}: unknown engine {engine!r} for the IFToMM file checks; valid: "
+                             "['mujoco', 'pinocchio', 'urdf']")
+
+
 def mujoco_model(mechanism: str, timestep: float, integrator: str, solref_timeconst: float,
                  gravity: float) -> mujoco.MjModel:
     """The mechanism's MJCF compiled and checked at load (`check_mujoco_model`), with the run's settings."""
@@ -208,13 +261,9 @@ class PinocchioMechanism:
         self.model.gravity.linear = np.array([0.0, -gravity, 0.0])
         self.data = self.model.createData()
         # the stated closures (DESIGN) on Pinocchio's own frames, checked at the initial pose before anything else
+        check_pinocchio_model(self.model, self.path, mechanism)
         self.closures = [Closure(*self._on_joint(b1, a), *self._on_joint(b2, b))
                          for _, b1, a, b2, b in DESIGN[mechanism]["closures"]]
-        r0 = self.closure(pin.neutral(self.model)).reshape(-1, 3)
-        for (name, b1, _, b2, _), r in zip(DESIGN[mechanism]["closures"], r0, strict=True):
-            gap = float(np.linalg.norm(r))
-            if not gap <= CLOSURE_RTOL * BAR:
-                raise _closure_error(self.path, name, b2 if b2 != "world" else b1, gap, "Pinocchio")
         self.mj = mujoco_model(mechanism, 1e-3, "rk4", 0.004, gravity)
         self.penalty, self.omega = float(penalty), float(omega)
         # the four-bar is integrated on its parallelogram branch q = (s, -s, s): a linear map, exact on that branch;

@@ -46,6 +46,7 @@ SPEC = ModelSpec(
     modes=analysis.modes_report,
     freqresp=analysis.freqresp,
     under_wire=_under_wire,
+    mujoco_model=analysis.mujoco_model,
     cases="mbsuite.models.pantograph.cases",
     # defaults chosen from scripts/pantograph_workprecision.py: RK4 at 1e-3 s reaches 3e-5 relative physics error
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.

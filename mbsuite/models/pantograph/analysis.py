@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 from ...analysis.harmonic import fundamental
@@ -239,6 +240,28 @@ def run(scene: Scene) -> SimResult:
         return assemble(scene, tr.t, sig, engine="mujoco", events=ev,
                         stats={"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep,
                                "warnings": tr.warnings}, health=[*pre, excursion(th, th0)])
+
+
+def mujoco_model(scene: Scene) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """The `mujoco_model` hook (`mbsuite view`): the compiled MuJoCo model of exactly the scene's effects (engine
+    plugins for the cylinder and the compliant elbow, `mujoco.py`) with the scene's integrator and timestep, and its
+    data in the state a MuJoCo run starts from: the static equilibrium at the ram height y_w(0) (or the scene's
+    `initial = "fortran"` start), at rest, cylinder at rest, ctrl[catenary] = y_w(0), after mj_forward."""
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    u = input_of(scene, p)
+    s = scene.solver
+    x0 = initial_theta(scene, ode, u)
+    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
+    y0 = float(np.asarray(u(np.zeros(1))).ravel()[0])
+    if scene.input.get("initial", "equilibrium") == "equilibrium":
+        q0 = mp.equilibrium(y0, theta_to_q(ode.theta(x0[:ode.nq])))
+    else:
+        q0 = theta_to_q(x0[:3])
+    mp.set_static(q0, y0)
+    mp.data.time = 0.0
+    return mp.model, mp.data
 
 
 # ------------------------------------------------------------------------------------------------ linearisation

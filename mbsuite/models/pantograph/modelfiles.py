@@ -33,6 +33,8 @@ from ...paths import models_root
 from .params import PantographParams
 
 AXIS = "0 -1 0"
+#: depth of the (visual) floor plane below the base hinge, m; the floor takes part in no contact
+FLOOR_DEPTH = 0.28
 
 
 def _f(x: float) -> str:
@@ -232,17 +234,32 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
      q3 = theta_h + theta_2 - pi. One root body (Pinocchio reads only the first top-level body).
      ctrl[catenary] = ram/wire height y_w (m). Engine plugins: call mbsuite.native.load() before compiling.
      No contacts (the wire acts through the catenary actuator) and one constraint island: collision detection and
-     island discovery are switched off, which changes no result and saves 17 % of a step. -->
+     island discovery are switched off, which changes no result and saves 17 % of a step. Lights, the floor, the
+     camera "side" and every geom are for looking only: no geom collides (contype = conaffinity = 0) and every body
+     states its inertia, so the geoms add no mass. -->
 <mujoco model="pantograph">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{_f(timestep)}" integrator="implicitfast" gravity="0 0 {_f(-g)}">
     <flag contact="disable" island="disable"/>
   </option>
-{extension}  <default>
+{extension}  <visual>
+    <headlight ambient="0.3 0.3 0.3" diffuse="0.4 0.4 0.4"/>
+  </visual>
+  <asset>
+    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.65 0.8" rgb2="0.1 0.12 0.15" width="512"
+             height="3072"/>
+    <texture name="grid" type="2d" builtin="checker" rgb1="0.25 0.3 0.35" rgb2="0.2 0.25 0.3" width="256"
+             height="256"/>
+    <material name="grid" texture="grid" texrepeat="8 8" reflectance="0.1"/>
+  </asset>
+  <default>
     <geom contype="0" conaffinity="0" rgba="0.75 0.75 0.8 1"/>
   </default>
   <worldbody>
-    <light pos="0 -4 4" dir="0 1 -1"/>
+    <light name="key" pos="0.9 -4 4" dir="0 1 -1" directional="true"/>
+    <light name="fill" pos="0.9 4 3" dir="0 -1 -0.6" diffuse="0.3 0.3 0.3"/>
+    <geom name="floor" type="plane" size="0 0 0.05" pos="0 0 {_f(-FLOOR_DEPTH)}" material="grid"/>
+    <camera name="side" pos="{_f(0.45 * p.l1)} -5.0 0.85" xyaxes="1 0 0 0 0 1" fovy="45"/>
     <body name="base">
       <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
       <geom name="base_plate" type="box" size="0.4 0.3 0.03" pos="0.2 0 -0.25" rgba="0.3 0.3 0.3 1"/>
@@ -255,6 +272,10 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
         <geom name="lower_arm" type="capsule" fromto="0 0 0 {_f(p.l1)} 0 0" size="0.03"/>
         <site name="elbow_pinion" pos="{_f(p.l1)} 0 0" size="{_f(p.le)}"/>
         <site name="cylinder_lever" pos="{_f(lx)} 0 {_f(lz)}" size="0.02"/>
+        <geom name="cylinder_lever" type="capsule" fromto="0 0 0 {_f(lx)} 0 {_f(lz)}" size="0.02"
+              rgba="0.8 0.4 0.1 1"/>
+        <geom name="elbow_pinion" type="cylinder" fromto="{_f(p.l1)} -0.04 0 {_f(p.l1)} 0.04 0"
+              size="{_f(p.le)}" rgba="0.8 0.4 0.1 1"/>
         <body name="upper_arm" pos="{_f(p.l1)} 0 0">
           <joint name="knuckle_joint" type="hinge" axis="{AXIS}" damping="{_f(b2)}" frictionloss="{_f(c2)}"
                solreffriction="{sf} 1"/>

@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     print("\n== Summary", flush=True)
     peaks = fr.get("peaks_hz", {})
     for m, pk in peaks.items():
-        print(f"pantograph {m:>10}: F1 peaks {', '.join(f'{x:.2f}' for x in pk['F1'])} Hz; "
+        print(f"pantograph {m:>17}: F1 peaks {', '.join(f'{x:.2f}' for x in pk['F1'])} Hz; "
               f"HD peaks {', '.join(f'{x:.2f}' for x in pk['HD'])} Hz")
     if "thesis_resonances_simulated_hz" in fr:
         print(f"thesis (Eppinger 1984): simulated {fr['thesis_resonances_simulated_hz']} Hz, "

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import textwrap
 import time
 import warnings
 from collections.abc import Callable
@@ -325,10 +326,12 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
                      f"static contact force {r.static_force:.2f} N; run time {r.timing['total_s']:.2f} s wall, "
                      f"{r.timing['cpu_s']:.2f} s CPU "
                      f"({r.timing['steps']} steps, {r.timing['dofs']} DOFs, {r.timing['us_per_step']:.0f} us/step)")
+        lines[-1] = textwrap.fill(lines[-1], 100, subsequent_indent="  ")
     lines.append(f"speed ratio V/c = {run.regime['speed_ratio']:.3f} (c = {run.regime['cw_wave_speed_kmh']:.1f} km/h), "
                  f"regime: {run.regime['regime']}")
+    lines[-1] = textwrap.fill(lines[-1], 100, subsequent_indent="  ")
     for w in run.warnings:
-        lines.append(f"WARNING: {w}")
+        lines.append(textwrap.fill(f"WARNING: {w}", 100, subsequent_indent="  "))
     data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "engine": run.engine,
             "element_length": run.params.element_length,
             "timestep": run.dt, "regime": {k: v for k, v in run.regime.items() if k != "warnings"},

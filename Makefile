@@ -32,6 +32,10 @@ bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tes
 	$(BIN)/python scripts/bench_paths.py
 	$(BIN)/python scripts/bench_sweep.py
 
+docs: $(STAMP)  ## the documentation site (API reference, model pages, gallery) -> out/site/; warnings are errors
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	$(BIN)/python scripts/build_docs.py
+
 mutants: $(STAMP)  ## seeded physics defects, one at a time, against the default suite (tens of minutes)
 	$(BIN)/python scripts/mutants.py --json out/mutants.json
 

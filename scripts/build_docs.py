@@ -1,0 +1,104 @@
+"""Build the documentation site (mkdocs-material + mkdocstrings, strict: any warning is an error).
+
+The pages are the repository's own documents, gathered into `docs/` at build time so that each exists once: the top
+README becomes the home page, each model's README its model page; `docs/gallery.md` shows every figure the suite writes
+beside the command that makes it (the figures are made here, by those very commands, unless `--no-figures`).
+
+    python scripts/build_docs.py               # -> out/site/
+    python scripts/build_docs.py --no-figures  # reuse the figures of an earlier build
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+MODELS = ("pantograph", "coupler", "drives", "catenary", "iftomm")
+
+# (title, command, figure files written into --out, what the figure shows)
+GALLERY: list[tuple[str, str, list[str], str]] = [
+    ("Pantograph frequency response", "mbsuite freqresp pantograph --methods linear,mujoco",
+     ["freqresp.png"], "Response amplitude and phase of F1, F2, HD and y_d per unit ram amplitude, from the "
+     "linearisation about the mean ram height and from MuJoCo time simulations, with the thesis' resonances."),
+    ("Pantograph time history", "mbsuite run pantograph", ["run.png"],
+     "The lab scene's signals over time, one panel per unit."),
+    ("EN 50318 passage", "mbsuite catenary catenary/en50318 --speed 250 --quality",
+     ["force_uplift_reference2mass_250kmh.png", "quality_reference2mass_250kmh.png"],
+     "Contact force, contact-wire height and uplift along the section; the current-collection quality criteria."),
+    ("Coupler criteria", "mbsuite coupler criteria --quick",
+     ["fig6_phi_difference.png", "fig9_criteria_single.png", "fig10_c5_double.png"],
+     "Kinematic errors and criteria c1-c5 of the single and double couplers over a revolution."),
+    ("Drives efficiency", "mbsuite drive efficiency drives/step_up_efficiency --loads 0.2,0.4,0.6 --duration 3",
+     ["efficiency.png"], "Efficiency and loss breakdown of the step-up drive against load speed."),
+    ("Work-precision", "mbsuite workprecision drives/coupled_clutches --quick --repeats 1", ["workprecision.png"],
+     "Error against wall time for every engine and setting; each point labelled with its step or tolerance."),
+]
+
+
+def _gather() -> None:
+    """Copy the repository's documents into docs/ (generated pages; git-ignored), rewriting their links."""
+    text = (ROOT / "README.md").read_text()
+    for m in MODELS:
+        text = text.replace(f"](mbsuite/models/{m}/README.md)", f"](models/{m}.md)")
+    text = text.replace("](docs/accuracy.md)", "](accuracy.md)")
+    (DOCS / "index.md").write_text(text)
+    (DOCS / "models").mkdir(exist_ok=True)
+    for m in MODELS:
+        page = (ROOT / "mbsuite" / "models" / m / "README.md").read_text()
+        page = page.replace("](../../../docs/accuracy.md)", "](../accuracy.md)")
+        page = re.sub(r"\]\((\.\./)+([^)]+)\)", r"] (`\2`)", page)  # other repository paths: shown as paths
+        (DOCS / "models" / f"{m}.md").write_text(page)
+
+
+def _figures(out: Path) -> None:
+    """Run every gallery command with --out and copy its figures into docs/gallery/."""
+    dest = DOCS / "gallery"
+    dest.mkdir(exist_ok=True)
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    for i, (_title, cmd, files, _what) in enumerate(GALLERY):
+        d = out / f"gallery_{i}"
+        argv = [sys.executable, "-m", "mbsuite.cli", *shlex.split(cmd)[1:], "--out", str(d)]
+        subprocess.run(argv, check=True, env=env, stdout=subprocess.DEVNULL)
+        for f in files:
+            hits = sorted(d.rglob(f))
+            if not hits:
+                raise SystemExit(f"gallery: {cmd!r} wrote no {f} into {d}")
+            shutil.copy2(hits[0], dest / f)
+
+
+def _gallery_page() -> None:
+    lines = ["# Gallery", "", "Every figure below is written by the command above it (`--out DIR`); the same "
+             "directory also holds the CSV files (SI units in the header) and `summary.json`.", ""]
+    for title, cmd, files, what in GALLERY:
+        lines += [f"## {title}", "", f"```\n{cmd} --out DIR\n```", "", what, ""]
+        lines += [f"![{title}](gallery/{f})" for f in files] + [""]
+    (DOCS / "gallery.md").write_text("\n".join(lines))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--no-figures", action="store_true", help="do not remake the gallery's figures")
+    args = ap.parse_args(argv)
+    _gather()
+    _gallery_page()
+    if not args.no_figures:
+        _figures(ROOT / "out" / "docs-figures")
+    missing = [f for _, _, files, _ in GALLERY for f in files if not (DOCS / "gallery" / f).is_file()]
+    if missing:
+        print(f"gallery figures missing: {missing}; run without --no-figures", file=sys.stderr)
+        return 2
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
+    return subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(ROOT / "mkdocs.yml")],
+                          cwd=ROOT, env=env).returncode
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -462,3 +462,14 @@ def test_signal_parameters_are_checked():
         Pulse(n=1.5)
     with pytest.raises(ParameterError, match="table signal"):
         Table(("a",), (1.0,))
+
+
+def test_view_models_are_the_runs_models():
+    """What `mbsuite view` opens is the model the scene runs: same bodies and degrees of freedom, finite state."""
+    for name, spec in sorted(registry.models().items()):
+        if spec.mujoco_model is None:
+            continue
+        scene = load_scene(name)
+        m, d = spec.mujoco_model(scene)
+        assert m.nbody > 1 and m.nv > 0 and np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)), name
+        assert m.opt.timestep == pytest.approx(scene.solver.timestep), name

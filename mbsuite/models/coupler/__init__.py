@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...registry import Effect, ModelSpec
-from .mujoco import INPUTS, OUTPUTS, run
+from .mujoco import INPUTS, OUTPUTS, run, view_model
 from .params import CouplerParams
 
 
@@ -39,5 +39,6 @@ SPEC = ModelSpec(
     cases="mbsuite.models.coupler.cases",
     extra={"solver_defaults": {"integrator": "implicitfast", "timestep": 5e-4, "duration": 2.0, "t_settle": 0.5,
                                "sample_dt": 2e-3}},
+    mujoco_model=view_model,
     file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
 )

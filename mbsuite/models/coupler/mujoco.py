@@ -227,6 +227,14 @@ def servo_hint(p: CouplerParams, inp: dict[str, float]) -> str:
             "the load, raise params.kv_drive)")
 
 
+def view_model(scene) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """The scene's double coupler as MuJoCo runs it (`mbsuite view`): its effects, assembled at the start pose."""
+    p: CouplerParams = scene.build_params()
+    m, d, _ = build(p, dict(scene.effects), _inputs(scene), scene.solver.timestep, scene.solver.integrator)
+    mujoco.mj_forward(m, d)
+    return m, d
+
+
 def run(scene) -> SimResult:
     """Time simulation of the double coupler (MuJoCo or the kinematic/quasi-static reference)."""
     p: CouplerParams = scene.build_params()

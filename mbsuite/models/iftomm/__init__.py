@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ...limits import Limit
 from ...registry import Effect, ModelSpec
-from .analysis import OUTPUTS, run
+from .analysis import OUTPUTS, run, view_model
 from .params import IftommParams
 
 
@@ -33,5 +33,6 @@ SPEC = ModelSpec(
     cases="mbsuite.models.iftomm.cases",
     extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3, "method": "DOP853",
                                "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "sample_dt": 1e-2}},
+    mujoco_model=view_model,
     file_checks={"iftomm_fourbar": _check_file, "iftomm_bricard": _check_file},
 )

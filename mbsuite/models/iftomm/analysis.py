@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 
 from ...errors import SceneError
@@ -18,6 +19,18 @@ def branch_angle(mechanism: str, q: np.ndarray) -> np.ndarray:
     """Four-bar: the coupler's absolute angle (0 on the parallelogram branch). Bricard: q1 + q3 (0 on the motion
     through the cube-hexagon pose, whose joints 1, 3, 5 turn by +-the same angle)."""
     return q[:, 0] + q[:, 1] if mechanism == "fourbar" else q[:, 0] + q[:, 2]
+
+
+def view_model(scene: Scene) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """The scene's mechanism as MuJoCo runs it (`mbsuite view`): compiled with the scene's settings, at q = 0 with
+    the scene's initial rates."""
+    p = scene.build_params()
+    sv = scene.solver
+    m = mujoco_model(scene.effects["mechanism"], sv.timestep, sv.integrator, p.solref_timeconst, p.gravity)
+    d = mujoco.MjData(m)
+    d.qvel[:] = initial_velocity(m, float(scene.input.get("rate", 0.0)))
+    mujoco.mj_forward(m, d)
+    return m, d
 
 
 def run(scene: Scene) -> SimResult:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import pytest
 
@@ -68,7 +69,8 @@ def test_timestep_past_the_wave_resolution_runs_when_allowed():
         res = mbsuite.run(scene)
     assert any("wave_courant" in w for w in res.warnings)
     (fig,) = [f for f in res.health if f.name == "wave_courant"]
-    assert fig.value == pytest.approx(122.28 * 0.005 / 0.5, rel=1e-3) and not fig.ok
+    # c dt / h with c the faster wire's sqrt(T/rho) (the messenger: sqrt(16000 / 1.07) = 122.28 m/s)
+    assert fig.value == pytest.approx(math.sqrt(16000.0 / 1.07) * 0.005 / 0.5, rel=1e-12) and not fig.ok
 
 
 def test_timestep_bounds():

@@ -1,4 +1,5 @@
-"""Coupled integrator: independent ODE reference, exact per-step contact and dropper laws (no lag), hard cases."""
+"""Coupled integrator: independent ODE reference, exact per-step contact and dropper laws (no lag), hard cases.
+The speed regimes (warning and refusal near the wave speed) are the registry case `catenary_critical_speed`."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbsuite.errors import ParameterError
-from mbsuite.models.catenary.analysis import ContactLostWarning, CriticalSpeedWarning, simulate, speed_regime
+from mbsuite.models.catenary.analysis import ContactLostWarning, CriticalSpeedWarning, simulate
 from mbsuite.models.catenary.fe import CW_T, CW_W, NDOF_NODE, assemble, hermite
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams
@@ -67,8 +68,11 @@ def test_trapezoidal_coupling_converges_to_independent_ode_solution():
         idx = np.rint(t_eval / dt).astype(int)
         assert np.allclose(res.t[idx], t_eval, atol=1e-12)
         errs.append(np.max(np.abs(res.force[idx] - f_ref)))
-    assert errs[1] < 0.05  # N, on a force of ~180 N peak
-    assert 3.0 < errs[0] / errs[1] < 5.0  # second order
+    # measured 0.099 N (2e-4 s) and 0.0248 N (1e-4 s) on a ~180 N peak; bound 2x above the finer one
+    assert errs[1] < 0.05
+    # second order: the error falls by 2^2 = 4 per halving (measured 4.004); a first-order slip (ratio 2) or an
+    # error floor (ratio ~1) fails
+    assert 3.5 < errs[0] / errs[1] < 4.5
 
 
 def test_contact_and_dropper_laws_hold_exactly_at_every_step():
@@ -86,22 +90,6 @@ def test_contact_and_dropper_laws_hold_exactly_at_every_step():
     assert np.all(res.dropper_elastic[~res.dropper_slack] >= -tol)
 
 
-def test_speed_regime_warns_and_refuses_supercritical():
-    p = CatenaryParams()
-    c = p.cw_wave_speed
-    assert 3.6 * c == pytest.approx(438.2, abs=0.1)  # sqrt(20000 / 1.35) m/s
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert speed_regime(p, 300 / 3.6)["regime"] == "subcritical"
-    with pytest.warns(CriticalSpeedWarning, match="EN 50119"):
-        r = speed_regime(p, 320 / 3.6)
-    assert r["regime"] == "above EN 50119 limit"
-    with pytest.warns(CriticalSpeedWarning, match="Near-critical"):
-        assert speed_regime(p, 420 / 3.6)["regime"] == "near-critical"
-    with pytest.raises(ParameterError, match="wave speed"):
-        speed_regime(p, 450 / 3.6)
-
-
 def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
     """420 km/h (96 % of the wave speed) with a light uplift: warned, contact lost and regained many times, all
     finite, the wire and pantograph stay within physical bounds."""
@@ -113,8 +101,9 @@ def test_near_critical_speed_high_speed_contact_loss_without_blow_up():
     assert np.all(np.isfinite(r.force)) and np.all(np.isfinite(r.uplift))
     ev = run.stats["loss_events"]
     assert len(ev) >= 3 and run.stats["loss_pct"] > 0
+    # no blow-up: measured |wire|, |head| <= 0.075 m and a peak force of 158 N; bounds 4x and 3.8x above
     assert np.max(np.abs(r.wire)) < 0.3 and np.max(np.abs(r.head)) < 0.3
-    assert np.max(r.force) < 20 * p.F0
+    assert np.max(r.force) < 10 * p.F0
 
 
 @pytest.mark.parametrize("F0", [0.0, -50.0])
@@ -156,7 +145,10 @@ def test_energy_balance_closes_through_contact_loss_and_recontact(law):
     work = np.concatenate([[0.0], np.cumsum(0.5 * (E["drive_power"][1:] + E["drive_power"][:-1]) * np.diff(r.t))])
     scale = np.max(np.abs(total - total[0]))
     assert scale > 10.0  # J: the passage does put energy into the wire
-    assert np.max(np.abs(total - total[0] - work)) < 5e-3 * scale
+    # measured 5.1e-4 (slack) and 1.44e-3 (linear: 10 losses and re-contacts) of the energy exchanged at dt 1e-4 s;
+    # bounds 5x and 3.5x above (a dropped loss or drive-work term of 0.3 % fails)
+    bound = {"slack": 2.5e-3, "linear": 5e-3}[law]
+    assert np.max(np.abs(total - total[0] - work)) < bound * scale
     if law == "linear":
         assert np.sum(np.diff((r.force <= 0).astype(int)) == 1) >= 5  # contact lost and regained repeatedly
 

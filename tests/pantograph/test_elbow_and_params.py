@@ -43,7 +43,7 @@ def test_chain_is_tangent_to_pinion(params):
 
 
 def test_elbow_eqsim_derivative_formula(params):
-    """EQSIM's DPH1DTH1 expression (seed 000 l.1337) equals our implicit derivative."""
+    """EQSIM's DPH1DTH1 expression (the thesis' FORTRAN listing, subroutine EQSIM) equals our implicit derivative."""
     el = Elbow(params)
     l1, xf, yf, le = params.l1, params.xf, params.yf, params.le
     for th1 in (0.2, 0.4237, 0.9):

@@ -142,7 +142,7 @@ def test_remaining_deviation_grows_with_amplitude_squared(lab_scene, ode, params
 
 
 def test_mujoco_vs_reference_at_default_timestep(lab_scene):
-    """Issue #2: amplitudes within 1 % and phases within 2 deg at the first two resonances and at 2 and 10 Hz, lab
+    """Amplitudes within 1 % and phases within 2 deg at the first two resonances and at 2 and 10 Hz, lab
     scene (Coulomb friction on: event-exact in the reference, frictionloss in MuJoCo)."""
     freqs = [2.0, 4.25, 8.5, 10.0]
     jobs = [(lab_scene.to_dict(), f, m) for f in freqs for m in ("mujoco", "reference")]
@@ -158,15 +158,29 @@ def test_mujoco_vs_reference_at_default_timestep(lab_scene):
 
 
 def test_coulomb_friction_lowers_resonance_peaks(lab_scene):
-    """The thesis' small Coulomb friction: at the first resonance it removes a few % of the F1 peak."""
-    jobs = [(lab_scene.replace(effects={"coulomb": c}).to_dict(), 4.25, "mujoco") for c in (True, False)]
-    on, off = run_sweep(_point, jobs, workers=0, progress=False)
-    assert on["F1"][0] < off["F1"][0]
-    assert on["F1"][0] > 0.8 * off["F1"][0]
+    """The thesis' small Coulomb friction removes 7.6 % of the F1 peak at the first resonance (4.25 Hz). MuJoCo's
+    frictionloss against a different method, the event-exact stick/slip reference: F1 on/off 0.92371 vs 0.92390,
+    the reductions differ by 0.25 % of themselves; bound 2 % (8x)."""
+    jobs = [(lab_scene.replace(effects={"coulomb": c}).to_dict(), 4.25, m)
+            for m in ("mujoco", "reference") for c in (True, False)]
+    mj_on, mj_off, ref_on, ref_off = (r["F1"][0] for r in run_sweep(_point, jobs, workers=0, progress=False))
+    drop_mj, drop_ref = 1.0 - mj_on / mj_off, 1.0 - ref_on / ref_off
+    assert drop_ref > 0.05  # friction matters at the resonance: the comparison is not of two zeros
+    assert drop_mj == pytest.approx(drop_ref, rel=0.02)
 
 
 def test_exact_chain_wrap_changes_statics_little():
-    """Erratum 22: the exact chain wrap moves the equilibrium by ~1e-2 rad at most."""
-    a = PantographODE().equilibrium()
-    b = PantographODE(elbow_kinematics="exact").equilibrium()
-    assert 1e-4 < np.max(np.abs(a[:3] - b[:3])) < 3e-2
+    """Erratum 22: the exact chain wrap moves the equilibrium by 6.4e-3 rad (theta_1). A different method predicts the
+    shift: one Newton step of the exact model's static residual from the B.6 equilibrium, -J^-1 r (first order in
+    the 0.016 rad theta_e difference). Measured: the prediction is off by 0.9 % of the shift (second-order terms);
+    bound 5 %."""
+    b6 = PantographODE()
+    exact = PantographODE(elbow_kinematics="exact")
+    a, b = b6.equilibrium(), exact.equilibrium()
+    shift = b[:3] - a[:3]
+    q, y, h = a[:3], b6.p.y_op, 1e-7
+    J = np.column_stack([(exact.static_residual(q + h * e, y) - exact.static_residual(q - h * e, y)) / (2 * h)
+                         for e in np.eye(3)])
+    predicted = np.linalg.solve(J, -exact.static_residual(q, y))
+    assert np.max(np.abs(predicted - shift)) < 0.05 * np.max(np.abs(shift))
+    assert np.max(np.abs(shift)) > 1e-3  # the two kinematics do differ (resolvable shift)

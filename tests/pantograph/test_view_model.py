@@ -17,7 +17,8 @@ from mbsuite.models.pantograph.modelfiles import q_to_theta
 ])
 def test_view_model_holds_the_scene_effects_and_the_runs_initial_state(scene_name, effects, nplugin, na):
     scene = load_scene(scene_name)
-    scene = scene.replace(effects=effects, outputs=["theta1", "theta2", "thetah", "y_w"], solver={"duration": 2e-3, "t_settle": 0.0, "sample_dt": scene.solver.timestep})
+    scene = scene.replace(effects=effects, outputs=["theta1", "theta2", "thetah", "y_w"],
+                          solver={"duration": 2e-3, "t_settle": 0.0, "sample_dt": scene.solver.timestep})
     m, d = scene.spec.mujoco_model(scene)
     assert isinstance(m, mujoco.MjModel) and isinstance(d, mujoco.MjData)
     assert m.nplugin == nplugin and m.na == na
@@ -32,8 +33,8 @@ def test_view_model_holds_the_scene_effects_and_the_runs_initial_state(scene_nam
         assert res[name][0] == pytest.approx(th[i], abs=1e-12)
     assert d.ctrl[0] == pytest.approx(res["y_w"][0], abs=1e-15)
     # ... and it is an equilibrium of MuJoCo's forces (friction off: the static balance alone). Measured max |qacc|
-    # 8.2e-12 rad/s^2 (all shipped scenes); a 1e-5 rad error in q1 gives 0.2. (The rigid elbow's soft equality makes its force from the
-    # acceleration itself, so there the rest state is checked by the run's first sample above only.)
+    # 8.2e-12 rad/s^2 (all shipped scenes); a 1e-5 rad error in q1 gives 0.2. (The rigid elbow's soft equality makes
+    # its force from the acceleration itself: there the first sample of the run is the check.)
     if m.neq == 0:
         m.dof_frictionloss[:] = 0.0
         mujoco.mj_forward(m, d)

@@ -11,7 +11,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,6 +28,9 @@ from .quality import plot as quality_plot
 from .quality import table_rows as quality_table_rows
 from .sim import CoupledResult, CoupledSimulation
 from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
 
 #: ratio V / c above which a warning is issued: EN 50119 limits the line speed to 70 % of the CW wave speed
 WARN_RATIO = 0.7
@@ -239,6 +242,7 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
 
 # --- scene plumbing ---------------------------------------------------------------------------------------------
 def scene_speed(scene, speed_kmh: float | None) -> float:
+    """The passage speed (km/h): `speed_kmh` if given, else the scene's `input.speed`; SceneError if neither."""
     v = speed_kmh if speed_kmh is not None else scene.input.get("speed")
     if v is None:
         raise SceneError("no speed: give --speed KMH or [input] speed = ... (km/h) in the scene")
@@ -364,10 +368,10 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
 
 
 def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Write each run's contact-force record (`contact_force_<pantograph>_<droppers>_<speed>kmh.csv`, SI units in
+    the header) and the force/uplift figure of all of them (`force_uplift_<pantograph>_<speed>kmh.png`); return the
+    paths."""
+    from ...plotting import save
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -378,17 +382,32 @@ def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
         files.append(write_csv(out / f"contact_force_{tag}.csv", [
             ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force), ("force_filtered_20Hz", "N", r.filtered),
             ("head_height", "m", res.head), ("wire_height", "m", res.wire)]))
+    files.append(save(force_uplift_figure(runs),
+                      out / f"force_uplift_{runs[0].pantograph}_{runs[0].speed_kmh:g}kmh.png"))
+    return files
+
+
+def force_uplift_figure(runs: list[CatenaryRun]) -> MplFigure:
+    """Contact force (unfiltered and 20 Hz low-pass), contact-wire height at the contact point and uplift at the
+    steady arms of the statistics window, against the pantograph position; one colour per dropper law, the window
+    shaded, the supports as vertical lines."""
+    from ...plotting import figure
+
     p = runs[0].params
-    fig, axes = plt.subplots(3, 1, figsize=(11, 10), sharex=True)
+    fig, axes = figure(3, 1, size=(11, 10), sharex=True)
+    colours = {"slack": "tab:blue", "linear": "tab:red"}
+    styles = ("-", "--", ":", "-.")
     for r in runs:
         res = r.result
+        c = colours.get(r.dropper_law, "tab:green")
         lab = f"{r.dropper_law} droppers"
-        axes[0].plot(res.x, res.force, lw=0.4, alpha=0.5, label=f"{lab}, unfiltered")
-        axes[0].plot(res.x, r.filtered, lw=1.2, label=f"{lab}, 20 Hz low-pass")
-        axes[1].plot(res.x, 1000 * res.wire, lw=1.0, label=f"{lab}: CW at contact point")
-        for j, xs in enumerate(res.support_x):
-            if p.window_start <= xs <= p.window_end:
-                axes[2].plot(res.x, 1000 * res.uplift[:, j], lw=1.0, label=f"{lab}: steady arm x = {xs:g} m")
+        axes[0].plot(res.x, res.force, lw=0.4, alpha=0.4, color=c, label=f"{lab}: F, unfiltered")
+        axes[0].plot(res.x, r.filtered, lw=1.2, color=c, label=f"{lab}: F, 20 Hz low-pass")
+        axes[1].plot(res.x, 1000 * res.wire, lw=1.0, color=c, label=lab)
+        inside = [(j, xs) for j, xs in enumerate(res.support_x) if p.window_start <= xs <= p.window_end]
+        for (j, xs), ls in zip(inside, (styles * len(inside))[:len(inside)], strict=True):
+            axes[2].plot(res.x, 1000 * res.uplift[:, j], lw=1.0, color=c, ls=ls,
+                         label=f"{lab}: steady arm at x = {xs:g} m")
     for ax in axes:
         ax.set_xlim(p.x_start, p.x_end)
         ax.axvspan(p.window_start, p.window_end, color="0.9", zorder=-1)
@@ -397,18 +416,12 @@ def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
                 ax.axvline(k * p.span_length, color="0.7", lw=0.5, zorder=-1)
         ax.grid(True, lw=0.3)
         ax.legend(fontsize=7, loc="upper left")
-    axes[0].set_ylabel("contact force (N)")
-    axes[1].set_ylabel("CW height at contact (mm)")
-    axes[2].set_ylabel("uplift at support (mm)")
-    axes[2].set_xlabel("pantograph position x (m)")
+    axes[0].set_ylabel("contact force F [N]")
+    axes[1].set_ylabel("contact-wire height at the\ncontact point [mm]")
+    axes[2].set_ylabel("contact-wire uplift at\nthe steady arm [mm]")
+    axes[2].set_xlabel("pantograph position x [m] (thin vertical lines: supports)")
     what = "EN 50318 reference scene" if runs[0].is_reference else "catenary passage"
     path = "" if runs[0].engine == "reference" else f" ({runs[0].engine} path)"
-    axes[0].set_title(f"{what}, {runs[0].pantograph} pantograph{path}, {runs[0].speed_kmh:g} km/h "
-                      "(grey: statistics window)")
-    fig.tight_layout()
-    tag = f"{runs[0].pantograph}_{runs[0].speed_kmh:g}kmh"
-    path = out / f"force_uplift_{tag}.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    files.append(path)
-    return files
+    axes[0].set_title(f"{what}, {runs[0].pantograph} pantograph{path}, {runs[0].speed_kmh:g} km/h; heights and "
+                      "uplift from the static state (grey: statistics window)", fontsize=10)
+    return fig

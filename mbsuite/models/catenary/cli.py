@@ -10,6 +10,7 @@ from ...scenes import load_scene
 
 
 def register(sub, add_common, emit) -> None:
+    """Add the `mbsuite catenary` command to the CLI's subparsers `sub`."""
     p = sub.add_parser("catenary", help="pantograph passage under the FE catenary: EN 50318 statistics, plots, CSV")
     p.add_argument("scene", nargs="?", default="catenary",
                    help="scene TOML path, 'catenary' (default scene) or catenary/<scene>")

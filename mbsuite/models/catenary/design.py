@@ -19,12 +19,16 @@ import itertools
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...errors import ParameterError
+from ...limits import limit_of
 from .params import CatenaryParams
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
 
 #: statistics each point returns (besides sigma/Fm and the verdicts)
 POINT_STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
@@ -96,16 +100,18 @@ def design_grid(scene, speeds: Sequence[float], vary: Mapping[str, Sequence[floa
 
 
 def plot_grid(grid: dict[str, Any], out: str | Path) -> list[Path]:
-    """sigma/Fm, the statistical minimum Fm - 3 sigma and the contact loss over speed (x) and the first varied
-    parameter (y), one row of panels per value of the other varied parameters; red hatched cells fail that
-    criterion. Returns the written PNG path(s)."""
-    import matplotlib
+    """Write `grid_figure(grid)` as `design_grid.png` in `out`; returns the written PNG path(s)."""
+    from ...plotting import save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    return [save(grid_figure(grid), Path(out) / "design_grid.png")]
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+
+def grid_figure(grid: dict[str, Any]) -> MplFigure:
+    """σ/Fm, the statistical minimum Fm − 3σ and the contact loss over speed (x) and the first varied parameter (y),
+    one row of panels per value of the other varied parameters; red numbers fail that criterion (EN 50367 limits:
+    σ ≤ 0.3 Fm, Fm − 3σ > 0, no contact loss)."""
+    from ...plotting import figure
+
     names = list(grid["vary"])
     speeds = grid["speeds"]
     ynames = names[:1]
@@ -116,10 +122,10 @@ def plot_grid(grid: dict[str, Any], out: str | Path) -> list[Path]:
     for pt in grid["points"]:
         key = (pt["speed_kmh"], pt[ynames[0]] if ynames else 0.0, tuple(pt[n] for n in rest))
         idx[key] = pt
-    panels = (("sigma_over_Fm", "sigma / Fm (limit 0.3)", "sigma_pass"),
-              ("stat_min", "Fm - 3 sigma (N, must be > 0)", "stat_min_pass"),
-              ("loss_pct", "contact loss (%)", "contact_loss_pass"))
-    fig, axes = plt.subplots(len(rest_combos), 3, figsize=(15, 3.6 * len(rest_combos)), squeeze=False)
+    panels = (("sigma_over_Fm", "σ / Fm [-] (limit 0.3)", "sigma_pass"),
+              ("stat_min", "Fm − 3σ [N] (must be > 0)", "stat_min_pass"),
+              ("loss_pct", "contact loss [%] (must be 0)", "contact_loss_pass"))
+    fig, axes = figure(len(rest_combos), 3, size=(15, 3.8 * len(rest_combos)), squeeze=False)
     for r, rc in enumerate(rest_combos):
         for c, (key, title, verdict) in enumerate(panels):
             ax = axes[r][c]
@@ -132,13 +138,25 @@ def plot_grid(grid: dict[str, Any], out: str | Path) -> list[Path]:
                         color="red" if b else "white", fontweight="bold" if b else "normal")
             ax.set_xticks(np.arange(len(speeds)) + 0.5, [f"{v:g}" for v in speeds])
             ax.set_yticks(np.arange(len(yvals)) + 0.5, [f"{y:g}" for y in yvals])
-            ax.set_xlabel("speed (km/h)")
-            ax.set_ylabel(ynames[0] if ynames else "")
-            sub = ", ".join(f"{n} = {v:g}" for n, v in zip(rest, rc, strict=True))
+            ax.set_xlabel("train speed v [km/h]")
+            ax.set_ylabel(_axis_label(ynames[0]) if ynames else "")
+            sub = ", ".join(f"{n} = {v:g} {_unit(n)}".rstrip() for n, v in zip(rest, rc, strict=True))
             ax.set_title(f"{title}{'; ' + sub if sub else ''}\n(red numbers fail)", fontsize=9)
             fig.colorbar(im, ax=ax)
-    fig.tight_layout()
-    path = out / "design_grid.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return [path]
+    return fig
+
+
+def _unit(name: str) -> str:
+    try:
+        return limit_of(CatenaryParams, name).unit or ""
+    except Exception:  # noqa: BLE001 - a name without a declared unit gets none
+        return ""
+
+
+def _axis_label(name: str) -> str:
+    try:
+        doc = limit_of(CatenaryParams, name).doc or name
+    except Exception:  # noqa: BLE001
+        doc = name
+    unit = _unit(name)
+    return f"{name}: {doc}" + (f" [{unit}]" if unit else "")

@@ -113,6 +113,7 @@ class CatenaryFE:
 
     @property
     def n(self) -> int:
+        """Number of free DOFs (pinned-end w DOFs removed)."""
         return self.free.size
 
     def cw_dofs_of_node(self, i: int) -> tuple[int, int]:

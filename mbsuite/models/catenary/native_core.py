@@ -141,22 +141,27 @@ class NativeCore:
     # --- state exchange ---------------------------------------------------------------------------------------
     @property
     def nslack(self) -> int:
+        """Number of slack droppers in the core's current slack set."""
         return int(self.job.nslack)
 
     def slack_set(self) -> tuple[list[int], np.ndarray]:
+        """The current slack set: dropper indices and their cancelling tensions (a copy)."""
         m = self.nslack
         return [int(i) for i in self.slk[:m]], self.sS[:m].copy()
 
     def set_slack(self, S: list[int], sS: np.ndarray) -> None:
+        """Replace the core's slack set by dropper indices `S` with cancelling tensions `sS`."""
         m = len(S)
         self.slk[:m] = S
         self.sS[:m] = sS
         self.job.nslack = m
 
     def place(self, k: int, x: float) -> None:
+        """Place contact k at position x (m): its element and Hermite shape functions N(x)."""
         self.lib.mbs_cat_place(ctypes.byref(self.job), k, float(x))
 
     def wire(self, k: int) -> float:
+        """Contact-wire height (m, from the undisturbed level) at contact k, from the predicted state."""
         return float(self.lib.mbs_cat_wire(ctypes.byref(self.job), k))
 
     def set_force(self, k: int, f: float) -> None:
@@ -165,6 +170,7 @@ class NativeCore:
         self.gv[4 * k:4 * k + 4] = self.Nl[4 * k:4 * k + 4] * f
 
     def solve(self, b: np.ndarray) -> np.ndarray:
+        """x = S^-1 b by the block-bidiagonal forward and back sweeps (S = M + hC + h^2 K)."""
         x = np.ascontiguousarray(b, dtype=float).copy()
         self.lib.mbs_cat_solve(ctypes.byref(self.job), x.ctypes.data)
         return x
@@ -178,19 +184,24 @@ class NativeCore:
 
     # --- stages and the loop ----------------------------------------------------------------------------------
     def predict(self, t_new: float) -> None:
+        """Predict stage: the banded solve for u* of the step ending at `t_new` (no local forces)."""
         self.lib.mbs_cat_predict(ctypes.byref(self.job), float(t_new))
 
     def local(self) -> None:
+        """Local stage: contact forces and slack set by the active-set iteration (SolverError if it fails)."""
         if self.lib.mbs_cat_local(ctypes.byref(self.job)):
             raise SolverError(self._error_text(4, 0.0))
 
     def advance(self) -> None:
+        """Advance stage: end-of-step displacement and momentum recursions with the local forces."""
         self.lib.mbs_cat_advance(ctypes.byref(self.job))
 
     def record(self, row: int, t: float) -> None:
+        """Write the current state into record row `row` at time `t` (s)."""
         self.lib.mbs_cat_record(ctypes.byref(self.job), int(row), float(t))
 
     def check(self) -> int:
+        """Finite-state and small-displacement check: 0, or an error code (`_error_text`)."""
         return int(self.lib.mbs_cat_check(ctypes.byref(self.job)))
 
     def run(self, n0: int, n1: int, check_every: int) -> int:
@@ -199,6 +210,7 @@ class NativeCore:
 
     @property
     def n_local(self) -> int:
+        """Total number of local-problem iterations so far."""
         return int(self.job.n_local)
 
     def _error_text(self, code: int, t: float) -> str:

@@ -41,18 +41,25 @@ SECTION_KEYS = ("effects", "params")
 
 
 class Pantograph(Protocol):
+    """What the catenary needs of a pantograph under the wire: heights from the undisturbed CW level (m),
+    forces in N; over one step the contact force varies linearly f0 -> f1 (the trapezoidal rule's force history)."""
     name: str
     affine: bool
 
-    def static(self, y_wire: float, k_wire: float) -> float: ...
+    def static(self, y_wire: float, k_wire: float) -> float:
+        """Set the static state pressing on a wire at height y_wire through a spring k_wire; return the force."""
 
-    def trial(self, t: float, dt: float, f0: float, f1: float) -> float: ...
+    def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        """Contact-point height at t + dt under the force history f0 -> f1; the committed state is unchanged."""
 
-    def commit(self) -> None: ...
+    def commit(self) -> None:
+        """Accept the last trial as the new state."""
 
-    def head(self) -> float: ...
+    def head(self) -> float:
+        """Contact-point height (m) of the committed state."""
 
-    def signals(self) -> dict[str, float]: ...
+    def signals(self) -> dict[str, float]:
+        """The committed state's output signals (SI units)."""
 
 
 class TwoMassPantograph:
@@ -94,6 +101,7 @@ class TwoMassPantograph:
                 m2 * v2 - h * (k12 * x1 + k22 * x2) + h * self.F0)
 
     def static(self, y_wire: float, k_wire: float) -> float:
+        """Static state against a wire at y_wire through k_wire: K x = [-f, F0], f = k_wire (x1 - y_wire)."""
         # K x = [-f, F0] with f = k_wire (x1 - y_wire)
         A = self.Km + np.array([[k_wire, 0.0], [0.0, 0.0]])
         self.x = np.linalg.solve(A, np.array([k_wire * y_wire, self.F0]))
@@ -110,6 +118,7 @@ class TwoMassPantograph:
         return float(self.x[0]) + 2 * h * (S[0][0] * r1 + S[0][1] * r2), h * h * S[0][0]
 
     def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        """Head height at t + dt by the trapezoidal rule under f0 -> f1 (pending until `commit`)."""
         if dt != self._dt:
             self._prepare(dt)
         h = dt / 2
@@ -122,12 +131,15 @@ class TwoMassPantograph:
         return float(x_new[0])
 
     def commit(self) -> None:
+        """Accept the last trial."""
         self.x, self.v = self._pending
 
     def head(self) -> float:
+        """Head displacement x1 (m) of the committed state."""
         return float(self.x[0])
 
     def signals(self) -> dict[str, float]:
+        """Head and frame displacements (m) of the committed state."""
         return {"head_displacement": float(self.x[0]), "frame_displacement": float(self.x[1])}
 
     def pack(self, out: np.ndarray, dt: float) -> None:

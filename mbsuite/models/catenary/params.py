@@ -121,6 +121,7 @@ class CatenaryParams:
 
     @property
     def mw_wave_speed(self) -> float:
+        """Messenger-wire transverse wave speed sqrt(T_mw / rho_mw) (m/s)."""
         return math.sqrt(self.mw_tension / self.mw_mass)
 
     def rayleigh(self) -> tuple[float, float]:

@@ -29,10 +29,13 @@ import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ...errors import ParameterError
 from ...limits import check_fields, param
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
 
 #: target curve coefficients per system: (a N/(km/h)^2, upper b N, lower b N), NQ limit (%)
 SYSTEMS: dict[str, dict[str, float]] = {
@@ -147,25 +150,38 @@ def table_rows(q: dict[str, Any]) -> list[list[str]]:
 
 
 def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path) -> Path:
-    """One figure: the target band Fm(v) with each pantograph's Fm +- sigma at its speed (left), and each criterion's
-    value over its limit with the verdict (right)."""
-    import matplotlib
+    """Write `figure(assessments)` to `path` (PNG) and return it."""
+    from ...plotting import save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    return save(figure(assessments), path)
+
+
+#: short axis labels of the criteria (the table's labels are longer)
+_SHORT = {"mean_force": "mean force\nFm", "sigma": "std. dev.\nσ", "stat_min": "stat. min.\nFm − 3σ",
+          "contact_loss": "contact\nloss", "arcing_nq": "arcing\nNQ", "uplift": "uplift at\nsteady arm"}
+
+
+def figure(assessments: list[tuple[str, dict[str, Any]]]) -> MplFigure:
+    """The target band Fm(v) with each pantograph's Fm ± σ at its speed (left), and each criterion's value over its
+    limit with the verdict (right; for Fm − 3σ the ratio is 1 − (Fm − 3σ − floor) / Fm, so that above 1 fails)."""
     import numpy as np
 
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
+    from ...plotting import figure as new_figure
+
+    fig, (ax, bx) = new_figure(1, 2, size=(12, 4.8))
     c = QualityCriteria(**assessments[0][1]["criteria"])
     v = np.linspace(0.0, max(400.0, max(q["speed_kmh"] for _, q in assessments)), 200)
     ax.fill_between(v, c.fm_a * v**2 + c.fm_b_lower, c.fm_a * v**2 + c.fm_b, color="0.85",
-                    label=f"target band ({c.system}): {c.fm_a:g} v^2 + [{c.fm_b_lower:g}, {c.fm_b:g}] N")
+                    label=f"target band ({c.system}): Fm = {c.fm_a:g} v² + [{c.fm_b_lower:g}, {c.fm_b:g}] N, "
+                          "v in km/h")
     names = list(CRITERIA)
     width = 0.8 / len(assessments)
+    hatches = ("", "//", "..", "xx")
     for i, (name, q) in enumerate(assessments):
         r = q["rows"]
-        ax.errorbar([q["speed_kmh"]], [r["mean_force"]["value"]], yerr=[r["sigma"]["value"]], fmt="o", capsize=4,
-                    label=f"{name}: Fm +- sigma ({'pass' if q['pass'] else 'FAIL'})")
+        ax.errorbar([q["speed_kmh"] + 4 * (i - (len(assessments) - 1) / 2)], [r["mean_force"]["value"]],
+                    yerr=[r["sigma"]["value"]], fmt="o", capsize=4,
+                    label=f"{name}: Fm ± σ ({'pass' if q['pass'] else 'FAIL'})")
         ratios = []
         for k in names:
             row = r[k]
@@ -176,16 +192,16 @@ def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path) -> Path:
             else:
                 ratios.append(row["value"] / row["high"] if row["high"] > 0 else (0.0 if row["value"] <= 0 else 2.0))
         colors = ["tab:green" if r[k]["pass"] else "tab:red" for k in names]
-        bx.bar(np.arange(len(names)) + i * width, ratios, width, color=colors, edgecolor="k", label=name)
+        bx.bar(np.arange(len(names)) + i * width, ratios, width, color=colors, edgecolor="k",
+               hatch=hatches[i % len(hatches)], label=name)
     bx.axhline(1.0, color="k", lw=1)
-    bx.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=20)
-    bx.set_ylabel("value / limit (green pass, red fail)")
-    ax.set_xlabel("speed (km/h)")
-    ax.set_ylabel("mean contact force (N)")
+    bx.set_xticks(np.arange(len(names)) + 0.4 - width / 2, [_SHORT[k] for k in names], fontsize=8)
+    bx.set_ylabel("value / limit [-] (green: pass, red: fail)")
+    bx.set_title(f"current-collection criteria ({c.system}) at {assessments[0][1]['speed_kmh']:g} km/h", fontsize=10)
+    ax.set_xlabel("train speed v [km/h]")
+    ax.set_ylabel("mean contact force Fm [N]")
+    ax.set_title("mean contact force Fm ± standard deviation σ vs the target band", fontsize=10)
     ax.grid(True, lw=0.3)
-    ax.legend(fontsize=7)
-    bx.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    ax.legend(fontsize=7, loc="upper left")
+    bx.legend(fontsize=7, title="bars (hatch)", title_fontsize=7)
+    return fig

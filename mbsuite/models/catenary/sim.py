@@ -84,6 +84,7 @@ class BandedSPD:
         self.bandwidth = bw
 
     def solve(self, b: np.ndarray) -> np.ndarray:
+        """x = S^-1 b with the stored banded Cholesky factor (LAPACK dpbtrs)."""
         x, info = lapack.dpbtrs(self.c, b, lower=0)
         if info != 0:
             raise SolverError(f"banded solve failed (dpbtrs info = {info})")

@@ -21,7 +21,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from .pantographs import build as build_pantograph
 from .params import CatenaryParams
 from .sim import CHECK_EVERY, CoupledResult, CoupledSimulation, _native_error
 from .stats import en50318_statistics
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
 
 #: length of a pantograph head along the track (m): two contact points closer than this would share one head
 HEAD_WIDTH = 0.5
@@ -451,6 +454,7 @@ def train_report(run: TrainRun, quality=None):
     of a train passage; `quality` (QualityCriteria) adds the quality report of every pantograph."""
     from pathlib import Path
 
+    from ...plotting import save
     from ...results import Report, format_table, write_csv
     from .quality import plot as quality_plot
     from .quality import table_rows
@@ -488,44 +492,45 @@ def train_report(run: TrainRun, quality=None):
         data["quality_pass"] = all(q["pass"] for q in qs)
 
     def write(out: Path) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         files = []
-        p = run.params
-        fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True)
         for k, res in enumerate(run.results):
             tag = f"p{k + 1}_{run.names[k]}_{run.speed_kmh:g}kmh"
             files.append(write_csv(out / f"contact_force_{tag}.csv", [
                 ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force),
                 ("force_filtered_20Hz", "N", run.filtered[k]), ("head_height", "m", res.head),
                 ("wire_height", "m", res.wire)]))
-            axes[0].plot(res.x, run.filtered[k], lw=1.0, label=f"{labels[k]}: 20 Hz low-pass")
-            axes[1].plot(res.x, 1000 * res.wire, lw=1.0, label=f"{labels[k]}: CW at its contact point")
-        for ax in axes:
-            ax.axvspan(p.window_start, p.window_end, color="0.9", zorder=-1)
-            ax.set_xlim(p.x_start, p.x_end)
-            ax.grid(True, lw=0.3)
-            ax.legend(fontsize=7, loc="upper left")
-        axes[0].set_ylabel("contact force (N)")
-        axes[1].set_ylabel("CW height at contact (mm)")
-        axes[1].set_xlabel("each pantograph's own position x (m)")
-        axes[0].set_title(f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h (grey: statistics window)")
-        fig.tight_layout()
-        path = out / f"train_force_{run.speed_kmh:g}kmh.png"
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        files.append(path)
+        files.append(save(train_figure(run, labels), out / f"train_force_{run.speed_kmh:g}kmh.png"))
         if qs:
             files.append(quality_plot(list(zip(labels, qs, strict=True)),
                                       out / f"quality_train_{run.speed_kmh:g}kmh.png"))
         return files
 
     return Report(data=data, table="\n".join(lines), write=write)
+
+
+def train_figure(run: TrainRun, labels: list[str]) -> MplFigure:
+    """Each pantograph's 20 Hz low-pass contact force and the contact-wire height at its contact point against its
+    own position (the statistics window shaded); `labels` names the pantographs."""
+    from ...plotting import figure
+
+    p = run.params
+    fig, axes = figure(2, 1, size=(11, 7), sharex=True)
+    for k, res in enumerate(run.results):
+        axes[0].plot(res.x, run.filtered[k], lw=1.0, label=f"{labels[k]}")
+        axes[1].plot(res.x, 1000 * res.wire, lw=1.0, label=f"{labels[k]}")
+    for ax in axes:
+        ax.axvspan(p.window_start, p.window_end, color="0.9", zorder=-1)
+        ax.set_xlim(p.x_start, p.x_end)
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=7, loc="upper left")
+    axes[0].set_ylabel("contact force F, 20 Hz low-pass [N]")
+    axes[1].set_ylabel("contact-wire height at\nthe contact point [mm]")
+    axes[1].set_xlabel("each pantograph's own position x [m]")
+    axes[0].set_title(f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h; wire height from its static "
+                      "state (grey: statistics window)", fontsize=10)
+    return fig
 
 
 def train_to_simresult(run: TrainRun, scene):

@@ -1,4 +1,4 @@
-"""Brecknell-Willis asymmetric pantograph (Eppinger 1984, seed 000): three cross-checked paths.
+"""Brecknell-Willis asymmetric pantograph (Eppinger 1984): three cross-checked paths.
 
 - `reference`: hand-derived equations (numpy/scipy), event-exact stick/slip;
 - `pinocchio`: M(q), gravity, frame Jacobians from the URDF/MJCF;

@@ -59,6 +59,7 @@ INPUTS: dict[str, dict[str, Limit]] = {
 
 
 def config_of(scene: Scene) -> PantographConfig:
+    """The scene's effects as a `PantographConfig`."""
     return PantographConfig(**dict(scene.effects))
 
 
@@ -535,10 +536,11 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
                 cols.append((f"{m}_{s}_amplitude_ratio", "m/m", np.abs(c[s])))
                 cols.append((f"{m}_{s}_phase", "deg", np.degrees(np.angle(c[s]))))
         files = [write_csv(out / "freqresp.csv", cols)]
-        from .plots import plot_freqresp, plot_time_histories
+        from ...plotting import save
+        from .plots import plot_freqresp, plot_time_histories, time_history_runs
 
-        files.append(plot_freqresp(out / "freqresp.png", freqs, curves))
-        files += plot_time_histories(out, scene)
+        files.append(save(plot_freqresp(freqs, curves), out / "freqresp.png"))
+        files.append(save(plot_time_histories(time_history_runs(scene)), out / "time_histories.png"))
         return files
 
     return Report(data, "\n".join(lines), write)
@@ -584,6 +586,8 @@ def equilibrium_all_paths(scene: Scene) -> dict:
 
 
 def equilibrium_report(scene: Scene) -> Report:
+    """The `equilibrium` hook: the static equilibrium at the operating height from the reference, Pinocchio and
+    MuJoCo, side by side."""
     p = scene.build_params()
     ode = PantographODE(p, config_of(scene))
     paths = equilibrium_all_paths(scene)

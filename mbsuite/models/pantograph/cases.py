@@ -126,13 +126,13 @@ def _pantograph_unilateral(ck: Checker) -> None:
     ck.le("total loss time MuJoCo vs reference, relative (4.7x the measured 0.43 %)",
           abs(tot_m / tot_r - 1) if tot_r else math.inf, 0.02)
     # the output is clipped at zero, so test the unclipped spring force ks (y_d - y_w) of the reference's states:
-    # negative inside every event-located loss (the head below the wire), non-negative outside, up to what the head
-    # moves in one 1 ms sample next to an event (|dy_d/dt| <= 0.1 m/s: ks * 1e-4 m = 18 N)
+    # negative inside every event-located loss (the head below the wire) and non-negative outside (the reference
+    # locates the events exactly: measured min +0.20 N outside, max -0.012 N inside)
     fs = ks * (ref["y_d"] - ref["y_w"])
     inside = _loss_mask(ref.t, ref.events)
     ck.le("unclipped spring force inside the reference's losses (N; measured max -0.012)", float(np.max(fs[inside])),
           0.0)
-    ck.ge("unclipped spring force outside the reference's losses (N)", float(np.min(fs[~inside])), -18.0)
+    ck.ge("unclipped spring force outside the reference's losses (N)", float(np.min(fs[~inside])), 0.0)
     ck.le("unclipped spring force reaches below -100 N (real losses, not grazing)", float(np.min(fs)), -100.0)
     ck.true("contact-force output = max(unclipped, 0) (both paths)",
             all(np.array_equal(np.maximum(r["contact_force"], 0.0), r["contact_force"])
@@ -183,6 +183,8 @@ def _pantograph_energy_100s(ck: Checker) -> None:
 
 
 class PantographStudy(Study):
+    """The pantograph's work-precision study: MuJoCo integrators x timesteps and scipy methods x tolerances against
+    a Radau rtol 1e-12 reference."""
     SIGNALS = ("F1", "F2", "HD", "y_d")
     MJ_INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4", "discrete")
     MJ_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5)
@@ -218,6 +220,7 @@ class PantographStudy(Study):
         return go
 
     def settings(self) -> list[Setting]:
+        """The settings measured: MuJoCo integrator x timestep and scipy method x rtol."""
         out = []
         integ = ("implicitfast", "rk4") if self.quick else self.MJ_INTEGRATORS
         steps = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
@@ -232,6 +235,7 @@ class PantographStudy(Study):
         return out
 
     def reference(self):
+        """The reference result (Radau rtol 1e-12) and its check against DOP853 rtol 1e-12."""
         ref = run(self.base.replace(solver={"engine": "reference", "method": "Radau", "rtol": 1e-12, "atol": 1e-14}))
         chk = run(self.base.replace(solver={"engine": "reference", "method": "DOP853", "rtol": 1e-12, "atol": 1e-14}))
         err, det = self.physics_error(chk, ref)
@@ -240,11 +244,14 @@ class PantographStudy(Study):
                      "check_physics_error": err}
 
     def state_error(self, res, ref) -> float:
+        """Largest deviation of F1, F2, HD, y_d from the reference after settling, over the amplitude A."""
         m = ref.t >= self.ts
         grid = ref.t[m]
         return max(float(np.max(np.abs(np.interp(grid, res.t, res[s]) - ref[s][m]))) / self.A for s in self.SIGNALS)
 
     def physics_error(self, res, ref):
+        """Largest relative error of the physics metrics (fundamental of F1, HD; contact-force mean and std) and
+        each."""
         det = {}
         for s in ("F1", "HD"):
             a, b = fundamental(res.t, res[s], self.f, self.ts), fundamental(ref.t, ref[s], self.f, self.ts)
@@ -277,7 +284,7 @@ HARD_CASES: tuple[HardCase, ...] = (
              "push-only contact: non-smooth force, repeated contact loss and impact",
              "pantograph/unilateral (2.5 mm at 4.25 Hz), 4 s, both engines",
              "losses detected (>= 20), counts agree within 1, paired starts/durations within 2.5 ms, total loss "
-             "time within 2 %; unclipped spring force < 0 inside losses, >= -18 N outside",
+             "time within 2 %; unclipped spring force <= 0 inside losses, >= 0 outside",
              _pantograph_unilateral),
     HardCase("pantograph_over_large_timestep", "pantograph",
              "explicit/semi-implicit integration far above the stable step",
@@ -293,6 +300,7 @@ HARD_CASES: tuple[HardCase, ...] = (
 
 
 def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    """The `workprecision_study` hook: the pantograph study of this scene."""
     return PantographStudy(scene, quick=quick)
 
 

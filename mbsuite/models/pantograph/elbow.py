@@ -1,4 +1,4 @@
-"""Elbow (lower-arm chain) kinematics, Appendix B of Eppinger (1984), seed 000 l.1077-1121.
+"""Elbow (lower-arm chain) kinematics, Appendix B (Eqs B.1-B.6) of Eppinger (1984).
 
 The pinion (radius le) sits at the elbow C = (l1 cos th1, l1 sin th1); the chain ("fourth bar") runs from the base point
 F = (xf, -yf) tangent to the pinion. With t = tan(phi1) the tangency condition B.2 is the quadratic B.3,
@@ -25,6 +25,7 @@ from .params import PantographParams
 
 @dataclass(frozen=True)
 class ElbowState:
+    """The elbow at one theta_1: theta_e (B.3-B.6) and its derivative dtheta_e/dtheta_1."""
     theta_e: float  #: pinion angle (rad)
     dtheta_e: float  #: d theta_e / d theta_1 (-)
     phi1: float  #: chain angle (rad)

@@ -46,11 +46,13 @@ def _inertia(I: float) -> tuple[float, float, float]:
 
 
 def theta_to_q(theta: np.ndarray) -> np.ndarray:
+    """Relative joint coordinates q from absolute angles (theta_1, theta_2, theta_h)."""
     t1, t2, th = theta
     return np.array([t1, math.pi - t1 - t2, th + t2 - math.pi])
 
 
 def q_to_theta(q: np.ndarray) -> np.ndarray:
+    """Absolute angles (theta_1, theta_2, theta_h) from relative joint coordinates q."""
     q1, q2, q3 = q
     return np.array([q1, math.pi - q1 - q2, q1 + q2 + q3])
 
@@ -64,6 +66,7 @@ def lever_local(p: PantographParams) -> tuple[float, float]:
 
 
 def urdf_text(p: PantographParams | None = None) -> str:
+    """The URDF of the pantograph's spanning tree for these parameters (default Table 3-I)."""
     p = p or PantographParams()
     lx, lz = lever_local(p)
 

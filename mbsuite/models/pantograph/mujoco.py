@@ -171,6 +171,7 @@ class MujocoPantograph:
 
     def stepper(self, every: int = 1, what: str = "pantograph (MuJoCo)",
                 data: mujoco.MjData | None = None) -> core.Stepper:
+        """A native-core stepper of this model recording `channels()` every `every` steps."""
         return core.Stepper(self.model, self.data if data is None else data, self.channels(), every=every, what=what,
                             allow_callbacks=not self.plugins)
 

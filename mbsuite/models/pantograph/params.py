@@ -1,4 +1,4 @@
-"""Brecknell-Willis pantograph parameters: Table 3-I of Eppinger (1984), seed 000 lines 560-600, SI units.
+"""Brecknell-Willis pantograph parameters: Table 3-I of Eppinger (1984), SI units.
 
 Angles are measured from the horizontal (Fig 3-3): the lower arm points forward, the upper arm backward, the head
 forward.
@@ -31,7 +31,7 @@ def _nonneg(default: float, unit: str, doc: str, hi: float | None = None) -> flo
 
 @dataclass(frozen=True)
 class PantographParams:
-    """Table 3-I (seed 000, l.560-600). Every field in SI units, declared with its valid range
+    """Table 3-I of Eppinger (1984). Every field in SI units, declared with its valid range
     (`mbsuite.limits.param`); `__post_init__` checks them, then the geometry across fields."""
 
     l1: float = _pos(1.95, "m", "lower link length")
@@ -103,4 +103,5 @@ class PantographParams:
         return self.Pg * self.Ap
 
     def replace(self, **changes: float) -> PantographParams:
+        """A copy with some fields changed (checked again)."""
         return dataclasses.replace(self, **changes)

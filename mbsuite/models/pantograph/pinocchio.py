@@ -46,6 +46,7 @@ class PinocchioPantograph:
         self.elbow = Elbow(self.p, exact=self.cfg.elbow_kinematics == "exact")
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space mass matrix M(q) (CRBA)."""
         M = pin.crba(self.model, self.data, np.asarray(q, float))
         return np.triu(M) + np.triu(M, 1).T
 
@@ -54,6 +55,7 @@ class PinocchioPantograph:
         return pin.computeGeneralizedGravity(self.model, self.data, np.asarray(q, float)).copy()
 
     def frame_position(self, q: np.ndarray, fid: int) -> np.ndarray:
+        """World position of a named frame at joint positions q."""
         pin.framesForwardKinematics(self.model, self.data, np.asarray(q, float))
         return self.data.oMf[fid].translation.copy()
 
@@ -62,6 +64,7 @@ class PinocchioPantograph:
         return pin.computeFrameJacobian(self.model, self.data, np.asarray(q, float), fid, LWA).copy()
 
     def contact_height(self, q: np.ndarray) -> float:
+        """Height y_d of the contact point at joint positions q."""
         return float(self.frame_position(q, self.f_contact)[2])
 
     def static_generalized_force(self, q: np.ndarray, y_w: float) -> np.ndarray:

@@ -99,6 +99,8 @@ class PantographODE:
 
     # ---------------------------------------------------------------- kinematics
     def theta(self, q: np.ndarray) -> np.ndarray:
+        """Absolute angles (theta_1, theta_2, theta_h) from the generalized coordinates (rigid elbow: theta_2 =
+        theta_e(theta_1))."""
         if self.nq == 3:
             return np.asarray(q[:3], dtype=float)
         return np.array([q[0], self.elbow(q[0]).theta_e, q[1]])
@@ -119,16 +121,19 @@ class PantographODE:
         return p.l1 * math.sin(t[0]) + p.l2 * math.sin(t[1]) + p.lh * math.sin(t[2])
 
     def contact_jacobian_theta(self, t: np.ndarray) -> np.ndarray:
+        """d y_d / d theta = (l1 cos theta_1, l2 cos theta_2, lh cos theta_h)."""
         p = self.p
         return np.array([p.l1 * math.cos(t[0]), p.l2 * math.cos(t[1]), p.lh * math.cos(t[2])])
 
     def contact_velocity(self, x: np.ndarray) -> float:
+        """Rate of the contact height dy_d/dt of state x."""
         q, qd = x[: self.nq], x[self.nq : 2 * self.nq]
         J, _ = self.theta_jacobian(q)
         return float(self.contact_jacobian_theta(self.theta(q)) @ (J @ qd))
 
     # ---------------------------------------------------------------- hand-derived model pieces (absolute angles)
     def mass_matrix_theta(self, t: np.ndarray) -> np.ndarray:
+        """Mass matrix M(theta) of Eqs 3.10-3.12 (A.28, A.31, A.34 after errata 4, 5, 8)."""
         p = self.p
         m11 = p.I1 + p.m1 * p.d1**2 + (p.m2 + p.mh) * p.l1**2
         m22 = p.I2 + p.m2 * p.d2**2 + p.mh * p.l2**2
@@ -167,6 +172,7 @@ class PantographODE:
         return p.lb * math.cos(p.alpha - t1), p.lb * math.sin(p.alpha - t1)
 
     def cylinder_force(self, t1: float, P: float | None) -> float:
+        """Cylinder force on the lever: linear 3.26, nonlinear 3.22 (P - Pa) Ap, constant Pg Ap."""
         p = self.p
         if self.cfg.cylinder == "constant":
             return p.Pg * p.Ap  # 3.23 / 3.27
@@ -195,6 +201,7 @@ class PantographODE:
         return sgn * self.gas * Pu * r ** (1.0 / p.gamma) * math.sqrt(1.0 - r ** ((p.gamma - 1.0) / p.gamma))
 
     def cylinder_rate(self, t1: float, t1d: float, P: float) -> float:
+        """Rate of the cylinder state: linear 3.24-3.25, nonlinear corrected 3.18/3.21 (errata 10-14)."""
         p = self.p
         xp, dxp = self.cylinder_lever(t1)
         if self.cfg.cylinder == "linear":
@@ -269,6 +276,8 @@ class PantographODE:
         return dx
 
     def rhs(self, t: float, x: np.ndarray, y_w: float, modes: FrictionModes | None = None) -> np.ndarray:
+        """State derivative of the smooth model at ram height y_w (Coulomb friction from the current stick/slip
+        state)."""
         return self.rhs_with_force(t, x, self.contact_force(y_w, self.contact_height(x)), modes)
 
     def energy(self, x: np.ndarray, y_w: float) -> float:
@@ -364,6 +373,7 @@ class PantographODE:
 # -------------------------------------------------------------------- time integration with events
 @dataclass
 class RefSolution:
+    """A reference-path solution: times, states, events, RHS calls and smooth segments."""
     t: np.ndarray
     x: np.ndarray  # (n, len(t))
     events: list[dict]

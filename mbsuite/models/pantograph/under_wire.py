@@ -91,6 +91,7 @@ class EppingerReference:
         self._pending = None
 
     def static(self, y_wire: float, k_wire: float) -> float:
+        """Static equilibrium under the wire at height y_w; returns the contact force."""
         _no_free_equilibrium(k_wire, self.params)
         ode = PantographODE(dataclasses.replace(self.params, ks=float(k_wire)), self.cfg)
         y_w = self.y_op + y_wire
@@ -108,17 +109,21 @@ class EppingerReference:
         return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
     def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        """Contact force after a trial step of h to wire height y_w, the state left unchanged."""
         xn = self._rk4(t, dt, f0, f1)
         self._pending = xn
         return self.ode.contact_height(xn) - self.y_op
 
     def commit(self) -> None:
+        """Take the last trial step."""
         self.x = self._pending
 
     def head(self) -> float:
+        """Current contact-point height y_d."""
         return self.ode.contact_height(self.x) - self.y_op
 
     def signals(self) -> dict[str, float]:
+        """The pantograph's own signals at the current state."""
         t = self.ode.theta(self.x[: self.ode.nq])
         return {"head_displacement": self.head(), "theta_1": float(t[0]), "theta_2": float(t[1]),
                 "theta_h": float(t[2])}
@@ -168,6 +173,7 @@ class EppingerMujoco:
         m.actuator_ctrllimited[i] = 0
 
     def static(self, y_wire: float, k_wire: float) -> float:
+        """Static equilibrium under the wire at height y_w; returns the contact force."""
         _no_free_equilibrium(k_wire, self.params)
         m, d, i = self.m, self.d, self.i_cat
         gain, bias, flim, clim = self._spring
@@ -188,6 +194,7 @@ class EppingerMujoco:
         return -f_up
 
     def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        """Contact force after a trial step of h to wire height y_w, the state left unchanged."""
         if dt != self.timestep:
             raise SolverError(f"Eppinger pantograph (MuJoCo) built for time step {self.timestep:g} s, asked to step "
                               f"{dt:g} s: build it with the catenary's time step")
@@ -201,6 +208,7 @@ class EppingerMujoco:
         return y
 
     def commit(self) -> None:
+        """Take the last trial step."""
         self._state, self._pending = self._pending, self._state
         # the data still holds the last trial (now committed) unless head()/signals() restored the old state since
         self._holds = "committed" if self._holds == "trial" else None
@@ -212,11 +220,13 @@ class EppingerMujoco:
             self._holds = "committed"
 
     def head(self) -> float:
+        """Current contact-point height y_d."""
         self._sync()
         xpos = self.d.site_xpos
         return float(xpos[self.site_c, 2] - xpos[self.site_o, 2]) - self.y_op
 
     def signals(self) -> dict[str, float]:
+        """The pantograph's own signals at the current state."""
         self._sync()
         th = q_to_theta(np.array(self.d.qpos[:3]))
         return {"head_displacement": self.head(), "theta_1": float(th[0]), "theta_2": float(th[1]),

@@ -94,3 +94,21 @@ def test_bad_input():
         RotorSystem(names=["a"], J=np.ones(1), B=np.zeros(1), frictions=[Friction("f", 0, -1, [Part("p", 1)], 0.5)])
     with pytest.raises(ParameterError, match="friction torque"):
         RotorSystem(names=["a"], J=np.ones(1), B=np.zeros(1), frictions=[Friction("f", 0, -1, [Part("p", -1.0)])])
+
+
+@pytest.mark.parametrize("factor, slips", [(0.995, False), (1.005, True)])
+def test_breakaway_threshold_is_sharp(factor, slips):
+    """The lock holds up to its breakaway torque peak x tau and not beyond: at 0.5 % below it the hand path never
+    slips, at 0.5 % above it slips from t = 0 (a breakaway bound off by 1 % is caught either way)."""
+    tau, peak = 1.0, 1.2
+    J0, J1 = 1e-3, 1e-3
+    drive = factor * peak * tau * (J0 + J1) / J1  # the clutch must carry factor x breakaway to hold
+    res = simulate_reference(_two_rotors(J0, J1, tau, peak=peak, drive=drive), [0, 0, 0], [0, 0, 0], 0.05,
+                             sample_dt=1e-3)
+    slip = np.max(np.abs(res.q[0] - res.q[1]))
+    if slips:
+        # sliding from t = 0 at the sliding torque tau: q0 - q1 = 1/2 (a0 - a1) t^2 (closed form, rel 1e-9)
+        expected = 0.5 * ((drive - tau) / J0 - tau / J1) * res.t**2
+        np.testing.assert_allclose(res.q[0] - res.q[1], expected, rtol=1e-9, atol=1e-15)
+    else:
+        assert res.events == [] and slip == 0.0

@@ -93,3 +93,16 @@ def test_command_lines_parse(path, cmd):
 
 def test_there_are_command_examples():
     assert len(COMMANDS) >= 5
+
+
+@pytest.mark.parametrize("name", sorted(mbsuite.models()))
+def test_model_readme_lists_every_parameter_and_input(name):
+    """Each model's README names every parameter field and every input key a scene may set (with its default)."""
+    import dataclasses
+
+    spec = mbsuite.get_model(name)
+    text = (ROOT / "mbsuite" / "models" / name / "README.md").read_text()
+    fields = [f.name for f in dataclasses.fields(spec.params_cls)]
+    keys = sorted({k for keys in spec.inputs.values() for k in keys})
+    missing = [n for n in [*fields, *keys] if f"`{n}`" not in text and f"| {n} |" not in text]
+    assert not missing, f"{name} README does not list: {missing}"

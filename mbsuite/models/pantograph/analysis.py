@@ -605,7 +605,14 @@ def equilibrium_report(scene: Scene) -> Report:
                           "elbow wind-up (rad)"], rows, ".10g")
     table += "\nmax |theta - theta_ref| (rad): " + ", ".join(f"{k} {v:.2e}" for k, v in
                                                                data["max_difference_rad"].items())
-    return Report(data, table)
+    keys = [("theta1", "rad"), ("theta2", "rad"), ("thetah", "rad"), ("y_d", "m"), ("contact_force", "N"),
+            ("elbow_windup", "rad"), ("theta_e", "rad"), ("dtheta_e_dtheta1", "-")]
+
+    def write(out: Path) -> list[Path]:
+        return [write_csv(Path(out) / "equilibrium.csv", [("path", "", list(paths))]
+                          + [(k, u, [data[n][k] for n in paths]) for k, u in keys])]
+
+    return Report(data, table, write)
 
 
 def modes_report(scene: Scene, height: float | None = None) -> Report:
@@ -630,6 +637,14 @@ def modes_report(scene: Scene, height: float | None = None) -> Report:
               + (" (the mean of the scene's input)" if height is None else "")
               + "; reference: central-difference Jacobian of the hand-derived ODE; MuJoCo: mjd_transitionFD at "
               f"timestep {MODES_TIMESTEP:g} s (implicit), log(mu)/h. Coulomb friction excluded.")
-    return Report({"linearised_at_height_m": y_lin, "reference": ref, "mujoco": mj}, table)
+    def write(out: Path) -> list[Path]:
+        n = len(ref)
+        mjc = [mj[i] if i < len(mj) else {"f_n": float("nan"), "zeta": float("nan")} for i in range(n)]
+        return [write_csv(Path(out) / "modes.csv", [
+            ("mode", "", [md["kind"] for md in ref]), ("f_n_reference", "Hz", [md["f_n"] for md in ref]),
+            ("zeta_reference", "-", [md["zeta"] for md in ref]), ("f_n_mujoco", "Hz", [m["f_n"] for m in mjc]),
+            ("zeta_mujoco", "-", [m["zeta"] for m in mjc]), ("height", "m", [y_lin] * n)])]
+
+    return Report({"linearised_at_height_m": y_lin, "reference": ref, "mujoco": mj}, table, write)
 
 

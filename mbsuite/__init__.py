@@ -20,7 +20,8 @@ from .errors import (  # noqa: E402
 )
 from .health import AccuracyError, judge  # noqa: E402
 from .paths import model_file, model_files  # noqa: E402
-from .registry import get_model, models  # noqa: E402
+from .registry import get_model  # noqa: E402
+from .registry import models as model_specs
 from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
 
 
@@ -52,7 +53,7 @@ __all__ = [
     "load_scene",
     "model_file",
     "model_files",
-    "models",
+    "model_specs",
     "native",
     "run",
     "scene_from_dict",

@@ -95,7 +95,7 @@ def test_there_are_command_examples():
     assert len(COMMANDS) >= 5
 
 
-@pytest.mark.parametrize("name", sorted(mbsuite.models()))
+@pytest.mark.parametrize("name", sorted(mbsuite.model_specs()))
 def test_model_readme_lists_every_parameter_and_input(name):
     """Each model's README names every parameter field and every input key a scene may set (with its default)."""
     import dataclasses

@@ -473,3 +473,12 @@ def test_view_models_are_the_runs_models():
         m, d = spec.mujoco_model(scene)
         assert m.nbody > 1 and m.nv > 0 and np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel)), name
         assert m.opt.timestep == pytest.approx(scene.solver.timestep), name
+
+
+def test_top_level_api_survives_importing_the_models():
+    """Importing a model package binds `mbsuite.models` to the package: no public function may live under that
+    name (it would be replaced); the registry is `mbsuite.model_specs()`."""
+    import mbsuite.models.pantograph  # noqa: F401
+
+    assert callable(mbsuite.model_specs) and set(mbsuite.model_specs()) == set(MODELS)
+    assert callable(mbsuite.run) and callable(mbsuite.load_scene) and callable(mbsuite.model_file)

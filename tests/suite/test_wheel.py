@@ -28,7 +28,7 @@ import mbsuite
 from mbsuite.engines import native
 
 out = {"file": mbsuite.__file__, "runs": {}, "mjcf": {}, "urdf": {}}
-for name in sorted(mbsuite.models()):
+for name in sorted(mbsuite.model_specs()):
     scene = mbsuite.load_scene(name)
     if name != "catenary":  # a passage is a fixed length of line: its short form is the 2-mass scene below
         scene = scene.replace(solver={"duration": min(scene.solver.duration, 0.3), "t_settle": 0.0})

@@ -30,12 +30,16 @@ def _candidates() -> list[Path]:
 
 
 def models_root() -> Path:
-    """The directory holding `mjcf/` and `models_urdf/`. An `MBSUITE_MODELS_DIR` that does not hold them is an error
-    (never a silent fall-back to the shipped files)."""
+    """The directory holding `mjcf/` and `models_urdf/`. `MBSUITE_MODELS_DIR`, when set, must hold at least one of
+    them (a file asked for in a missing one is then an error naming it): never a silent fall-back to the shipped
+    files."""
     env = os.environ.get("MBSUITE_MODELS_DIR")
-    if env and not ((Path(env) / "mjcf").is_dir() and (Path(env) / "models_urdf").is_dir()):
-        raise ModelFileError(f"MBSUITE_MODELS_DIR={env} does not hold mjcf/ and models_urdf/; unset it to use the "
-                             "shipped model files")
+    if env:
+        root = Path(env)
+        if not ((root / "mjcf").is_dir() or (root / "models_urdf").is_dir()):
+            raise ModelFileError(f"MBSUITE_MODELS_DIR={env} holds neither mjcf/ nor models_urdf/; unset it to use "
+                                 "the shipped model files")
+        return root
     candidates = _candidates()
     for root in candidates:
         if (root / "mjcf").is_dir() and (root / "models_urdf").is_dir():

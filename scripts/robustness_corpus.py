@@ -464,8 +464,9 @@ def input_attempts() -> Iterator[Attempt]:
 
 # ------------------------------------------------------------------------------------------------- model files
 COPY_MODELS = f"""
-import pathlib, re, shutil
+import os, pathlib, re, shutil
 import mbsuite.paths as P
+os.environ.pop("MBSUITE_MODELS_DIR", None)  # the shipped files, whatever the attempt will set
 root = P.models_root()
 dst = pathlib.Path("{DIR}/models")
 shutil.copytree(root / "mjcf", dst / "mjcf")

@@ -153,7 +153,8 @@ class Pulse(Signal):
         _finite("pulse", amplitude=self.amplitude, width=self.width, period=self.period, offset=self.offset,
                 t0=self.t0)
         if isinstance(self.n, bool) or not isinstance(self.n, int | float) or self.n != int(self.n):
-            raise ParameterError(f"pulse signal: n (number of periods) must be a whole number >= 0, got {self.n!r}")
+            raise ParameterError(f"pulse signal: n = {self.n!r} must be a whole number >= 0 (the number of periods; "
+                                 "0: unlimited)")
         if not (0.0 <= self.width <= 1.0 and self.period > 0 and self.n >= 0):
             raise ParameterError(f"pulse signal: need 0 <= width <= 1, period > 0, n >= 0; got {self}")
 

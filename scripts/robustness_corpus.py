@@ -1207,7 +1207,10 @@ class Runner:
         return env
 
     def _limit(self) -> None:
+        """In the attempt's process: the memory limit, and Ctrl-C's default disposition (a corpus started in the
+        background inherits SIGINT ignored, which would make the Ctrl-C attempts meaningless)."""
         resource.setrlimit(resource.RLIMIT_AS, (self.memory, self.memory))
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
 
     def _exec(self, cmd: list[str], env: dict[str, str], cwd: Path, timeout: float
               ) -> tuple[int | None, str, str, float]:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
 import warnings
 
 import pytest
@@ -73,10 +72,8 @@ def test_tiny_elements_are_refused_before_anything_is_built(monkeypatch):
 
     monkeypatch.setattr(analysis, "assemble", boom)
     scene = load_scene("catenary").replace(params={"element_length": 1e-4})
-    t0 = time.perf_counter()
     with pytest.raises(SceneError, match="element-steps exceed params.max_element_steps") as err:
-        mbsuite.run(scene)
-    assert time.perf_counter() - t0 < 1.0
+        mbsuite.run(scene)  # refused before anything is assembled (`assemble` above would raise)
     msg = str(err.value)
     # 2 wires x ceil(600 m / 1e-4 m) elements; ceil(420 m / (250/3.6 m/s x 2e-4 s)) steps
     assert "12,000,000 elements" in msg and "30,240 steps" in msg

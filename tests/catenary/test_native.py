@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -85,15 +83,12 @@ def test_native_core_reports_a_diverging_state():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("speed", [250.0, 300.0])
-def test_reference_scene_statistics_unchanged_and_fast(speed):
+def test_reference_scene_statistics_unchanged(speed):
     """The shipped EN 50318 setting: the core's eight statistics equal the Python path's within 1e-8 N / 1e-8 mm
-    (measured <= 1e-11: the same scheme to rounding; 1000x), and one run costs at most 1.5 s CPU (measured
-    1.06-1.30 s on one core of the 2-core test machine)."""
+    (measured <= 1e-11: the same scheme to rounding; 1000x). Its cost is measured by
+    `scripts/catenary_benchmark.py`, not asserted here."""
     p = CatenaryParams(element_length=0.5)
     py = simulate(p, speed, 2e-4, native=False)
-    c0 = time.process_time()
     nat = simulate(p, speed, 2e-4)
-    cpu = time.process_time() - c0
     for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct"):
         assert abs(nat.stats[k] - py.stats[k]) < 1e-8, k
-    assert cpu < 1.5

@@ -8,7 +8,6 @@ import os
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import mujoco
@@ -224,7 +223,6 @@ def test_parse_values_errors_name_the_text(text, match):
 
 
 def test_too_many_points_fail_before_anything_is_built():
-    t0 = time.perf_counter()
     with pytest.raises(SceneError, match="1,000,000,000 points exceed the limit of 10,000"):
         parse_values("1:1e9:1")  # what once exhausted the memory
     with pytest.raises(SceneError, match="exceed the limit"):
@@ -235,7 +233,6 @@ def test_too_many_points_fail_before_anything_is_built():
         run_sweep(_cube, range(10**12), workers=1)
     with pytest.raises(SceneError, match="more than 10,000"):
         run_sweep(_cube, itertools.count(), workers=1)  # an endless generator is read only up to the limit
-    assert time.perf_counter() - t0 < 1.0
     assert len(parse_values("1:20000:1", max_points=20_000)) == 20_000  # the limit can be raised
     assert check_grid([100, 100], max_points=10_000) == 10_000
     with sweep_options(max_points=5):

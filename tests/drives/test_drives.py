@@ -85,14 +85,12 @@ def _balance_ok(sys_, res):
 
 def test_step_up_paths_agree(step_up_pair):
     """Over >= 20 energy cycles: same cycles, equal lock/release event counts, every lock-up and release within one
-    MuJoCo step (1e-4 s; measured max 2.5e-5 s, 4x), load speed within 1e-4 (measured 9.7e-6, 10x), both balances
+    MuJoCo step (1e-4 s; measured max 6.5e-5 s, 1.5x), load speed within 1e-4 (measured 9.8e-6, 10x), both balances
     closed (`_balance_ok`).
 
-    Documented deviation (README "Deviations"): at t = 3.668 s the sliding brake's slip reverses *grazing* (the
-    spring end dips to -0.03 rad/s for ~2 ms). The exact path passes through (holding torque above breakaway at its
-    crossing), MuJoCo - whose crossing falls 1.4 ms earlier in this ill-conditioned tangency - locks and breaks loose
-    again 0.15 ms (1.5 steps) later. Such a blip (stuck < 2 MuJoCo steps) is taken out before pairing; at most one is
-    allowed, and the exact path must have no lock within 3 ms of it."""
+    At t = 3.668 s the sliding brake's slip reverses grazing (the spring end rises to +0.035 rad/s for 0.7 ms after a
+    pass-through and comes back): both paths lock there and break loose again after 81 us (exact) and 146 us
+    (MuJoCo, 1.5 steps); these short locks are paired like every other event."""
     (_, ra, ca, sys_), (_, rb, cb, _) = step_up_pair["reference"], step_up_pair["mujoco"]
     sa, sb = drive.cycle_stats(ra, ca, 0.5), drive.cycle_stats(rb, cb, 0.5)
     assert sa["n_cycles"] >= 20 and sa["n_cycles"] == sb["n_cycles"]
@@ -100,16 +98,14 @@ def test_step_up_paths_agree(step_up_pair):
     cmd = drive.compare_commands(ca, cb)
     assert cmd["same_sequence"] and not cmd["flips"], cmd
     els = ["clutch", "spring_ground"]
-    assert not drive.short_locks(ra, els, 2e-4)
-    blips = drive.short_locks(rb, els, 2e-4)
-    assert len(blips) <= 1, blips
-    for _, t_s, _ in blips:
-        assert not [e for e in ra.events if e["to"] == "stuck" and abs(e["t"] - t_s) < 3e-3]
-    cmp = drive.compare_events(ra, drive.without_events(rb, blips), els)
+    short_a, short_b = drive.short_locks(ra, els, 2e-4), drive.short_locks(rb, els, 2e-4)
+    assert [s[0] for s in short_a] == [s[0] for s in short_b] == ["spring_ground"]
+    assert abs(short_a[0][1] - short_b[0][1]) < 1e-4
+    cmp = drive.compare_events(ra, rb, els)
     assert {"clutch->stuck", "clutch->free", "spring_ground->stuck"} <= set(cmp)
     for k, v in cmp.items():
         assert v["n_a"] == v["n_b"], (k, v)
-        assert v["max_dt"] <= 1e-4, (k, v)  # one MuJoCo step (measured 2.5e-5 s); the controller sample is 2 ms
+        assert v["max_dt"] <= 1e-4, (k, v)  # one MuJoCo step (measured 6.5e-5 s); the controller sample is 2 ms
     _balance_ok(sys_, ra)
     _balance_ok(sys_, rb)
 

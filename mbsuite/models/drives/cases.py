@@ -155,7 +155,9 @@ def _drives_big_step(ck: Checker) -> None:
     sc = load_scene("drives/step_up_pwm").replace(solver={"engine": "mujoco", "duration": 0.2, "t_settle": 0.0})
     ck.raises("a timestep that does not divide the controller period", lambda: run(sc.replace(
         solver={"timestep": 3e-4})), SceneError, "must divide the controller period")
-    res = run(sc.replace(solver={"timestep": 2e-3}))
+    # h = 2 ms: RK4 over a step as long as the controller period leaves 9.1e-5 of the input in the energy balance,
+    # next to the health figure's bound 1e-4; the case is about the step, so it keeps the result whatever the figure
+    res = run(sc.replace(solver={"timestep": 2e-3, "allow_inaccurate": True}))
     ck.finite("h = controller period (2 ms)", *res.signals.values())
     # measured 9.1e-5 at h = 2 ms (RK4 truncation over a step as long as the controller period): bound 5.5x
     ck.le("h = 2 ms: energy balance residual / input", abs(res.stats["energy_balance"]["relative"]), 5e-4)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any, Protocol
 
@@ -35,6 +35,7 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
+from ... import perturbation
 from ...errors import ParameterError, SolverError
 
 FWD, STUCK, BWD, FREE = 1, 0, -1, 2
@@ -121,6 +122,15 @@ class RotorSystem:
     def __post_init__(self) -> None:
         self.J = np.asarray(self.J, float)
         self.B = np.asarray(self.B, float)
+        if perturbation.active():  # the stability check: every coefficient perturbed (copies; callers' objects kept)
+            pv = perturbation.value
+            self.J, self.B = perturbation.state(self.J, "rotor.J"), perturbation.state(self.B, "rotor.B")
+            self.springs = [replace(s, K=pv(s.K, key=f"{s.name}.K"), D=pv(s.D, key=f"{s.name}.D"))
+                            for s in self.springs]
+            self.frictions = [replace(f, parts=[replace(p, level=pv(p.level, key=f"{p.label}.level")) for p in f.parts])
+                              for f in self.frictions]
+            self.sources = [replace(s, c0=pv(s.c0, key=f"{s.label}.c0"), c1=pv(s.c1, key=f"{s.label}.c1"),
+                                    c2=pv(s.c2, key=f"{s.label}.c2")) for s in self.sources]
         for nm, j in zip(self.names, self.J, strict=True):
             if not (np.isfinite(j) and j > 0):
                 raise ParameterError(f"inertia of rotor '{nm}' must be positive, got {j!r} kg m^2")
@@ -634,7 +644,11 @@ class ReferenceSimulator:
             self._start_piece()
         solver = self.solver
         t_hard, kind = self._next_hard_time()
-        if solver.t < t_hard and solver.status == "running":
+        # a new solver step only once the current one is used up: after a breakpoint that kept the piece (a controller
+        # sample that changed nothing), the rest of the step, (self.t, solver.t], is scanned and recorded first with
+        # this step's own dense output - stepping on would evaluate the next step's interpolant before its start
+        # (extrapolated samples) and miss an event inside the rest
+        if self.t >= solver.t and solver.t < t_hard and solver.status == "running":
             self._f_known = [(solver.t, solver.f)]  # the right-hand side at the step's start (`_grazing_step`)
             msg = solver.step()
             self._f_known.append((solver.t, solver.f))
@@ -685,6 +699,12 @@ class ReferenceSimulator:
                             break
                         te = min(t_new, float(np.nextafter(te, np.inf)))
                 fired.append((te, tag))
+            elif tag[0] != "engage" and t_new > t_lo and -d * a0 <= 0.0 and -d * a1 < 0.0:
+                # a function that starts a piece at its zero - a slip after a pass-through (the lock was tried and
+                # the element slides on the other way), a stuck torque at its breakaway limit - starts with a
+                # round-off residue of either sign; on the wrong side its later crossing changes no sign at the
+                # scan's ends, so it is located on the dense output instead (the same outcome for either residue)
+                fired.append((self._first_return(lambda tt, g=g, yf=yfun, d=d: -d * g(tt, yf(tt)), t_lo, t_new), tag))
             elif tag[0] == "lock" and t_new > t_lo and -d * a0 > self.v_tol:
                 if self._graze is None:
                     self._graze = self._grazing_step(yfun)
@@ -692,6 +712,24 @@ class ReferenceSimulator:
                 if te is not None and t_lo < te <= t_new:
                     fired.append((te, tag))
         return fired
+
+    @staticmethod
+    def _first_return(s: Callable[[float], float], t_lo: float, t_new: float, n: int = 64) -> float:
+        """First instant in (t_lo, t_new] at which an event function s (signed so that > 0 is its armed side: a slip
+        in its sliding direction, a breakaway margin), having risen above zero, comes back to zero; s(t_lo) is a
+        round-off residue <= 0 and s(t_new) < 0. The dense output is sampled at n points to bracket the first
+        positive-to-non-positive change (a degree-7 interpolant has at most 7 roots), then located by `_root`. A
+        function that never rose fires at t_lo (the state machine decides again there: a stuck torque past its limit
+        breaks; a slip that cannot open is tried as a lock, a repeat is caught as mode chattering)."""
+        ts = np.linspace(t_lo, t_new, n + 1)
+        opened = False
+        for k in range(1, n + 1):
+            sk = s(float(ts[k]))
+            if sk > 0.0:
+                opened = True
+            elif opened:
+                return _root(s, float(ts[k - 1]), float(ts[k]))
+        return t_lo
 
     def _grazing_step(self, yfun) -> dict[int, float]:
         """Grazing locks inside the current solver step: a slip that touches zero and turns back (e.g. a freewheel

@@ -26,8 +26,8 @@ from .params import MAX_ELEMENT_STEPS, CatenaryParams
 from .quality import QualityCriteria, assess, criteria_from
 from .quality import plot as quality_plot
 from .quality import table_rows as quality_table_rows
-from .sim import CoupledResult, CoupledSimulation
-from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics
+from .sim import CoupledResult, CoupledSimulation, steps_to_cover
+from .stats import ACCEPTED_RANGES, STAT_NAMES, check_ranges, en50318_statistics, in_window
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -76,7 +76,7 @@ def passage_size(p: CatenaryParams, speed_ms: float, dt: float) -> tuple[int, in
     has at least ceil(length / element_length) elements (key points only add some), the pantograph moves
     x_end - x_start at speed_ms in steps of dt."""
     per_wire = math.ceil(p.length / p.element_length)
-    steps = math.ceil((p.x_end - p.x_start) / (speed_ms * dt) - 1e-9)
+    steps = steps_to_cover(p.x_end - p.x_start, speed_ms, dt)
     return 2 * per_wire, steps
 
 
@@ -208,7 +208,7 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
     stats, ff = en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p)
     t3, c3 = time.perf_counter(), time.process_time()
     warn = list(regime["warnings"]) + step_warn
-    w = (res.x >= p.window_start) & (res.x <= p.window_end)
+    w = in_window(res.x, p)
     if not np.any(res.force[w] > 0):
         msg = (f"the pantograph is off the wire for the whole window [{p.window_start}, {p.window_end}] m "
                f"(static uplift F0 = {p.F0} N): no contact force to analyse")

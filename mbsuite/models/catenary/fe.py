@@ -73,7 +73,8 @@ def build_nodes(p: CatenaryParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     keys = np.asarray(keys)
     pieces = []
     for a, b in zip(keys[:-1], keys[1:], strict=True):
-        n = max(1, math.ceil((b - a) / p.element_length - 1e-9))
+        r = (b - a) / p.element_length  # a whole number of elements stays one under a relative change < 1e-8
+        n = max(1, math.ceil(r - 1e-8 * max(1.0, r)))
         pieces.append(a + (b - a) * np.arange(n) / n)
     pieces.append(keys[-1:])
     x = np.concatenate(pieces)
@@ -144,11 +145,14 @@ def assemble(p: CatenaryParams) -> CatenaryFE:
     nn = x.size
     nfull = NDOF_NODE * nn
     h = np.diff(x)
+    groups, inverse = np.unique(np.round(h, 9), return_inverse=True)
     rows, cols, kv, mv = [], [], [], []
     for wire, (rho, T, EI) in ((CW_W, (p.cw_mass, p.cw_tension, p.cw_EI)), (MW_W, (p.mw_mass, p.mw_tension, p.mw_EI))):
-        # elements with equal length share matrices: group them
-        for he in np.unique(np.round(h, 12)):
-            sel = np.nonzero(np.isclose(h, he, rtol=0, atol=1e-9))[0]
+        # elements with equal length (to 1e-9 m) share matrices: each element belongs to exactly one group (lengths
+        # a last bit apart, e.g. 0.5 and 0.49999999999994 m, once fell into two groups that each took both)
+        for g in range(groups.size):
+            sel = np.nonzero(inverse == g)[0]
+            he = float(np.mean(h[sel]))
             ke, me = beam_stiffness(EI, T, he), beam_mass(rho, he)
             dofs = np.stack([NDOF_NODE * sel + wire, NDOF_NODE * sel + wire + 1,
                              NDOF_NODE * (sel + 1) + wire, NDOF_NODE * (sel + 1) + wire + 1], axis=1)

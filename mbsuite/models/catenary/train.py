@@ -31,8 +31,8 @@ from .native_core import NativeCore
 from .pantographs import Pantograph, TwoMassPantograph
 from .pantographs import build as build_pantograph
 from .params import CatenaryParams
-from .sim import CHECK_EVERY, CoupledResult, CoupledSimulation, _native_error
-from .stats import en50318_statistics
+from .sim import CHECK_EVERY, CoupledResult, CoupledSimulation, _native_error, steps_to_cover
+from .stats import en50318_statistics, supports_in_window
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -95,7 +95,7 @@ def check_train(p: CatenaryParams, spacings: Sequence[float], head_width: float 
 
 
 def _entry_step(offset: float, V: float, dt: float) -> int:
-    return int(math.ceil(offset / (V * dt) - 1e-9))
+    return steps_to_cover(offset, V, dt)
 
 
 def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: Sequence[str | Pantograph],
@@ -246,7 +246,7 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
         up = np.where(near, res.uplift, -np.inf)
         s, ff = en50318_statistics(res.t, x, res.force, np.where(np.isfinite(up), up, 0.0), sx, dt, p)
         # the uplift charged to this pantograph: only while it is within UPLIFT_REACH of the steady arm
-        win = (sx >= p.window_start - 1e-9) & (sx <= p.window_end + 1e-9)
+        win = supports_in_window(sx, p)
         per = {f"{xsup:g}": float(1000 * np.max(up[:, j])) for j, xsup in enumerate(sx) if win[j]}
         s["uplift_at_supports_mm"] = per
         s["uplift_mm"] = max(per.values()) if per else 0.0

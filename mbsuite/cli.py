@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import math
 import os
 import sys
 from collections.abc import Sequence
@@ -50,7 +51,7 @@ def _analyses(spec: registry.ModelSpec) -> list[str]:
     """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
     out = [a for a in ANALYSES if getattr(spec, "mujoco_model" if a == "view" else a) is not None]
     if spec.run is not None:
-        out.append("sweep")
+        out += ["sweep", "perturb"]
     if spec.cases:
         out += ["workprecision", "hardcases"]
     group = CLI_GROUPS.get(spec.name)
@@ -158,6 +159,55 @@ def _cmd_hardcases(args: argparse.Namespace) -> None:
     bad = [n for n, o in outcomes.items() if not o.passed and not hardcases.get(n).expected_failure]
     if bad:
         raise MbsuiteError("hard case(s) failed: " + ", ".join(bad))
+
+
+def _cmd_perturb(args: argparse.Namespace) -> None:
+    from . import hardcases, perturbation
+
+    try:
+        epsilons = [float(e) for e in args.eps.split(",")]
+    except ValueError as exc:
+        raise MbsuiteError(f"--eps {args.eps!r} is not a comma list of numbers, e.g. 1e-12,1e-9") from exc
+    for e in epsilons:
+        if not (math.isfinite(e) and 0.0 < e < 1e-3):
+            raise MbsuiteError(f"--eps {e!r} is invalid; valid: (0, 1e-3) (a relative perturbation)")
+    if not 1 <= args.draws <= MAX_REPEATS:
+        raise MbsuiteError(f"--draws {args.draws} is invalid; valid: integer in [1, {MAX_REPEATS}]")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise MbsuiteError(f"--duration {args.duration!r} is invalid; valid: (0, inf) s")
+    scenes = []
+    if not args.hardcases_only:
+        names = args.target or sorted(registry.models())
+        for t in names:
+            if "/" in t or t.endswith(".toml"):
+                scenes.append(load_scene(t))
+            else:
+                scenes += [load_scene(f"{t}/{s}") for s in registry.get_model(t).scene_files()]
+    cases = []
+    if args.hardcases or args.hardcases_only:
+        models = {t.split("/")[0] for t in args.target} if args.target else None
+        cases = [c for c in hardcases.cases(include_slow=not args.no_slow)
+                 if (models is None or c.model in models) and not c.expected_failure]
+    reports = []
+    for sc in scenes:
+        if args.duration is not None and getattr(sc.solver, "duration", None) and sc.solver.duration > args.duration:
+            upd = {"duration": args.duration}
+            if getattr(sc.solver, "t_settle", None):
+                upd["t_settle"] = min(sc.solver.t_settle, 0.5 * args.duration)
+            sc = sc.replace(solver=upd)
+        base = None
+        for e in epsilons:
+            rep = perturbation.check_scene(sc, eps=e, draws=args.draws, seed=args.seed, base=base)
+            base = rep.base
+            reports.append(rep)
+            print(" ".join(map(str, rep.row())), file=sys.stderr, flush=True) if args.verbose else None
+    for c in cases:
+        for e in epsilons:
+            reports.append(perturbation.check_case(c, eps=e, draws=args.draws, seed=args.seed))
+    _emit(perturbation.report(reports), args, None)
+    bad = sorted({r.target for r in reports if not r.ok})
+    if bad:
+        raise MbsuiteError("unstable under perturbation: " + ", ".join(bad))
 
 
 def _cmd_sweep(args: argparse.Namespace) -> None:
@@ -415,6 +465,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--verbose", action="store_true", help="print each setting as it finishes (stderr)")
     _common(p)
     p.set_defaults(func=_cmd_workprecision)
+
+    p = sub.add_parser("perturb", help="stability under perturbation: every parameter, input and initial state "
+                                       "changed by a relative eps; invariants, sensitivities, jumps")
+    p.add_argument("target", nargs="*", help="scenes (model/scene or TOML path) or models (all their scenes); "
+                                             "default: every shipped scene")
+    p.add_argument("--eps", default="1e-12,1e-9", help="comma list of relative perturbations (default 1e-12,1e-9)")
+    p.add_argument("--draws", type=int, default=2, help="perturbed copies per eps (seeded; default 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first draw (default 0)")
+    p.add_argument("--duration", type=float, help="shorten longer runs to this many seconds (s)")
+    p.add_argument("--hardcases", action="store_true", help="also run the hard cases (of the targets' models)")
+    p.add_argument("--hardcases-only", action="store_true", help="only the hard cases")
+    p.add_argument("--no-slow", action="store_true", help="leave out the slow hard cases")
+    p.add_argument("--verbose", action="store_true", help="print each row as it finishes (stderr)")
+    _common(p)
+    p.set_defaults(func=_cmd_perturb)
 
     p = sub.add_parser("hardcases", help="the hard-case registry: what is hard, the scene, what is asserted")
     p.add_argument("--run", action="store_true", help="run the cases and report each assertion (exit 2 on failure)")

@@ -122,6 +122,9 @@ def check_fields(obj: Any, owner: str, error: type[Exception] = ParameterError) 
         v = lim.check(f"{owner} {f.name}", getattr(obj, f.name), error)
         if v is not getattr(obj, f.name):
             object.__setattr__(obj, f.name, v)
+    from . import perturbation  # inside `perturbation.perturbed` (the stability check) every float is perturbed
+
+    perturbation.fields(obj)
 
 
 def limits_table(cls: Any) -> list[tuple[str, str, str, str, str]]:

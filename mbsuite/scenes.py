@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from . import perturbation
 from .errors import SceneError
 from .limits import Limit
 from .registry import ModelSpec, get_model, models
@@ -242,6 +243,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
                 inp[key] = decl.check(f"input.{key}{where}", inp[key], SceneError)
             elif decl.has_default:
                 inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
+            if decl.kind is float and decl.choices is None and isinstance(inp.get(key), float):
+                inp[key] = perturbation.value(inp[key], decl, f"input.{key}")  # unchanged outside the stability check
     for key, v in inp.items():  # keys without a declared Limit: at least finite, never a nested table
         if isinstance(v, float) and not math.isfinite(v):
             raise SceneError(f"input.{key} = {v!r}{where} must be a finite number")

@@ -13,6 +13,21 @@ that wheel's `libmujoco`, and cached under `$MBSUITE_NATIVE_DIR` (default `$XDG_
 mujoco or an edited source compiles anew, nothing stale is ever loaded. Compiling against the installed wheel's own
 headers (rather than at wheel-build time against whatever mujoco the build environment held) is what keeps the plugin
 structs and `mjData` offsets right whatever mujoco 4.x a user has.
+
+Floating point is pinned by the flags (`CFLAGS`): `-ffp-contract=off` forbids the compiler to fuse a*b+c into one
+fused multiply-add (GCC fuses by default in its GNU C modes whenever the target has FMA: on aarch64 and ppc64 always,
+on x86-64 under `-march=native` or an FMA-capable `-march`; clang fuses within an expression). Every sum is then
+computed in the order the source writes it, with one rounding per operation, so the library's arithmetic is the same
+on every CPU and for every `-march`. Nothing else needs pinning: `-fno-fast-math` keeps the compiler from reordering
+sums (GCC's vectoriser keeps floating-point reductions in order, "fold-left"), and on x86-64 and aarch64 doubles carry
+no excess precision. What the flags cannot pin is the C library's `sin`, `cos`, `pow`, `atan2`, ...: glibc picks an
+FMA variant at run time on CPUs that have FMA, and its results differ from the other variant's by one ulp for a few
+arguments in ten thousand (docs/reproducibility.md has the measurements).
+
+`MBSUITE_NATIVE_EXTRA_CFLAGS` (shell words, e.g. "-march=native") is appended to the flags for checks such as the
+determinism tests, which build the library with two `-march` settings and compare the results bit for bit. The extra
+flags come last, so they can undo the pinning ("-ffp-contract=fast -mfma" does); they are part of the cache key, so
+such a build never replaces the default one. Leave it unset for results that follow docs/reproducibility.md.
 """
 
 from __future__ import annotations
@@ -33,7 +48,11 @@ from ...errors import MbsuiteError
 HERE = Path(__file__).resolve().parent
 MODELS_DIR = HERE.parents[1] / "models"
 LIB_NAME = "libmbsuite_native.so"
-CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-parameter", "-fno-fast-math")
+#: compiler flags; `-fno-fast-math -ffp-contract=off` pin the floating point (module docstring)
+CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-parameter", "-fno-fast-math",
+          "-ffp-contract=off")
+#: environment variable whose shell words are appended to CFLAGS (checks only; part of the cache key)
+EXTRA_CFLAGS_ENV = "MBSUITE_NATIVE_EXTRA_CFLAGS"
 ABI_VERSION = 1
 
 _lock = threading.Lock()
@@ -66,6 +85,11 @@ def mujoco_dirs() -> tuple[Path, Path]:
     return inc, libs[0]
 
 
+def cflags() -> tuple[str, ...]:
+    """The flags the library is compiled with: `CFLAGS`, then the words of $MBSUITE_NATIVE_EXTRA_CFLAGS (if set)."""
+    return CFLAGS + tuple(shlex.split(os.environ.get(EXTRA_CFLAGS_ENV, "")))
+
+
 def _compiler() -> list[str]:
     """The C compiler command: $CC (may carry arguments, e.g. "ccache gcc"), else cc, gcc or clang."""
     cc = shlex.split(os.environ.get("CC", "")) or [shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
@@ -94,7 +118,7 @@ def build_key() -> str:
     for p in sources() + _headers():
         h.update(p.name.encode())
         h.update(p.read_bytes())
-    h.update(" ".join(CFLAGS).encode())
+    h.update(" ".join(cflags()).encode())
     cc = _compiler()
     h.update(" ".join(cc).encode())
     h.update(subprocess.run([*cc, "--version"], capture_output=True, text=True, check=False).stdout.encode())
@@ -127,7 +151,7 @@ def build(force: bool = False) -> Path:
         out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".build-", suffix=".so", dir=out.parent)
     os.close(fd)
-    cmd = [*_compiler(), *CFLAGS, f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),
+    cmd = [*_compiler(), *cflags(), f"-I{inc}", f"-I{HERE}", *map(str, sources()), "-o", tmp, str(lib),
            f"-Wl,-rpath,{lib.parent}", "-lm"]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
@@ -167,8 +191,17 @@ def load() -> ctypes.CDLL:
         lib.mbs_fault_text.restype = ctypes.c_char_p
         lib.mbs_signal.argtypes = [ctypes.c_void_p, ctypes.c_double]
         lib.mbs_signal.restype = ctypes.c_double
+        lib.mbs_fp_contract_probe.argtypes = [ctypes.c_double] * 3
+        lib.mbs_fp_contract_probe.restype = ctypes.c_double
         _lib = lib
         return lib
+
+
+def fuses_multiply_add() -> bool:
+    """True if the loaded library fuses a*b+c into one rounding (an FMA): never with `CFLAGS`; a build whose
+    $MBSUITE_NATIVE_EXTRA_CFLAGS re-enable contraction on an FMA target does."""
+    a, b = 1.0 + 2.0**-30, 1.0 - 2.0**-30  # a*b = 1 - 2^-60: rounds to 1 unless fused with the -1
+    return load().mbs_fp_contract_probe(a, b, -1.0) != 0.0
 
 
 def job_size() -> int:

@@ -173,6 +173,8 @@ double mbs_signal(const double* s, double t) {
 /* ------------------------------------------------------------------------------------------------ the core */
 int mbs_abi_version(void) { return MBS_ABI_VERSION; }
 
+double mbs_fp_contract_probe(double a, double b, double c) { return a * b + c; }
+
 static int finite_state(const mjModel* m, const mjData* d) {
   for (int i = 0; i < m->nq; i++) if (!isfinite(d->qpos[i])) return 0;
   for (int i = 0; i < m->nv; i++) if (!isfinite(d->qvel[i])) return 0;

@@ -139,4 +139,9 @@ int mbs_job_size(void);
 int mbs_abi_version(void);
 #define MBS_ABI_VERSION 1
 
+/* a * b + c as the source writes it. Compiled with -ffp-contract=off it is rounded twice (the product, then the sum);
+ * a build allowed to fuse it into one FMA rounds once. With a = 1 + 2^-30, b = 1 - 2^-30, c = -1 it returns 0 when
+ * unfused and -2^-60 when fused: the determinism tests ask the compiled library which it is. */
+double mbs_fp_contract_probe(double a, double b, double c);
+
 #endif  /* MBSUITE_NATIVE_H_ */

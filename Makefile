@@ -3,17 +3,30 @@ PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+# the versions the suite last passed with (`make lock`), and the lowest versions pyproject.toml allows
+TESTED := constraints/tested.txt
+LOWEST := constraints/lowest.txt
+LOW_VENV := .venv-lowest
+LOW_STAMP := $(LOW_VENV)/.installed
 export MPLBACKEND ?= Agg
 
-.PHONY: demo test test-slow lint bench mutants corpus docs clean
+.PHONY: demo test test-slow test-lowest lock lint bench mutants corpus docs clean
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-$(STAMP): $(BIN)/python pyproject.toml
-	$(BIN)/python -m pip install --quiet -e ".[dev]"
+$(STAMP): $(BIN)/python pyproject.toml $(TESTED)
+	$(BIN)/python -m pip install --quiet -c $(TESTED) -e ".[dev]"
 	touch $(STAMP)
+
+# a venv of its own, rebuilt whole when the bounds change, so that nothing newer is left over from an earlier set
+$(LOW_STAMP): pyproject.toml $(LOWEST)
+	rm -rf $(LOW_VENV)
+	$(PY) -m venv $(LOW_VENV)
+	$(LOW_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(LOW_VENV)/bin/python -m pip install --quiet -c $(LOWEST) -e ".[test]"
+	touch $(LOW_STAMP)
 
 demo: $(STAMP)  ## the headline in ~1 min: pantograph frequency response, EN 50318 table; files in out/demo/
 	$(BIN)/python scripts/demo.py --out out/demo
@@ -24,6 +37,16 @@ test: $(STAMP)  ## default suite (slow studies excluded)
 test-slow: $(STAMP)  ## long studies only
 	$(BIN)/python -m pytest -q -m slow
 
+test-lowest: $(LOW_STAMP)  ## default suite at the lowest versions pyproject.toml allows, in .venv-lowest
+	$(LOW_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|matplotlib|distributed|tqdm|mujoco|pin|pytest|hypothesis)=='
+	$(LOW_VENV)/bin/python -m pytest -q
+
+lock:  ## constraints/tested.txt <- the versions installed in .venv (after `make test` passed there)
+	@test -f $(STAMP) || { echo "make lock: no installed .venv; run make test first" >&2; exit 1; }
+	{ echo "# Versions make test last passed with, written by make lock from .venv (docs/dependencies.md)"; \
+	  $(BIN)/python -m pip freeze --exclude-editable; } > $(TESTED).tmp
+	mv $(TESTED).tmp $(TESTED)
+
 lint: $(STAMP)
 	$(BIN)/ruff check mbsuite tests scripts
 
@@ -33,7 +56,7 @@ bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tes
 	$(BIN)/python scripts/bench_sweep.py
 
 docs: $(STAMP)  ## the documentation site (API reference, model pages, gallery) -> out/site/; warnings are errors
-	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	$(BIN)/python -m pip install --quiet -c $(TESTED) -e ".[docs]"
 	$(BIN)/python scripts/build_docs.py
 
 mutants: $(STAMP)  ## seeded physics defects, one at a time, against the default suite (tens of minutes)
@@ -43,4 +66,4 @@ corpus: $(STAMP)  ## the hostile robustness corpus: every outcome classified (ab
 	$(BIN)/python scripts/robustness_corpus.py --workers 2 --json-out out/robustness_corpus.json
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) $(LOW_VENV) .native-cache .native-cache-lowest out .pytest_cache

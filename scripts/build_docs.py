@@ -48,12 +48,12 @@ def _gather() -> None:
     text = (ROOT / "README.md").read_text()
     for m in MODELS:
         text = text.replace(f"](mbsuite/models/{m}/README.md)", f"](models/{m}.md)")
-    text = text.replace("](docs/accuracy.md)", "](accuracy.md)")
+    text = re.sub(r"\]\(docs/([A-Za-z_]+\.md)\)", r"](\1)", text)  # docs/accuracy.md, docs/stability.md, ...
     (DOCS / "index.md").write_text(text)
     (DOCS / "models").mkdir(exist_ok=True)
     for m in MODELS:
         page = (ROOT / "mbsuite" / "models" / m / "README.md").read_text()
-        page = page.replace("](../../../docs/accuracy.md)", "](../accuracy.md)")
+        page = re.sub(r"\]\(\.\./\.\./\.\./docs/([A-Za-z_]+\.md)\)", r"](../\1)", page)
         page = re.sub(r"\]\((\.\./)+([^)]+)\)", r"] (`\2`)", page)  # other repository paths: shown as paths
         (DOCS / "models" / f"{m}.md").write_text(page)
 

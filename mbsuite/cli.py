@@ -200,10 +200,13 @@ def _cmd_perturb(args: argparse.Namespace) -> None:
             rep = perturbation.check_scene(sc, eps=e, draws=args.draws, seed=args.seed, base=base)
             base = rep.base
             reports.append(rep)
-            print(" ".join(map(str, rep.row())), file=sys.stderr, flush=True) if args.verbose else None
+            if args.verbose:
+                print(" ".join(map(str, rep.row())), file=sys.stderr, flush=True)
     for c in cases:
         for e in epsilons:
             reports.append(perturbation.check_case(c, eps=e, draws=args.draws, seed=args.seed))
+            if args.verbose:
+                print(" ".join(map(str, reports[-1].row())), file=sys.stderr, flush=True)
     _emit(perturbation.report(reports), args, None)
     bad = sorted({r.target for r in reports if not r.ok})
     if bad:

@@ -7,6 +7,8 @@ shipped scene at its defaults and every hard case, at 1e-12 and 1e-9."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -117,3 +119,24 @@ def test_every_hard_case_stable(case):
     for eps in perturbation.EPSILONS:
         rep = perturbation.check_case(hardcases.get(case), eps=eps, draws=2)
         assert rep.ok, rep.errors
+
+
+def test_cli_perturb(capsys):
+    """`mbsuite perturb`: a scene and a model's hard cases, JSON with one report per target and eps; bad options exit 2
+    naming the option."""
+    from mbsuite.cli import main
+
+    assert main(["perturb", "iftomm/fourbar", "--eps", "1e-12,1e-9", "--draws", "1", "--duration", "0.3",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["total"] == data["passed"] == 2
+    assert [(r["target"], r["eps"]) for r in data["reports"]] == [("iftomm/fourbar", 1e-12), ("iftomm/fourbar", 1e-9)]
+    assert all(r["invariants"] and r["max_kappa"] < perturbation.KAPPA_MAX for r in data["reports"])
+    assert main(["perturb", "iftomm", "--hardcases-only", "--eps", "1e-12", "--draws", "1", "--no-slow",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {r["target"] for r in data["reports"]} == {"iftomm_fourbar_singular", "iftomm_bricard_overconstrained"}
+    for bad, word in ((["--eps", "0"], "--eps"), (["--eps", "x"], "--eps"), (["--draws", "0"], "--draws"),
+                      (["--duration", "-1"], "--duration")):
+        assert main(["perturb", "iftomm/fourbar", *bad]) == 2
+        assert word in capsys.readouterr().err

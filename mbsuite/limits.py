@@ -16,6 +16,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
+from . import perturbation
 from .errors import ParameterError
 
 _NO_DEFAULT = object()
@@ -122,9 +123,7 @@ def check_fields(obj: Any, owner: str, error: type[Exception] = ParameterError) 
         v = lim.check(f"{owner} {f.name}", getattr(obj, f.name), error)
         if v is not getattr(obj, f.name):
             object.__setattr__(obj, f.name, v)
-    from . import perturbation  # inside `perturbation.perturbed` (the stability check) every float is perturbed
-
-    perturbation.fields(obj)
+    perturbation.fields(obj)  # inside `perturbation.perturbed` (the stability check) every float is perturbed
 
 
 def limits_table(cls: Any) -> list[tuple[str, str, str, str, str]]:

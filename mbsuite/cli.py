@@ -190,11 +190,7 @@ def _cmd_perturb(args: argparse.Namespace) -> None:
                  if (models is None or c.model in models) and not c.expected_failure]
     reports = []
     for sc in scenes:
-        if args.duration is not None and getattr(sc.solver, "duration", None) and sc.solver.duration > args.duration:
-            upd = {"duration": args.duration}
-            if getattr(sc.solver, "t_settle", None):
-                upd["t_settle"] = min(sc.solver.t_settle, 0.5 * args.duration)
-            sc = sc.replace(solver=upd)
+        sc = perturbation.shortened(sc, args.duration)
         base = None
         for e in epsilons:
             rep = perturbation.check_scene(sc, eps=e, draws=args.draws, seed=args.seed, base=base)

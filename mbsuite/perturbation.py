@@ -108,11 +108,6 @@ def fields(obj: Any) -> None:
             object.__setattr__(obj, f.name, value(v, lim, f"{type(obj).__name__}.{f.name}"))
 
 
-def mapping(d: Mapping[str, Any]) -> dict[str, Any]:
-    """A copy of `d` with its float values perturbed (a scene's `[input]` section)."""
-    return {k: (value(v, key=f"input.{k}") if isinstance(v, float) else v) for k, v in d.items()}
-
-
 def state(x: Sequence[float] | np.ndarray, key: str = "state") -> np.ndarray:
     """An initial state perturbed entry by entry, relative (an entry at exactly zero - a rotor at rest - stays there:
     a relative perturbation of zero is zero)."""
@@ -123,6 +118,17 @@ def state(x: Sequence[float] | np.ndarray, key: str = "state") -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------------ the check
+def shortened(scene: Any, duration: float | None) -> Any:
+    """`scene` with a run longer than `duration` (s) cut to it (its settling time to at most half of it); None or a
+    shorter run: the scene itself."""
+    if duration is None or not getattr(scene.solver, "duration", None) or scene.solver.duration <= duration:
+        return scene
+    upd: dict[str, float] = {"duration": duration}
+    if getattr(scene.solver, "t_settle", None):
+        upd["t_settle"] = min(scene.solver.t_settle, 0.5 * duration)
+    return scene.replace(solver=upd)
+
+
 @dataclass
 class OutputSensitivity:
     """One headline output across the copies: its value, the largest change, kappa, and whether it jumped."""

@@ -22,13 +22,7 @@ FAST_CASES = ["drives_clutch_lock_unlock", "drives_engagement_mismatch", "pantog
 
 
 def _shortened(name: str, duration: float | None):
-    sc = load_scene(name)
-    if duration is None:
-        return sc
-    upd = {"duration": duration}
-    if getattr(sc.solver, "t_settle", None):
-        upd["t_settle"] = min(sc.solver.t_settle, 0.5 * duration)
-    return sc.replace(solver=upd)
+    return perturbation.shortened(load_scene(name), duration)
 
 
 @pytest.mark.parametrize("name,duration", FAST_SCENES, ids=[n for n, _ in FAST_SCENES])

@@ -200,26 +200,25 @@ def headline(res: Any) -> dict[str, tuple[float, float]]:
     top-level group (an energy residual by the energies of its balance), and per signal its final, min and max,
     scaled by the largest magnitude among the signals of its unit."""
     out: dict[str, tuple[float, float]] = {}
-    groups: dict[str, float] = {}
 
-    def walk(prefix: str, group: str, v: Any) -> None:
+    def walk(prefix: str, v: Any) -> None:
         if isinstance(v, bool) or any(fnmatch.fnmatchcase(prefix, p) for p in WORK_COUNTERS):
             return
         if isinstance(v, int | float | np.integer | np.floating):
-            x = float(v)
-            if math.isfinite(x):
-                out[prefix] = (x, abs(x))
-                groups[group] = max(groups.get(group, 0.0), abs(x))
+            if math.isfinite(float(v)):
+                out[prefix] = (float(v), abs(float(v)))
         elif isinstance(v, Mapping):
             for k, w in v.items():
-                walk(f"{prefix}.{k}", group or f"{prefix}.{k}", w)
+                walk(f"{prefix}.{k}", w)
         elif isinstance(v, list | tuple):
             out[f"{prefix}.count"] = (float(len(v)), float(len(v)))
 
-    walk("stats", "", res.stats)
-    for k, (x, _) in list(out.items()):
+    walk("stats", res.stats)
+    groups: dict[str, float] = {}  # "stats.<key>" -> the largest magnitude under it
+    for k, (x, _) in out.items():
         g = ".".join(k.split(".")[:2])
-        out[k] = (x, max(abs(x), groups.get(g, 0.0)))
+        groups[g] = max(groups.get(g, 0.0), abs(x))
+    out = {k: (x, groups[".".join(k.split(".")[:2])]) for k, (x, _) in out.items()}
     out["events.count"] = (float(len(res.events)), float(len(res.events)))
     sig = {k: np.asarray(v, float) for k, v in res.signals.items()}
     sig = {k: a for k, a in sig.items() if a.size and np.all(np.isfinite(a))}

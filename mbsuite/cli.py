@@ -189,18 +189,12 @@ def _cmd_perturb(args: argparse.Namespace) -> None:
         cases = [c for c in hardcases.cases(include_slow=not args.no_slow)
                  if (models is None or c.model in models) and not c.expected_failure]
     reports = []
-    for sc in scenes:
-        sc = perturbation.shortened(sc, args.duration)
-        base = None
+    targets = [(perturbation.check_scene, perturbation.shortened(sc, args.duration)) for sc in scenes]
+    for check, target in targets + [(perturbation.check_case, c) for c in cases]:
+        base = None  # the unperturbed run, made once for every eps
         for e in epsilons:
-            rep = perturbation.check_scene(sc, eps=e, draws=args.draws, seed=args.seed, base=base)
-            base = rep.base
-            reports.append(rep)
-            if args.verbose:
-                print(" ".join(map(str, rep.row())), file=sys.stderr, flush=True)
-    for c in cases:
-        for e in epsilons:
-            reports.append(perturbation.check_case(c, eps=e, draws=args.draws, seed=args.seed))
+            reports.append(check(target, eps=e, draws=args.draws, seed=args.seed, base=base))
+            base = reports[-1].base
             if args.verbose:
                 print(" ".join(map(str, reports[-1].row())), file=sys.stderr, flush=True)
     _emit(perturbation.report(reports), args, None)

@@ -153,7 +153,7 @@ class PerturbationReport:
     invariants: dict[str, tuple[float, float, float]] = field(default_factory=dict)  # name -> (base, worst, bound)
     outputs: list[OutputSensitivity] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
-    base: Any = field(default=None, repr=False, compare=False)  # the unperturbed SimResult (scenes)
+    base: Any = field(default=None, repr=False, compare=False)  # the unperturbed run: SimResult (scene) or Outcome (case)
 
     @property
     def ok(self) -> bool:
@@ -286,18 +286,19 @@ def check_scene(scene: Any, *, eps: float = EPSILONS[0], draws: int = 3, seed: i
 KAPPA_CASE = 1e3
 
 
-def check_case(case: Any, *, eps: float = EPSILONS[0], draws: int = 2, seed: int = 0) -> PerturbationReport:
+def check_case(case: Any, *, eps: float = EPSILONS[0], draws: int = 2, seed: int = 0,
+               base: Any = None) -> PerturbationReport:
     """Run hard case `case` unperturbed and `draws` times inside `perturbed`. In every copy every assertion must hold:
     errors, conditions and `raises` exactly; a bound `value <= b` as `value <= b + KAPPA_CASE eps` (the case's closed
     forms use the unperturbed constants). The asserted values are reported as invariants: name -> (unperturbed, worst
-    copy, bound)."""
+    copy, bound). `base`: the unperturbed `Outcome` if already computed (kept in the report's `base`)."""
     from .hardcases import run_case
 
     rep = PerturbationReport(case.name, eps, draws)
     allowance = KAPPA_CASE * eps
     for i in range(-1, draws):
         if i < 0:
-            out = run_case(case)
+            out = rep.base = base if base is not None else run_case(case)
         else:
             with perturbed(eps, seed + i):
                 out = run_case(case)

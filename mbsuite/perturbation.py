@@ -153,7 +153,7 @@ class PerturbationReport:
     invariants: dict[str, tuple[float, float, float]] = field(default_factory=dict)  # name -> (base, worst, bound)
     outputs: list[OutputSensitivity] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
-    base: Any = field(default=None, repr=False, compare=False)  # the unperturbed run: SimResult (scene) or Outcome (case)
+    base: Any = field(default=None, repr=False, compare=False)  # unperturbed run: SimResult or Outcome
 
     @property
     def ok(self) -> bool:

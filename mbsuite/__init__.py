@@ -26,15 +26,16 @@ from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
 
 
 def run(scene: Scene | str, engine: str | None = None):
-    """Run a scene's time simulation with its engine (or `engine`), returning a `SimResult`."""
+    """Run a scene's time simulation on its path (`solver.engine`, or `engine`: a key or label of the model's path
+    table, `mbsuite list`), returning a `SimResult` whose health figures are judged here, once."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     spec = scene.spec
-    if spec.run is None:
+    if not spec.paths:
         raise SceneError(f"model '{spec.name}' has no time simulation")
     if engine is not None:
         scene = scene.replace(solver={"engine": engine})
-    res = spec.run(scene)
+    res = spec.paths[scene.solver.engine].run(scene)
     res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate,
                               what=f"{spec.name} scene {scene.name or scene.source or ''}".strip()))
     return res

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import SceneError
+from .solver import SolverSettings
 
 
 @dataclass(frozen=True)
@@ -38,10 +39,25 @@ class Effect:
 
 
 @dataclass(frozen=True)
+class RunPath:
+    """One way to run a model's time simulation: a row of the model's path table (like scipy's `METHODS`).
+
+    `run(scene) -> SimResult` takes a validated scene whose `solver.engine` is this path's key; it neither tests the
+    engine again nor judges health (`mbsuite.run` picks the path and judges the result, once). `label` says what the
+    path is (`equations`, `kinematic`, `pinocchio`, `fe`, `mujoco`, ...; a scene may write it in `solver.engine`),
+    `what` says it in one line for `mbsuite list`."""
+
+    run: Callable[..., Any]
+    label: str
+    what: str
+
+
+@dataclass(frozen=True)
 class ModelSpec:
     """What a model offers. Hooks take a validated `Scene` and return plain results (dicts / result objects).
 
-    - `run(scene, engine) -> SimResult`
+    - `paths`: the path table, engine key (what scenes write in `solver.engine`) -> `RunPath`; `engines` lists its keys
+    - `solver`: the model's default solver settings (a scene's `[solver]` overrides them key by key)
     - `equilibrium(scene) -> dict`, `modes(scene) -> dict`, `freqresp(scene, freqs, progress) -> dict`
     Any hook may be None: the CLI then says the model does not support that analysis.
 
@@ -67,10 +83,10 @@ class ModelSpec:
     effects: Mapping[str, Effect]
     inputs: Mapping[str, Mapping[str, Any]]  # input type -> {key: mbsuite.limits.Limit (range, unit, doc, default)}
     outputs: Mapping[str, str]  # signal -> SI unit
-    engines: tuple[str, ...]
     scenes_dir: Path
     default_scene: str
-    run: Callable[..., Any] | None = None
+    paths: Mapping[str, RunPath] = field(default_factory=dict)
+    solver: SolverSettings = field(default_factory=SolverSettings)
     equilibrium: Callable[..., Any] | None = None
     modes: Callable[..., Any] | None = None
     freqresp: Callable[..., Any] | None = None
@@ -80,6 +96,26 @@ class ModelSpec:
     under_wire: Callable[..., Any] | None = None
     mujoco_model: Callable[..., Any] | None = None
     file_checks: Mapping[str, Callable[..., None]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        labels = [p.label for p in self.paths.values()]
+        clash = [p.label for k, p in self.paths.items() if p.label in self.paths and p.label != k]
+        if len(set(labels)) != len(labels) or clash:
+            raise ValueError(f"model '{self.name}': path labels must be unique and name no other path: {labels}")
+        if self.paths and self.solver.engine not in self.paths:
+            raise ValueError(f"model '{self.name}': default engine {self.solver.engine!r} is not one of its paths "
+                             f"{list(self.paths)}")
+
+    @property
+    def engines(self) -> tuple[str, ...]:
+        """The keys of the path table (what a scene may write in `solver.engine`)."""
+        return tuple(self.paths)
+
+    def path_key(self, engine: str) -> str:
+        """The path table's key for `engine` (a key or a path's label), or `engine` itself if it names no path."""
+        if engine in self.paths:
+            return engine
+        return next((k for k, p in self.paths.items() if p.label == engine), engine)
 
     def suite(self) -> Any:
         """The model's suite module (`cases`), or None if it declares none."""

@@ -40,84 +40,12 @@ from . import perturbation
 from .errors import SceneError
 from .limits import Limit
 from .registry import ModelSpec, get_model, models
+from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver")
-INTEGRATORS = ("euler", "implicit", "implicitfast", "rk4", "discrete")
-SCIPY_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 MAX_SCENE_BYTES = 1_000_000
-DEFAULT_MAX_STEPS = 5e7  # size guard; a scene or --max-steps may raise it
 
 
-@dataclass(frozen=True)
-class SolverSettings:
-    """Solver settings. MuJoCo uses `integrator` and `timestep`; the reference path uses `method`, `rtol`, `atol`,
-    `max_step`. `duration` is the simulated time (s); `t_settle` the part of it treated as start-up transient.
-    `max_steps` guards against a legal but enormous job (duration / timestep steps, also the sample count): raise it
-    deliberately for a long run. `allow_inaccurate` keeps a result whose health figures exceed their bounds, with a
-    loud warning in the result (default: such a run is an error)."""
-
-    engine: str = "mujoco"
-    integrator: str = "implicitfast"
-    timestep: float = 5e-4
-    method: str = "LSODA"
-    rtol: float = 1e-8
-    atol: float = 1e-10
-    max_step: float = 0.0  # 0 = unlimited
-    duration: float = 10.0
-    t_settle: float = 0.0
-    sample_dt: float = 0.0  # output sampling interval; 0 = every step (MuJoCo) / solver's dense output at timestep
-    allow_inaccurate: bool = False
-    max_steps: float = DEFAULT_MAX_STEPS
-
-    def check(self, engines: tuple[str, ...]) -> None:
-        """Check every setting (type, finiteness, range, the size guard); a SceneError names the first bad one."""
-        for name in ("engine", "integrator", "method"):
-            v = getattr(self, name)
-            if not isinstance(v, str):
-                raise SceneError(f"solver.{name} = {v!r} must be a string")
-        if self.engine not in engines:
-            raise SceneError(f"solver.engine = {self.engine!r} is not available; valid engines: {list(engines)}")
-        if self.integrator not in INTEGRATORS:
-            raise SceneError(f"solver.integrator = {self.integrator!r}; valid integrators: {list(INTEGRATORS)}")
-        if self.method not in SCIPY_METHODS:
-            raise SceneError(f"solver.method = {self.method!r}; valid methods: {list(SCIPY_METHODS)}")
-        if not isinstance(self.allow_inaccurate, bool):
-            raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r} must be true or false")
-        for name, lim in SOLVER_LIMITS.items():
-            lim.check(f"solver.{name}", getattr(self, name), SceneError)
-        if self.t_settle >= self.duration:
-            raise SceneError(
-                f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
-        if self.timestep >= self.duration:
-            raise SceneError(f"solver.timestep ({self.timestep} s) must be shorter than solver.duration "
-                             f"({self.duration} s)")
-        if self.engine == "reference" and self.max_step > 0 and self.duration / self.max_step > self.max_steps:
-            raise SceneError(
-                f"solver.duration / solver.max_step = {self.duration:g} s / {self.max_step:g} s = "
-                f"{self.duration / self.max_step:.3g} steps exceeds solver.max_steps = {self.max_steps:.3g}; enlarge "
-                "solver.max_step or raise solver.max_steps (CLI: --max-steps) if you mean it")
-        steps = self.duration / self.timestep
-        if steps > self.max_steps:
-            raise SceneError(
-                f"solver.duration / solver.timestep = {self.duration:g} s / {self.timestep:g} s = {steps:.3g} steps "
-                f"exceeds solver.max_steps = {self.max_steps:.3g}; shorten the run, enlarge the step, or raise "
-                "solver.max_steps (CLI: --max-steps) if you mean it")
-        if self.sample_dt > 0 and self.sample_dt > self.duration:
-            raise SceneError(f"solver.sample_dt ({self.sample_dt} s) must not exceed solver.duration "
-                             f"({self.duration} s)")
-
-
-# the valid range of every numeric solver setting (the error message and the docs read this table)
-SOLVER_LIMITS = {
-    "timestep": Limit(lo=0.0, lo_open=True, hi=1.0, unit="s", doc="MuJoCo step / output grid of the reference path"),
-    "rtol": Limit(lo=1e-14, hi=0.1, doc="relative tolerance of the reference path"),
-    "atol": Limit(lo=0.0, lo_open=True, hi=1.0, doc="absolute tolerance of the reference path"),
-    "max_step": Limit(lo=0.0, hi=1.0, unit="s", doc="largest step of the reference path (0: unlimited)"),
-    "duration": Limit(lo=0.0, lo_open=True, hi=1e5, unit="s", doc="simulated time"),
-    "t_settle": Limit(lo=0.0, hi=1e5, unit="s", doc="start-up transient left out of statistics"),
-    "sample_dt": Limit(lo=0.0, hi=1e5, unit="s", doc="output sampling interval (0: every step)"),
-    "max_steps": Limit(lo=1.0, hi=1e12, doc="size guard: most steps (and samples) a run may take"),
-}
 
 
 SOLVER_KEYS = tuple(f.name for f in dataclasses.fields(SolverSettings))
@@ -272,9 +200,10 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     bad = sorted(set(solver_in) - set(SOLVER_KEYS))
     if bad:
         raise SceneError(f"unknown solver key(s) {bad}{where}; valid keys: {list(SOLVER_KEYS)}")
-    defaults = spec.extra.get("solver_defaults", {})
+    if isinstance(solver_in.get("engine"), str):
+        solver_in["engine"] = spec.path_key(solver_in["engine"])  # a path's label ("equations") names its key
     try:
-        solver = SolverSettings(**{**defaults, **solver_in})
+        solver = dataclasses.replace(spec.solver, **solver_in)
     except TypeError as exc:
         raise SceneError(f"[solver]{where}: {exc}") from exc
     solver.check(spec.engines)

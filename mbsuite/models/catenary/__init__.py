@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...limits import Limit
-from ...registry import Effect, ModelSpec
+from ...registry import Effect, ModelSpec, RunPath
+from ...solver import SolverSettings
 from .pantographs import validate_section
 from .params import CatenaryParams
 from .quality import validate_section as validate_quality
@@ -48,11 +49,13 @@ SPEC = ModelSpec(
                                            "against the parameters when the passage starts)")}},
     outputs={"contact_force": "N", "contact_force_filtered": "N", "position": "m", "head_height": "m",
              "wire_height": "m", "slack_droppers": "-", "uplift": "m"},
-    engines=("reference", "mujoco"),
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="en50318",
-    run=_run,
+    paths={
+        "reference": RunPath(_run, "fe", "FE catenary (compiled core) + the pantograph's hand-derived equations"),
+        "mujoco": RunPath(_run, "fe+mujoco", "FE catenary (compiled core) + the pantograph on MuJoCo (eppinger only)"),
+    },
     sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train},
     cases="mbsuite.models.catenary.cases",
-    extra={"solver_defaults": {"engine": "reference", "timestep": 1e-4, "duration": 6.1}},
+    solver=SolverSettings(engine="reference", timestep=1e-4, duration=6.1),
 )

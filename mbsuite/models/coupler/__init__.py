@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...registry import Effect, ModelSpec
+from ...registry import Effect, ModelSpec, RunPath
+from ...solver import SolverSettings
 from .mujoco import INPUTS, OUTPUTS, run, view_model
 from .params import CouplerParams
 
@@ -32,13 +33,16 @@ SPEC = ModelSpec(
     },
     inputs={"constant_speed": INPUTS},
     outputs=OUTPUTS,
-    engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).resolve().parent / "scenes",
     default_scene="double_lateral",
-    run=run,
+    paths={
+        "mujoco": RunPath(run, "mujoco", "MuJoCo: the double coupler's dynamics (S joints as balls, closures as "
+                                         "equalities)"),
+        "reference": RunPath(run, "kinematic", "the hand-derived kinematic solution (quasi-static, Maniowski & "
+                                               "Czauderna)"),
+    },
     cases="mbsuite.models.coupler.cases",
-    extra={"solver_defaults": {"integrator": "implicitfast", "timestep": 5e-4, "duration": 2.0, "t_settle": 0.5,
-                               "sample_dt": 2e-3}},
+    solver=SolverSettings(integrator="implicitfast", timestep=5e-4, duration=2.0, t_settle=0.5, sample_dt=2e-3),
     mujoco_model=view_model,
     file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
 )

@@ -11,7 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...limits import Limit
-from ...registry import Effect, ModelSpec
+from ...registry import Effect, ModelSpec, RunPath
+from ...solver import SolverSettings
 from .model import SIGNALS, run
 from .params import PARAM_SETS, DriveParams
 
@@ -48,11 +49,13 @@ SPEC = ModelSpec(
         "none": {},
     },
     outputs=SIGNALS,
-    engines=("reference", "mujoco"),
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="step_up_pwm",
-    run=run,
+    paths={
+        "reference": RunPath(run, "equations", "hand-derived equations (Oldaker Ch. 3), event-exact stick/slip "
+                                               "(scipy DOP853 between events)"),
+        "mujoco": RunPath(run, "mujoco", "MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
+    },
     cases="mbsuite.models.drives.cases",
-    extra={"solver_defaults": {"engine": "reference", "integrator": "rk4", "timestep": 1e-4, "rtol": 1e-9,
-                               "atol": 1e-11, "duration": 2.0}},
+    solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),
 )

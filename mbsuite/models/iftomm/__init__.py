@@ -6,7 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...limits import Limit
-from ...registry import Effect, ModelSpec
+from ...registry import Effect, ModelSpec, RunPath
+from ...solver import SolverSettings
 from .analysis import OUTPUTS, run, view_model
 from .params import IftommParams
 
@@ -26,13 +27,16 @@ SPEC = ModelSpec(
     inputs={"initial": {"rate": Limit(lo=-100.0, hi=100.0, unit="rad/s", default=0.0,
                                       doc="initial rate of the first (input) joint on the free motion (0: at rest)")}},
     outputs=OUTPUTS,
-    engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="fourbar",
-    run=run,
+    paths={
+        "mujoco": RunPath(run, "mujoco", "MuJoCo: the mechanism with its closures as equality constraints"),
+        "reference": RunPath(run, "pinocchio", "Pinocchio: constrained dynamics (proximal solver) integrated by "
+                                               "scipy"),
+    },
     cases="mbsuite.models.iftomm.cases",
-    extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3, "method": "DOP853",
-                               "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "sample_dt": 1e-2}},
+    solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="DOP853", rtol=1e-8, atol=1e-10,
+                          duration=10.0, sample_dt=1e-2),
     mujoco_model=view_model,
     file_checks={"iftomm_fourbar": _check_file, "iftomm_bricard": _check_file},
 )

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...registry import Effect, ModelSpec
+from ...registry import Effect, ModelSpec, RunPath
+from ...solver import SolverSettings
 from . import analysis
 from .params import PantographParams
 
@@ -38,10 +39,14 @@ SPEC = ModelSpec(
     },
     inputs=analysis.INPUTS,
     outputs=analysis.UNITS,
-    engines=("mujoco", "reference"),
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="lab",
-    run=analysis.run,
+    paths={
+        "mujoco": RunPath(analysis.run, "mujoco", "MuJoCo: the MJCF of the scene's effects, cylinder and elbow as "
+                                                  "engine plugins, the native core's loop"),
+        "reference": RunPath(analysis.run, "equations", "hand-derived equations (numpy/scipy, Eppinger Ch. 3), "
+                                                        "event-exact stick/slip"),
+    },
     equilibrium=analysis.equilibrium_report,
     modes=analysis.modes_report,
     freqresp=analysis.freqresp,
@@ -50,6 +55,6 @@ SPEC = ModelSpec(
     cases="mbsuite.models.pantograph.cases",
     # defaults chosen from scripts/pantograph_workprecision.py: RK4 at 1e-3 s reaches 3e-5 relative physics error
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.
-    extra={"solver_defaults": {"engine": "mujoco", "integrator": "rk4", "timestep": 1e-3,
-                               "method": "LSODA", "rtol": 1e-8, "atol": 1e-10, "duration": 10.0, "t_settle": 5.0}},
+    solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="LSODA", rtol=1e-8, atol=1e-10,
+                          duration=10.0, t_settle=5.0),
 )

@@ -19,6 +19,7 @@ from .errors import (  # noqa: E402
     SolverError,
 )
 from .health import AccuracyError, judge  # noqa: E402
+from .modelfiles import load_model_file  # noqa: E402
 from .paths import model_file, model_files  # noqa: E402
 from .registry import get_model  # noqa: E402
 from .registry import models as model_specs
@@ -51,6 +52,7 @@ __all__ = [
     "SceneError",
     "SolverError",
     "get_model",
+    "load_model_file",
     "load_scene",
     "model_file",
     "model_files",

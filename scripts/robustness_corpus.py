@@ -447,7 +447,6 @@ def input_attempts() -> Iterator[Attempt]:
         "table-nan": ("Table((0.0, float('nan')), (0.0, 1.0))", "table"),
         "constant-string": ("Constant('x')", "value"),
         "constant-none": ("Constant(None)", "value"),
-        "cosine-lift-nan": ("CosineLift(0.0, 1.0, float('nan'))", "frequency"),
 
     }
     for name, (expr, cul) in api.items():

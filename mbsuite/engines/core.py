@@ -35,8 +35,7 @@ import numpy as np
 
 from ..errors import SolverError
 from . import native
-from .mujoco_engine import _active as _scoped_callbacks
-from .mujoco_engine import warnings_raised
+from .mujoco_engine import active_callbacks, warnings_raised
 
 #: recordable MjData quantities (order mirrors the MBS_F_* enum of native/mbsuite.h)
 FIELDS = ("time", "qpos", "qvel", "act", "ctrl", "actuator_force", "actuator_length", "actuator_velocity",
@@ -110,6 +109,7 @@ class _Job(ctypes.Structure):
         ("status", ctypes.c_int), ("fail_step", ctypes.c_long), ("fail_time", ctypes.c_double),
         ("fail_col", ctypes.c_int), ("fail_value", ctypes.c_double), ("fail_plugin", ctypes.c_int),
         ("fail_code", ctypes.c_int), ("fail_what", ctypes.c_char_p), ("steps_done", ctypes.c_long),
+        ("fail_text", ctypes.c_char_p),
     ]
 
 
@@ -223,7 +223,7 @@ class Stepper:
         nstep = int(nstep)
         if nstep < 0:
             raise ValueError(f"nstep must be >= 0, got {nstep}")
-        if _scoped_callbacks and not self.allow_callbacks:
+        if active_callbacks() and not self.allow_callbacks:
             _refuse_python_callbacks(self.what)
         job = self._job
         if ctrl is not None:
@@ -315,7 +315,7 @@ class Stepper:
             hint += " or use an implicit integrator"
         at = f"at t = {job.fail_time:.6g} s"
         if job.status == 3:
-            return plugin_error(m, job.fail_plugin, job.fail_code, job.fail_value, job.fail_time,
+            return plugin_error(m, job.fail_plugin, job.fail_text.decode(), job.fail_value, job.fail_time,
                                 job.fail_what.decode() if job.fail_what else None, self.what, setting, hint)
         if job.status == 4:
             c = self.channels_flat_bound(job.fail_col)
@@ -342,13 +342,11 @@ class Stepper:
         return float(self._lo[col]), float(self._hi[col])
 
 
-def plugin_error(m: mujoco.MjModel, instance: int, code: int, value: float, time: float, what: str | None,
+def plugin_error(m: mujoco.MjModel, instance: int, text: str, value: float, time: float, what: str | None,
                  run: str, setting: str, hint: str) -> SolverError:
-    """The error of an mbsuite plugin fault: the effect (plugin instance) by name, the fault, the offending attribute or
-    value, and when."""
-    lib = native.load()
+    """The error of an mbsuite plugin fault: the effect (plugin instance) by name, the fault's text (the model's own
+    for a model-specific fault), the offending attribute or value, and when."""
     name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PLUGIN, instance) or f"instance {instance}"
-    text = lib.mbs_fault_text(code).decode()
     if time < 0:  # found when the data was created: the model's configuration, nothing to do with the run's numerics
         bad = f" '{what}'" if what else ""
         val = "" if value != value else f" (value {value:.6g})"
@@ -365,13 +363,14 @@ def check_plugin_faults(m: mujoco.MjModel, d: mujoco.MjData, run: str) -> None:
     if not m.nplugin:
         return
     lib = native.load()
-    code, time, value, what = ctypes.c_int(), ctypes.c_double(), ctypes.c_double(), ctypes.c_char_p()
+    code, time, value = ctypes.c_int(), ctypes.c_double(), ctypes.c_double()
+    what, text = ctypes.c_char_p(), ctypes.c_char_p()
     i = lib.mbs_plugin_fault(ctypes.c_void_p(m._address), ctypes.c_void_p(d._address), ctypes.byref(code),
-                             ctypes.byref(time), ctypes.byref(value), ctypes.byref(what))
+                             ctypes.byref(time), ctypes.byref(value), ctypes.byref(what), ctypes.byref(text))
     if i >= 0:
         setting = f"timestep {m.opt.timestep:g} s"
-        raise plugin_error(m, i, code.value, value.value, time.value, what.value.decode() if what.value else None,
-                           run, setting, DEFAULT_HINT)
+        raise plugin_error(m, i, text.value.decode(), value.value, time.value,
+                           what.value.decode() if what.value else None, run, setting, DEFAULT_HINT)
 
 
 def n_workers(workers: int = 0) -> int:

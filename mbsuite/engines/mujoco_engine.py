@@ -65,10 +65,14 @@ def check_compiled(model: mujoco.MjModel, name: str) -> None:
         raise ModelFileError(f"{name}: option timestep = {h!r} must be a positive finite number")
 
 
-def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False) -> mujoco.MjModel:
+FileCheck = Callable[[Path, str, object], None]
+
+
+def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False,
+               check: FileCheck | None = None) -> mujoco.MjModel:
     """Compile an MJCF file/string/MjSpec (mbsuite's engine plugins registered first); any parse or compile error is
-    re-raised as ModelFileError naming the source, on one line. A file of a model that declares checks for it
-    (`ModelSpec.file_checks`, e.g. loop closures against the stated link lengths) is checked too."""
+    re-raised as ModelFileError naming the source, on one line. `check(path, "mujoco", model)`, the checks a model
+    hands in for its own file (e.g. loop closures against the stated link lengths), runs on a loaded file."""
     native.load()
     name = "<string>" if from_string else ("<MjSpec>" if isinstance(source, mujoco.MjSpec) else str(source))
     try:
@@ -87,19 +91,9 @@ def load_model(source: str | Path | mujoco.MjSpec, *, from_string: bool = False)
     except Exception as exc:  # mujoco raises ValueError with the parser message
         raise ModelFileError(f"MuJoCo cannot load {name}: {one_line(exc)}") from exc
     check_compiled(m, name)
-    if not from_string and not isinstance(source, mujoco.MjSpec):
-        run_file_checks(Path(source), "mujoco", m)
+    if check is not None and not from_string and not isinstance(source, mujoco.MjSpec):
+        check(Path(source), "mujoco", m)
     return m
-
-
-def run_file_checks(path: Path, engine: str, model: object) -> None:
-    """Run the checks a model declares for a file of that name (`ModelSpec.file_checks[stem]`), if any."""
-    from ..registry import models
-
-    for spec in models().values():
-        check = spec.file_checks.get(path.stem)
-        if check is not None:
-            check(path, engine, model)
 
 
 def set_integrator(model: mujoco.MjModel, integrator: str, timestep: float) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import ModelFileError
+from .mujoco_engine import FileCheck, load_model, one_line, read_model_text
 
 
 @contextlib.contextmanager
@@ -38,16 +39,13 @@ def _native_stderr() -> Iterator[list[str]]:
             lines += [x for x in tmp.read().decode("utf-8", "replace").splitlines() if x.strip()]
 
 
-def _load(builder, kind: str, path: str | Path) -> pin.Model:
+def _load(builder, kind: str, path: str | Path, check: FileCheck | None) -> pin.Model:
     p = Path(path)
     if not p.is_file():
         raise ModelFileError(f"{kind} file not found: {p}")
-    from .mujoco_engine import one_line, read_model_text, run_file_checks
 
     read_model_text(p)
     if kind == "MJCF":  # MuJoCo's parser is strict (types, ranges); Pinocchio's ignores what it does not read
-        from .mujoco_engine import load_model
-
         load_model(p)
     try:
         with _native_stderr() as said:
@@ -57,20 +55,22 @@ def _load(builder, kind: str, path: str | Path) -> pin.Model:
     errors = [x for x in said if "error" in x.lower()]
     if errors:
         raise ModelFileError(f"Pinocchio reports errors reading {kind} {p}: {one_line('; '.join(errors))}")
-    run_file_checks(p, "urdf" if kind == "URDF" else "pinocchio", model)
+    if check is not None:
+        check(p, "urdf" if kind == "URDF" else "pinocchio", model)
     return model
 
 
-def load_urdf(path: str | Path) -> pin.Model:
+def load_urdf(path: str | Path, *, check: FileCheck | None = None) -> pin.Model:
     """Build a Pinocchio model from a URDF file; parse errors (also those urdfdom only prints) become
-    ModelFileError naming the file."""
-    return _load(pin.buildModelFromUrdf, "URDF", path)
+    ModelFileError naming the file. `check(path, "urdf", model)`: the checks a model hands in for its own file."""
+    return _load(pin.buildModelFromUrdf, "URDF", path, check)
 
 
-def load_mjcf(path: str | Path) -> pin.Model:
+def load_mjcf(path: str | Path, *, check: FileCheck | None = None) -> pin.Model:
     """Build a Pinocchio model from an MJCF file (only the first top-level body of <worldbody> is kept by Pinocchio);
-    the file is compiled by MuJoCo first, whose parser refuses what Pinocchio's would skip."""
-    return _load(pin.buildModelFromMJCF, "MJCF", path)
+    the file is compiled by MuJoCo first, whose parser refuses what Pinocchio's would skip.
+    `check(path, "pinocchio", model)`: the checks a model hands in for its own file."""
+    return _load(pin.buildModelFromMJCF, "MJCF", path, check)
 
 
 def frame_id(model: pin.Model, name: str) -> int:

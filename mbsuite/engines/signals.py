@@ -203,24 +203,3 @@ class Table(Signal):
     def params(self):
         """The parameters in the order the C evaluator reads them."""
         return (len(self.times), *self.times, *self.points)
-
-
-@dataclass(frozen=True)
-class CosineLift(Signal):
-    """offset + amplitude (1 - cos 2 pi f t): the pantograph's ram (Eppinger's YW)."""
-
-    offset: float
-    amplitude: float
-    frequency: float
-    kind = 6
-
-    def __post_init__(self) -> None:
-        _finite("cosine lift", offset=self.offset, amplitude=self.amplitude, frequency=self.frequency)
-
-    def values(self, t):
-        """The formula in the class docstring at the times `t` (vectorised)."""
-        return self.offset + self.amplitude * (1.0 - np.cos(2.0 * math.pi * self.frequency * t))
-
-    def params(self):
-        """The parameters in the order the C evaluator reads them."""
-        return (self.offset, self.amplitude, self.frequency)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from mbsuite.engines import native
-from mbsuite.engines.signals import Constant, CosineLift, Pulse, Ramp, Sine, Step, Table
+from mbsuite.engines.signals import Constant, Pulse, Ramp, Sine, Step, Table
 from mbsuite.errors import ParameterError
 
 SIGNALS = [
@@ -19,7 +19,6 @@ SIGNALS = [
     Pulse(amplitude=4.0, width=0.3, period=0.25, offset=1.0, t0=0.1, n=3),
     Pulse(amplitude=4.0, width=0.5, period=0.2),
     Table((0.0, 0.5, 0.5, 1.2), (1.0, 2.0, -1.0, 3.0)),
-    CosineLift(1.58, 1.85e-3, 4.25),
 ]
 
 

@@ -53,7 +53,7 @@ CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-paramet
           "-ffp-contract=off")
 #: environment variable whose shell words are appended to CFLAGS (checks only; part of the cache key)
 EXTRA_CFLAGS_ENV = "MBSUITE_NATIVE_EXTRA_CFLAGS"
-ABI_VERSION = 1
+ABI_VERSION = 2
 
 _lock = threading.Lock()
 _lib: ctypes.CDLL | None = None
@@ -184,11 +184,9 @@ def load() -> ctypes.CDLL:
             raise NativeBuildError("more engine plugins registered than the native core tracks (MBS_MAX_PLUGINS)")
         lib.mbs_job_size.restype = ctypes.c_int
         lib.mbs_plugin_fault.restype = ctypes.c_int
-        lib.mbs_plugin_fault.argtypes = [ctypes.c_void_p] * 6
+        lib.mbs_plugin_fault.argtypes = [ctypes.c_void_p] * 7
         lib.mbs_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
         lib.mbs_run.restype = ctypes.c_int
-        lib.mbs_fault_text.argtypes = [ctypes.c_int]
-        lib.mbs_fault_text.restype = ctypes.c_char_p
         lib.mbs_signal.argtypes = [ctypes.c_void_p, ctypes.c_double]
         lib.mbs_signal.restype = ctypes.c_double
         lib.mbs_fp_contract_probe.argtypes = [ctypes.c_double] * 3

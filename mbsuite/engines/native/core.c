@@ -49,6 +49,24 @@ void mbs_fault(mjData* d, int instance, int code, double value) {
   }
 }
 
+void mbs_model_fault(mjData* d, int instance, const char* text, double value) {
+  mbs_plugin_header* h = (mbs_plugin_header*)d->plugin_data[instance];
+  if (h && !h->fault) {
+    h->fault = MBS_FAULT_MODEL;
+    h->text = text;
+    h->fault_time = d->time;
+    h->fault_value = value;
+  }
+}
+
+void mbs_model_config_fault(mbs_plugin_header* h, const char* text, const char* what, double value) {
+  if (h && !h->fault) {
+    mbs_config_fault(h, what, value);
+    h->fault = MBS_FAULT_MODEL;
+    h->text = text;
+  }
+}
+
 void mbs_config_fault(mbs_plugin_header* h, const char* what, double value) {
   if (h && !h->fault) {
     h->fault = MBS_FAULT_CONFIG;
@@ -85,7 +103,8 @@ double mbs_config_number(const mjModel* m, int instance, const char* key, double
   return v;
 }
 
-int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what) {
+int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what,
+                     const char** text) {
   for (int i = 0; i < m->nplugin; i++) {
     if (!mbs_is_own_instance(m, i)) continue;
     const mbs_plugin_header* h = (const mbs_plugin_header*)d->plugin_data[i];
@@ -94,6 +113,7 @@ int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time,
       *time = h->at_load ? -1.0 : h->fault_time; /* < 0: found when the data was created */
       *value = h->fault_value;
       *what = h->what;
+      *text = (h->fault == MBS_FAULT_MODEL && h->text) ? h->text : mbs_fault_text(h->fault);
       return i;
     }
   }
@@ -104,10 +124,7 @@ const char* mbs_fault_text(int code) {
   switch (code) {
     case MBS_FAULT_CONFIG: return "a configuration attribute is missing, not a finite number or out of its range";
     case MBS_FAULT_NONFINITE: return "non-finite state (NaN or inf) reached the effect";
-    case MBS_FAULT_VOLUME: return "cylinder chamber volume V0 + Ap x_p became <= 0 (m^3)";
-    case MBS_FAULT_PRESSURE: return "absolute cylinder pressure became <= 0 (Pa)";
-    case MBS_FAULT_GEOMETRY: return "elbow chain has no tangent line to the pinion at this theta_1 (B^2 - 4AC)";
-    case MBS_FAULT_STATE_MACHINE: return "the stick/slip state machine does not settle (mode chattering)";
+    case MBS_FAULT_MODEL: return "a fault of the effect's model";
     default: return "unknown fault";
   }
 }
@@ -121,7 +138,6 @@ int mbs_signal_size(const double* spec) {
     case 3: return 5;
     case 4: return 7;
     case 5: return 2 + 2 * (int)spec[1];
-    case 6: return 4;
     default: return -1;
   }
 }
@@ -163,8 +179,6 @@ double mbs_signal(const double* s, double t) {
       double dt = tt[hi] - tt[lo];
       return dt > 0.0 ? yy[lo] + (yy[hi] - yy[lo]) * (t - tt[lo]) / dt : yy[hi];
     }
-    case 6:
-      return s[1] + s[2] * (1.0 - cos(2.0 * M_PI * s[3] * t));
     default:
       return NAN;
   }
@@ -274,14 +288,15 @@ static int plugin_faults(const mjModel* m, const mjData* d, mbs_job* J, long k, 
   if (!m->nplugin) return MBS_OK;
   int code;
   double time, value;
-  const char* what;
-  int i = mbs_plugin_fault(m, d, &code, &time, &value, &what);
+  const char *what, *text;
+  int i = mbs_plugin_fault(m, d, &code, &time, &value, &what, &text);
   if (i < 0) return MBS_OK;
   fail(J, MBS_FAIL_PLUGIN, k, time);
   J->fail_plugin = i;
   J->fail_code = code;
   J->fail_value = value;
   J->fail_what = what;
+  J->fail_text = text;
   return MBS_FAIL_PLUGIN;
 }
 
@@ -294,6 +309,7 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* J) {
   J->fail_plugin = -1;
   J->fail_code = 0;
   J->fail_what = NULL;
+  J->fail_text = NULL;
   if (J->every < 1 || J->check_every < 1 || J->nstep < 0 || (J->ctrl && (!J->ctrl_idx || J->ctrl_ncol < 1))) {
     fail(J, MBS_FAIL_ARGS, J->k0, d->time);
     return J->status;

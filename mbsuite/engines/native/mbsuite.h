@@ -15,41 +15,46 @@
  * harmless value, and the core stops the run after the current step with an error naming the instance, the fault
  * and the time. A plugin cannot raise: this is its only way out. */
 typedef struct {
-  int fault;          /* 0 = none; else a model-specific code, described by mbs_fault_text */
+  int fault;          /* 0 = none; else an MBS_FAULT_* code */
   int at_load;        /* 1: found when the data was created (a configuration fault): survives mj_resetData */
   double fault_time;  /* d->time of the first fault */
   double fault_value; /* the offending value */
   const char* what;   /* the offending configuration attribute or quantity (a static string), or NULL */
+  const char* text;   /* MBS_FAULT_MODEL: the model's own description of the fault (a static string) */
 } mbs_plugin_header;
 
 /* Register a plugin and remember its slot, so that the core can find mbsuite's instances in any model. */
 int mbs_register_plugin(const mjpPlugin* plugin);
 /* 1 if the plugin instance `instance` of m is one of mbsuite's. */
 int mbs_is_own_instance(const mjModel* m, int instance);
-/* Record a fault on an instance (the first one wins). */
+/* Record a fault of the core's kinds (MBS_FAULT_NONFINITE) on an instance (the first one wins). */
 void mbs_fault(mjData* d, int instance, int code, double value);
+/* Record a fault the model describes itself (`text`: a static string, e.g. "cylinder chamber volume became <= 0"):
+ * the engine layer knows no model, so every model-specific fault carries its own text. */
+void mbs_model_fault(mjData* d, int instance, const char* text, double value);
 /* Record a configuration fault found at init (names the attribute; survives mj_resetData). */
 void mbs_config_fault(mbs_plugin_header* h, const char* what, double value);
+/* A configuration fault the model describes itself: `text` says what is wrong, `what` names the attributes. */
+void mbs_model_config_fault(mbs_plugin_header* h, const char* text, const char* what, double value);
 /* Parse a numeric config attribute; `fallback` if absent (a NaN fallback makes it required). On a missing required,
  * malformed or non-finite value: records a configuration fault naming `key` on h and returns the fallback. */
 double mbs_config_number(const mjModel* m, int instance, const char* key, double fallback, mbs_plugin_header* h);
 /* Configuration check: if !ok, records a configuration fault naming `what` with `value`. Returns ok. */
 int mbs_config_require(mbs_plugin_header* h, int ok, const char* what, double value);
 /* Scan the mbsuite plugin instances of (m, d) for a fault: returns the instance id (or -1) and fills the rest; the
- * time is < 0 for a fault found when the data was created (a configuration fault). */
-int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what);
+ * time is < 0 for a fault found when the data was created (a configuration fault); `text` is the fault's description
+ * (the model's own for MBS_FAULT_MODEL, else mbs_fault_text(code)). */
+int mbs_plugin_fault(const mjModel* m, const mjData* d, int* code, double* time, double* value, const char** what,
+                     const char** text);
 /* 1 if more plugins were registered than the core can track (their faults would go unseen). */
 int mbs_plugin_overflow(void);
 
-/* Fault codes (all models); texts in core.c. */
+/* Fault codes of the core; texts in core.c. A model's own faults are MBS_FAULT_MODEL with the model's text. */
 enum {
   MBS_FAULT_NONE = 0,
   MBS_FAULT_CONFIG = 1,          /* a config attribute is missing or not a number */
   MBS_FAULT_NONFINITE = 2,       /* a non-finite input state */
-  MBS_FAULT_VOLUME = 3,          /* cylinder chamber volume <= 0 */
-  MBS_FAULT_PRESSURE = 4,        /* absolute pressure <= 0 */
-  MBS_FAULT_GEOMETRY = 5,        /* elbow chain has no tangent line */
-  MBS_FAULT_STATE_MACHINE = 6,   /* a stick/slip state machine does not settle */
+  MBS_FAULT_MODEL = 3,           /* described by the model (mbs_model_fault, mbs_model_config_fault) */
 };
 const char* mbs_fault_text(int code);
 
@@ -61,7 +66,6 @@ const char* mbs_fault_text(int code);
  *  3 ramp       [3, offset, height, t0, duration]                linear from offset to offset + height
  *  4 pulse      [4, offset, amplitude, width, period, t0, n]     n = 0: unlimited periods; width as a fraction 0..1
  *  5 table      [5, n, t_0..t_{n-1}, y_0..y_{n-1}]               piecewise linear, held outside
- *  6 cosine_lift[6, offset, amplitude, freq_hz]                  offset + A (1 - cos 2 pi f t) (the pantograph ram)
  */
 double mbs_signal(const double* spec, double t);
 /* length of a signal spec (number of doubles), or -1 for an unknown kind */
@@ -129,6 +133,7 @@ typedef struct {
   int fail_code;          /* plugin fault code, hook error, or the MuJoCo warning (mjtWarning) */
   const char* fail_what;  /* plugin fault: the offending attribute or quantity, or NULL */
   long steps_done;        /* steps integrated in this call */
+  const char* fail_text;  /* plugin fault: its description (the model's own text for MBS_FAULT_MODEL) */
 } mbs_job;
 
 int mbs_run(const mjModel* m, mjData* d, mbs_job* job);
@@ -137,7 +142,7 @@ int mbs_job_size(void);
 
 /* Version of the job layout; the Python side refuses a library with another. */
 int mbs_abi_version(void);
-#define MBS_ABI_VERSION 1
+#define MBS_ABI_VERSION 2
 
 /* a * b + c as the source writes it. Compiled with -ffp-contract=off it is rounded twice (the product, then the sum);
  * a build allowed to fuse it into one FMA rounds once. With a = 1 + 2^-30, b = 1 - 2^-30, c = -1 it returns 0 when

@@ -20,6 +20,7 @@
 #include "mbsuite.h"
 
 #define CHOKED_RATIO 0.528
+#define ELBOW_NO_TANGENT "elbow chain has no tangent line to the pinion at this theta_1 (B^2 - 4AC)"
 
 /* ------------------------------------------------------------------------------------------------ cylinder */
 static const char* cyl_attributes[] = {"model", "lb", "alpha", "kc", "bc", "Pg", "Pa", "Ap", "V0", "R_gas", "T", "gamma", "cd",
@@ -147,9 +148,9 @@ static void cyl_act_dot(const mjModel* m, mjData* d, int instance) {
   } else {
     double V = c->V0 + c->Ap * xp;
     if (V <= 0.0) {
-      mbs_fault(d, instance, MBS_FAULT_VOLUME, V);
+      mbs_model_fault(d, instance, "cylinder chamber volume V0 + Ap x_p became <= 0 (m^3)", V);
     } else if (P <= 0.0) {
-      mbs_fault(d, instance, MBS_FAULT_PRESSURE, P);
+      mbs_model_fault(d, instance, "absolute cylinder pressure became <= 0 (Pa)", P);
     } else {
       double dxp = c->lb * sin(c->alpha - t1) * d->actuator_velocity[i];
       rate = c->R * c->T / V * orifice_mass_flow(c, P) - P / V * c->Ap * dxp;
@@ -237,8 +238,7 @@ static int elbow_init(const mjModel* m, mjData* d, int instance) {
   mbs_config_require(h, joint_address(m, mj_getPluginConfig(m, instance, "joint2"), &e->q2, &e->v2), "joint2", NAN);
   double dphi, dl;
   if (!h->fault && !chain(e, 0.0, &e->phi1_0, &dphi, &e->lfb0, &dl)) {
-    mbs_config_fault(h, "le, xf, yf (the chain base lies inside the pinion circle)", 0.0);
-    h->fault = MBS_FAULT_GEOMETRY;
+    mbs_model_config_fault(h, ELBOW_NO_TANGENT, "le, xf, yf (the chain base lies inside the pinion circle)", 0.0);
   }
   return 0;
 }
@@ -257,7 +257,7 @@ static void elbow_compute(const mjModel* m, mjData* d, int instance, int capabil
   }
   double phi1, dphi1, lfb, dlfb;
   if (!chain(e, q1, &phi1, &dphi1, &lfb, &dlfb)) {
-    mbs_fault(d, instance, MBS_FAULT_GEOMETRY, q1);
+    mbs_model_fault(d, instance, ELBOW_NO_TANGENT, q1);
     return;
   }
   double te, dte;

@@ -8,7 +8,7 @@ import pytest
 from mbsuite.engines import mujoco_engine as me
 from mbsuite.engines import pinocchio_engine as pe
 from mbsuite.errors import ModelFileError
-from mbsuite.models.iftomm.mechanisms import check_model_file
+from mbsuite.models.iftomm.modelfiles import check_model_file
 from mbsuite.paths import mjcf_path
 
 

@@ -8,16 +8,10 @@ from pathlib import Path
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from .analysis import OUTPUTS, run, view_model
+from . import mujoco, pinocchio
+from .modelfiles import check_model_file
+from .outputs import OUTPUTS
 from .params import IftommParams
-
-
-def _check_file(path: Path, engine: str, model: object) -> None:
-    """The loaders' check of a shipped iftomm model file (closures at the stated lengths, inertias, names)."""
-    from .mechanisms import check_model_file
-
-    check_model_file(path, engine, model)
-
 
 SPEC = ModelSpec(
     name="iftomm",
@@ -30,13 +24,13 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="fourbar",
     paths={
-        "mujoco": RunPath(run, "mujoco", "MuJoCo: the mechanism with its closures as equality constraints"),
-        "reference": RunPath(run, "pinocchio", "Pinocchio: constrained dynamics (proximal solver) integrated by "
-                                               "scipy"),
+        "mujoco": RunPath(mujoco.run, "mujoco", "MuJoCo: the mechanism with its closures as equality constraints"),
+        "reference": RunPath(pinocchio.run, "pinocchio", "Pinocchio: M(q), h(q, v) of the same file, closures by a "
+                                                         "penalty formulation (four-bar on its branch), scipy ODE"),
     },
     cases="mbsuite.models.iftomm.cases",
     solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="DOP853", rtol=1e-8, atol=1e-10,
                           duration=10.0, sample_dt=1e-2),
-    mujoco_model=view_model,
-    file_checks={"iftomm_fourbar": _check_file, "iftomm_bricard": _check_file},
+    mujoco_model=mujoco.view_model,
+    file_checks={"iftomm_fourbar": check_model_file, "iftomm_bricard": check_model_file},
 )

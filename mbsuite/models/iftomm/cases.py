@@ -14,7 +14,7 @@ from ...engines import core
 from ...errors import MbsuiteError
 from ...hardcases import Checker, HardCase
 from ...scenes import Scene
-from .mechanisms import channels, closure_jacobian_rank, closure_of, initial_velocity, mujoco_model
+from .mujoco import channels, closure_jacobian_rank, closure_of, initial_velocity, mujoco_model
 
 
 def _iftomm_fourbar(ck: Checker) -> None:

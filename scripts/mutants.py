@@ -55,7 +55,7 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    s_moment = 2 * math.cos(math.pi / 4 - p.gamma) * l0 / l",
              "the closed-form condition number missing a factor R", "tests/coupler"),
     # --- IFToMM ------------------------------------------------------------------------------------------------------
-    Mutation("iftomm_mujoco_gravity_sign", "mbsuite/models/iftomm/mechanisms.py",
+    Mutation("iftomm_mujoco_gravity_sign", "mbsuite/models/iftomm/mujoco.py",
              "    m.opt.gravity[:] = [0.0, -gravity, 0.0]", "    m.opt.gravity[:] = [0.0, gravity, 0.0]",
              "gravity pointing up in the MuJoCo model of the benchmarks (a sign in the equations of motion)",
              "tests/iftomm"),
@@ -82,7 +82,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation("drives_damper_loss_dropped", "mbsuite/models/drives/friction.py",
              "            dE[k0 + i] = s.D * d_w * d_w", "            dE[k0 + i] = 0.0",
              "a spring-damper's dissipation dropped from the energy bookkeeping", "tests/drives"),
-    Mutation("iftomm_pinocchio_gravity_scaled", "mbsuite/models/iftomm/mechanisms.py",
+    Mutation("iftomm_pinocchio_gravity_scaled", "mbsuite/models/iftomm/pinocchio.py",
              "        self.model.gravity.linear = np.array([0.0, -gravity, 0.0])",
              "        self.model.gravity.linear = np.array([0.0, -0.999 * gravity, 0.0])",
              "gravity 0.1 % weak in the Pinocchio path of the benchmarks", "tests/iftomm"),

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import registry
-from .analysis.sweep import EXECUTORS, MAX_POINTS, check_grid, parse_values, sweep_options
+from .analysis.sweep import EXECUTORS, MAX_POINTS, SweepOptions, ambient_options, check_grid, parse_values
 from .errors import MbsuiteError
 from .limits import Limit
 from .results import Report, SimResult, format_table, to_jsonable
@@ -49,8 +49,9 @@ CLI_GROUPS: dict[str, str] = {}  # model -> its own command group (filled when t
 
 def _analyses(spec: registry.ModelSpec) -> list[str]:
     """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
-    out = [a for a in ANALYSES if getattr(spec, "mujoco_model" if a == "view" else a) is not None]
-    if spec.run is not None:
+    hooks = {"run": spec.paths or None, "view": spec.mujoco_model}
+    out = [a for a in ANALYSES if (hooks[a] if a in hooks else getattr(spec, a)) is not None]
+    if spec.paths:
         out += ["sweep", "perturb"]
     if spec.cases:
         out += ["workprecision", "hardcases"]
@@ -95,9 +96,14 @@ def _sweep_args(p: argparse.ArgumentParser) -> None:
                    help=f"size guard: most points of one sweep (default {MAX_POINTS})")
 
 
+def _sweep_options(args: argparse.Namespace) -> SweepOptions:
+    max_points = getattr(args, "max_points", None)
+    return SweepOptions(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
+                        store=getattr(args, "store", None), max_points=MAX_POINTS if max_points is None else max_points)
+
+
 def _sweeping(args: argparse.Namespace):
-    return sweep_options(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
-                         store=getattr(args, "store", None), max_points=getattr(args, "max_points", None))
+    return ambient_options(_sweep_options(args))
 
 
 MAX_REPEATS = 100
@@ -233,9 +239,8 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
         points.append((scene.to_dict(), sections))
     # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
     auto = "threads" if engines == {"mujoco"} else "local"
-    with _sweeping(args):
-        results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
-                            executor=None if args.executor else auto)
+    results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
+                        executor=None if args.executor else auto, options=_sweep_options(args))
     signals = [x for x in (args.signals.split(",") if args.signals else []) if x] or \
         sorted(results[0]["signals"]) if results else []
     head = [f"{s}.{n}" for s, n, _ in axes]
@@ -377,14 +382,12 @@ def _hook_command(hook: str):
         from . import run as run_scene
 
         scene = _load(args)
-        fn = getattr(scene.spec, hook)
+        fn = run_scene if hook == "run" else getattr(scene.spec, hook)  # run: judges the run's health figures
         if fn is None:
             raise MbsuiteError(f"model '{scene.model}' does not support '{hook}'")
         kwargs = _freq_args(args) if hook == "freqresp" else {}
         if hook == "modes" and getattr(args, "height", None) is not None:
             kwargs = {"height": args.height}
-        if hook == "run":
-            fn = run_scene  # judges the run's health figures
         with _sweeping(args):
             report = fn(scene, **kwargs)
         if isinstance(report, SimResult):

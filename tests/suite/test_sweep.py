@@ -16,6 +16,7 @@ import pytest
 
 from mbsuite import load_scene
 from mbsuite.analysis.sweep import (
+    SweepOptions,
     SweepStore,
     check_grid,
     get_state,
@@ -24,7 +25,6 @@ from mbsuite.analysis.sweep import (
     rollout_sweep,
     run_sweep,
     scene_point,
-    sweep_options,
 )
 from mbsuite.engines.mujoco_engine import callbacks
 from mbsuite.errors import SceneError
@@ -84,8 +84,8 @@ def test_dask_localcluster_identical_to_local(tmp_path):
         via_addr = run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address, store=store)
         assert run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address,
                          store=store) == via_addr
-        with sweep_options(executor="dask", scheduler=cluster.scheduler_address):
-            via_default = run_sweep(scene_point, jobs)  # how the CLI's --executor dask reaches analysis hooks
+        cli_options = SweepOptions(executor="dask", scheduler=cluster.scheduler_address)
+        via_default = run_sweep(scene_point, jobs, options=cli_options)  # how the CLI's --executor dask reaches hooks
     assert via_addr == local
     assert via_default == local
 
@@ -95,6 +95,23 @@ def test_dask_executor_needs_a_scheduler_and_unknown_executor_is_an_error():
         run_sweep(scene_point, _jobs(1), executor="dask")
     with pytest.raises(SceneError, match="valid"):
         run_sweep(scene_point, _jobs(1), executor="spark")
+
+
+def test_sweep_options_are_checked_once_and_keyword_only():
+    with pytest.raises(SceneError, match="scheduler"):
+        SweepOptions(executor="dask")
+    with pytest.raises(SceneError, match="valid"):
+        SweepOptions(executor="spark")
+    with pytest.raises(SceneError, match="max_points = 0 is invalid"):
+        SweepOptions(max_points=0)
+    with pytest.raises(TypeError):
+        SweepOptions("local")  # the fields are keyword-only
+    # a caller's preference wins, except that a preferred "threads" yields to a cluster the options ask for
+    dask = SweepOptions(executor="dask", scheduler="tcp://127.0.0.1:8786")
+    assert dask.executor_for(None) == "dask" and dask.executor_for("threads") == "dask"
+    assert dask.executor_for("local") == "local"
+    assert SweepOptions().executor_for(None) == "local"
+    assert SweepOptions(executor="threads").executor_for(None) == "threads"
 
 
 def _square(x: int) -> int:
@@ -235,9 +252,8 @@ def test_too_many_points_fail_before_anything_is_built():
         run_sweep(_cube, itertools.count(), workers=1)  # an endless generator is read only up to the limit
     assert len(parse_values("1:20000:1", max_points=20_000)) == 20_000  # the limit can be raised
     assert check_grid([100, 100], max_points=10_000) == 10_000
-    with sweep_options(max_points=5):
-        with pytest.raises(SceneError, match="6 points exceed the limit of 5"):
-            run_sweep(_cube, range(6), workers=1)
+    with pytest.raises(SceneError, match="6 points exceed the limit of 5"):
+        run_sweep(_cube, range(6), workers=1, options=SweepOptions(max_points=5))
     with pytest.raises(SceneError, match="max_points = 0 is invalid"):
         run_sweep(_cube, [1], max_points=0)
 

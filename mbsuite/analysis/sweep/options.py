@@ -1,0 +1,86 @@
+"""How and where a sweep runs: `SweepOptions` (executor, scheduler, store, point limit), checked once when made and
+handed to `run_sweep(options=...)` by whoever runs the sweep (the CLI builds one from `--executor/--scheduler/--store/
+--max-points`)."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...errors import SceneError
+
+EXECUTORS = ("local", "threads", "dask")
+MAX_POINTS = 10_000
+"""Default upper limit on the number of points of one sweep (raise it with `max_points`)."""
+
+
+def check_executor(executor: str, scheduler: Any) -> None:
+    """A `SceneError` for an unknown executor, or for "dask" without a scheduler."""
+    if executor not in EXECUTORS:
+        raise SceneError(f"unknown sweep executor {executor!r}; valid: {list(EXECUTORS)}")
+    if executor == "dask" and scheduler is None:
+        raise SceneError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
+
+
+def check_max_points(max_points: Any) -> int:
+    """`max_points` as an int, or a `SceneError` unless it is an integer >= 1."""
+    if isinstance(max_points, bool) or not isinstance(max_points, int | np.integer) or max_points < 1:
+        raise SceneError(f"max_points = {max_points!r} is invalid; valid: an integer >= 1")
+    return int(max_points)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepOptions:
+    """Where the points of a sweep run and how large it may be; a `SceneError` on construction for a bad value.
+
+    `executor`: "local", "threads" or "dask", or None to leave it to the caller of `run_sweep` (else "local");
+    `scheduler`: a Dask scheduler address or `Client` (needed by "dask"); `store`: the file to stream results to and
+    resume from; `max_points`: the size guard (default `MAX_POINTS`)."""
+
+    executor: str | None = None
+    scheduler: Any = None
+    store: str | Path | None = None
+    max_points: int = MAX_POINTS
+
+    def __post_init__(self) -> None:
+        if self.executor is not None:
+            check_executor(self.executor, self.scheduler)
+        object.__setattr__(self, "max_points", check_max_points(self.max_points))
+
+    def executor_for(self, preferred: str | None) -> str:
+        """The executor of a sweep whose caller prefers `preferred` (None: no preference): the caller's preference,
+        else these options' executor, else "local"; a preferred "threads" yields to "dask" (a cluster was asked for
+        and wins over a local preference)."""
+        executor = preferred or self.executor or "local"
+        return "dask" if executor == "threads" and self.executor == "dask" else executor
+
+
+_ambient = SweepOptions()
+
+
+@contextlib.contextmanager
+def ambient_options(options: SweepOptions) -> Iterator[None]:
+    """`options` for the `run_sweep` calls in the block that are given none: the way to reach an analysis hook whose
+    signature (the model's) has no `options` parameter. Pass `options=` where the signature allows it."""
+    global _ambient
+    saved = _ambient
+    _ambient = options
+    try:
+        yield
+    finally:
+        _ambient = saved
+
+
+def ambient() -> SweepOptions:
+    """The options `run_sweep` uses when it is given none (set by `ambient_options`; by default `SweepOptions()`)."""
+    return _ambient
+
+
+def current_executor() -> str:
+    """The executor a `run_sweep` call without `executor` and `options` would use."""
+    return ambient().executor_for(None)

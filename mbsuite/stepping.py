@@ -19,6 +19,8 @@ class StepObject(Protocol):
     t: float
     status: str
 
-    def step(self) -> None: ...
+    def step(self) -> None:
+        """Advance one step of the object's own kind (raises an `mbsuite.errors` exception on failure)."""
 
-    def run(self, t_end: float) -> object: ...
+    def run(self, t_end: float) -> object:
+        """Step until `t >= t_end` or `status != "running"`."""

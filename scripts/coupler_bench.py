@@ -29,6 +29,8 @@ import mbsuite
 from mbsuite.engines import core
 from mbsuite.models.coupler import SPEC
 from mbsuite.models.coupler import mujoco as cm
+from mbsuite.models.coupler.reference import kinematic_output, kinematic_pose
+from mbsuite.models.coupler.scenario import scene_inputs
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
 
@@ -44,7 +46,7 @@ def _timed(fn) -> float:
 def measure(scene, repeats: int) -> dict:
     """Median seconds per step of the bare rollout, the stepping and the whole run of one scene, and their ratios."""
     sv = scene.solver
-    p, inp = scene.build_params(), cm._inputs(scene)
+    p, inp = scene.build_params(), scene_inputs(scene)
     m, d, _ = cm.build(p, dict(scene.effects), inp, sv.timestep, sv.integrator)
     n = int(round(sv.duration / sv.timestep))
     every = max(1, int(round(sv.sample_dt / sv.timestep))) if sv.sample_dt > 0 else 1
@@ -72,17 +74,17 @@ def measure(scene, repeats: int) -> dict:
 def fpp_speedup(scene, repeats: int) -> dict:
     """Per-sample continuation vs the batched FPP on the samples of a MuJoCo run of the scene."""
     sv = scene.solver
-    p, inp = scene.build_params(), cm._inputs(scene)
+    p, inp = scene.build_params(), scene_inputs(scene)
     m, d, info = cm.build(p, dict(scene.effects), inp, sv.timestep, sv.integrator)
     n = int(round(sv.duration / sv.timestep))
     every = max(1, int(round(sv.sample_dt / sv.timestep)))
     tr = core.Stepper(m, d, cm.channels(m, p, inp), every=every).run(n, ctrl=cm.ramp_input(inp, n, sv.timestep),
                                                                      ctrl_idx=[0, 1])
     guess = cm.simulated_pose(p, tr)
-    seq = [_timed(lambda: cm.kinematic_output(p, inp, tr["phi_a"], info["u0"])) for _ in range(max(1, repeats // 3))]
-    bat = [_timed(lambda: cm.kinematic_pose(p, inp, tr["phi_a"], guess, tr.t)) for _ in range(repeats)]
-    diff = np.max(np.abs(cm.kinematic_output(p, inp, tr["phi_a"], info["u0"])
-                         - cm.kinematic_pose(p, inp, tr["phi_a"], guess, tr.t)[:, 0]))
+    seq = [_timed(lambda: kinematic_output(p, inp, tr["phi_a"], info["u0"])) for _ in range(max(1, repeats // 3))]
+    bat = [_timed(lambda: kinematic_pose(p, inp, tr["phi_a"], guess, tr.t)) for _ in range(repeats)]
+    diff = np.max(np.abs(kinematic_output(p, inp, tr["phi_a"], info["u0"])
+                         - kinematic_pose(p, inp, tr["phi_a"], guess, tr.t)[:, 0]))
     return {"samples": tr.t.size, "per_sample_s": float(np.median(seq)), "batched_s": float(np.median(bat)),
             "speedup": float(np.median(seq) / np.median(bat)), "max_diff_rad": float(diff)}
 

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 
 from mbsuite.models.coupler import analysis
-from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.jacobian import EQ15, paper_eq15_layout, single_jacobian
 from mbsuite.models.coupler.params import CouplerParams
 from mbsuite.results import format_table
 
@@ -19,8 +19,8 @@ from mbsuite.results import format_table
 def main() -> None:
     np.set_printoptions(precision=4, suppress=True)
     for g in (math.radians(17.0), 0.297):
-        J = ref.single_jacobian(CouplerParams(gamma=g, e_y=0.0))
-        diff = np.max(np.abs(ref.paper_eq15_layout(J) - ref.EQ15))
+        J = single_jacobian(CouplerParams(gamma=g, e_y=0.0))
+        diff = np.max(np.abs(paper_eq15_layout(J) - EQ15))
         print(f"gamma = {g:.5f}: max |J(paper layout) - Eq 15| = {diff:.2e}")
     rows, screws = [], []
     for ey in (0.0, 0.05, 0.1):

@@ -17,9 +17,10 @@ from mbsuite.cli import main
 from mbsuite.errors import GeometryError, ModelFileError
 from mbsuite.limits import undeclared
 from mbsuite.models.coupler import analysis
-from mbsuite.models.coupler import reference as ref
-from mbsuite.models.coupler.mujoco import revolution_guess
+from mbsuite.models.coupler.double import solve_double_wrapped_batch
 from mbsuite.models.coupler.params import CouplerParams
+from mbsuite.models.coupler.reference import revolution_guess
+from mbsuite.models.coupler.single import solve_single
 
 
 # ------------------------------------------------------------------------------------------- admissibility boundary
@@ -62,10 +63,10 @@ def test_admissibility_boundary(e_y):
     a_star = brentq(axial, 0.8 * e_y, e_y, xtol=1e-15)
     assert _independent_pose(p, 1.05 * a_star, state["u"])[1] < 0  # a (refused) solution beyond
     assert 0.85 * e_y < a_star < e_y  # roughly e_y > R alpha (0.914 and 0.902 x e_y measured)
-    inside = ref.solve_single(p, 0.0, a_star * (1 - 1e-4))
+    inside = solve_single(p, 0.0, a_star * (1 - 1e-4))
     np.testing.assert_allclose(inside.u, _independent_pose(p, a_star * (1 - 1e-4), u)[0], atol=1e-9)
     with pytest.raises(GeometryError) as exc:
-        ref.solve_single(p, 0.0, a_star * (1 + 1e-4))
+        solve_single(p, 0.0, a_star * (1 + 1e-4))
     msg = str(exc.value)
     assert f"alpha_bx = {a_star * (1 + 1e-4):.6g} rad" in msg and f"e_y = {e_y:g} m" in msg
     assert "interpenetrate" in msg and "axial component" in msg
@@ -80,7 +81,7 @@ def test_c5_extremum_converged_against_brute_force(l_b):
     N = 4096
     phi = np.arange(N) * 2 * math.pi / N
     inp = {"alpha_cx": 0.0, "alpha_cz": 0.0, "x_c": 0.0, "z_c": 0.1}
-    U = ref.solve_double_wrapped_batch(p, phi, np.array([0, 0, 0, 0.1]), revolution_guess(p, inp, phi))
+    U = solve_double_wrapped_batch(p, phi, np.array([0, 0, 0, 0.1]), revolution_guess(p, inp, phi))
     d = phi - U[:, 0]
     mean = d.mean()  # rectangle rule on the open periodic grid
     dev = np.abs(d - mean)
@@ -203,7 +204,7 @@ def test_malformed_mjcf_is_a_model_file_error(tmp_path, monkeypatch, capsys):
 
 
 def test_missing_name_and_bad_inertia_refused(tmp_path, monkeypatch):
-    from mbsuite.models.coupler.modelfiles import load_checked_mjcf
+    from mbsuite.models.coupler.filechecks import load_checked_mjcf
 
     f = _copy_models(tmp_path, monkeypatch, edit=('<site name="BC_S3"', '<site name="BC_S9"'))
     with pytest.raises(ModelFileError, match="site 'BC_S3'"):
@@ -227,7 +228,7 @@ def test_health_figures_on_both_engines():
     rf = mbsuite.run(sc, engine="reference")
     assert rf.health[0].value < 1e-12  # rigid FPP: |r| <= 1e-13 R^2
     from mbsuite.health import judge
-    from mbsuite.models.coupler.mujoco import closure_figure
+    from mbsuite.models.coupler.scenario import closure_figure
 
     with pytest.raises(mbsuite.AccuracyError, match="closure_residual = 0.005666 m exceeds its bound 0.004721 m"):
         judge([closure_figure(6e-3 * l, sc.build_params())])

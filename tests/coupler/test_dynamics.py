@@ -12,7 +12,8 @@ import mbsuite
 from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.coupler import SPEC
 from mbsuite.models.coupler import mujoco as cm
-from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.double import double_quasi_static, ramp_double
+from mbsuite.models.coupler.scenario import scene_inputs
 from mbsuite.scenes import load_scene
 
 
@@ -55,7 +56,7 @@ def test_massless_limit_forces_match_quasi_static():
     r = mbsuite.run(sc)
     p = sc.build_params()
     inp = np.array([0.0, 0.0, 0.0, 0.0, sc.input["z_c"]])
-    f, _ = ref.double_quasi_static(p, inp, ref._ramp_double(p, inp), sc.input["load_torque"])
+    f, _ = double_quasi_static(p, inp, ramp_double(p, inp), sc.input["load_torque"])
     np.testing.assert_allclose(r.stats["link_force_mean"], f, rtol=0.02)
 
 
@@ -82,7 +83,7 @@ def test_torque_ripple_matches_rigid_reference(name, extra):
 def test_effects_switch_model_content():
     sc = load_scene("coupler/double_lateral")
     p = sc.build_params()
-    inp = cm._inputs(sc)
+    inp = scene_inputs(sc)
     m1, _, _ = cm.build(p, {"gravity": True, "link_inertia": "real", "friction": False}, inp, 5e-4, "implicitfast")
     m2, _, _ = cm.build(p, {"gravity": False, "link_inertia": "massless", "friction": True}, inp, 5e-4, "implicitfast")
     b = mujoco.mj_name2id(m1, mujoco.mjtObj.mjOBJ_BODY, "link1")

@@ -13,8 +13,25 @@ import pytest
 
 from mbsuite.errors import GeometryError, ParameterError, SolverError
 from mbsuite.models.coupler import analysis
-from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.double import (
+    double_quasi_static,
+    double_residual,
+    double_revolution,
+    ramp_double,
+    solve_double,
+)
+from mbsuite.models.coupler.fpp import gauss_newton
+from mbsuite.models.coupler.geometry import NEXT
+from mbsuite.models.coupler.jacobian import (
+    EQ15,
+    analyse_jacobian,
+    cond_asymptotic,
+    paper_eq15_layout,
+    pitch_of_mixed_basis,
+    single_jacobian,
+)
 from mbsuite.models.coupler.params import GAMMA_17DEG, CouplerParams, geometry_params
+from mbsuite.models.coupler.single import single_points, single_residual, single_revolution
 
 G = GAMMA_17DEG
 
@@ -23,19 +40,19 @@ def test_eq1_link_length_is_the_chord_of_the_assembled_points():
     """Eq (1): the distance between a_k and b_{k+1} at the coplanar pose equals sqrt(2(1 - sin 2g)) R."""
     for g in (0.11, 0.297, 0.391):
         p = CouplerParams(gamma=g, e_y=0.0, R=1.7)
-        a, b, _, _ = ref.single_points(p, 0.0, 0.0, 0.0, np.array([-math.pi / 2, 0, 0, 0]))
-        d = np.linalg.norm(b[ref.NEXT] - a, axis=1)
+        a, b, _, _ = single_points(p, 0.0, 0.0, 0.0, np.array([-math.pi / 2, 0, 0, 0]))
+        d = np.linalg.norm(b[NEXT] - a, axis=1)
         np.testing.assert_allclose(d, 1.7 * math.sqrt(2 * (1 - math.sin(2 * g))), rtol=0, atol=1e-14)
 
 
 def test_eq15_reproduced_with_documented_layout():
     """Eq (15) digit for digit: transpose, Eq 13 moment sign, rows (x, z, -y | m_x, m_z, -m_y). Every entry
     rounded to the paper's 4 decimals is the printed one (the largest gap, 4.76e-5, is 0.88295 printed as 0.8829)."""
-    J = ref.single_jacobian(CouplerParams(e_y=0.0))
-    assert np.array_equal(np.round(ref.paper_eq15_layout(J), 4), ref.EQ15)
+    J = single_jacobian(CouplerParams(e_y=0.0))
+    assert np.array_equal(np.round(paper_eq15_layout(J), 4), EQ15)
     # with gamma = 0.297 exactly the moment entry is 0.8831, not 0.8829 (README erratum 7): the paper used 17 deg
-    J297 = ref.single_jacobian(CouplerParams(gamma=0.297, e_y=0.0))
-    assert np.max(np.abs(ref.paper_eq15_layout(J297) - ref.EQ15)) > 1e-4
+    J297 = single_jacobian(CouplerParams(gamma=0.297, e_y=0.0))
+    assert np.max(np.abs(paper_eq15_layout(J297) - EQ15)) > 1e-4
 
 
 @pytest.mark.parametrize("ey", [0.05, 0.1])
@@ -43,7 +60,7 @@ def test_condition_number_not_table2(ey):
     """Table 2's chi = 87 / 85 is not reproducible with the geometry that reproduces Eq (15) and Table 2's axes (README:
     chi = R^2 cos(2 gamma)/e_y = 16.58 / 8.29, from the SVD; a near-constant chi while e_y doubles is impossible).
     A documented disagreement with the paper, asserted as one."""
-    s = np.linalg.svd(ref.single_jacobian(CouplerParams(e_y=ey)), compute_uv=False)
+    s = np.linalg.svd(single_jacobian(CouplerParams(e_y=ey)), compute_uv=False)
     assert abs(s[0] / s[-1] - analysis.TABLE2[ey][3]) > 50
 
 
@@ -52,18 +69,18 @@ def test_condition_number_closed_form_scales_with_R_squared(R):
     """J mixes force and moment rows: chi = R^2 cos(2 gamma)/e_y (length units matter); below R ~ 0.85 a translational
     singular value dominates and there is no closed form (clear error, not a wrong number)."""
     p = CouplerParams(R=R, e_y=0.1)
-    s = np.linalg.svd(ref.single_jacobian(p), compute_uv=False)  # the numerical side: the SVD of J
+    s = np.linalg.svd(single_jacobian(p), compute_uv=False)  # the numerical side: the SVD of J
     # the derived closed form against the SVD, and cond_asymptotic against the SVD (measured <= 2.5e-15; bound 40x)
     assert s[0] / s[-1] == pytest.approx(R**2 * math.cos(2 * G) / 0.1, rel=1e-13)
-    assert ref.cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-13)
+    assert cond_asymptotic(p) == pytest.approx(s[0] / s[-1], rel=1e-13)
     with pytest.raises(ParameterError, match="too small"):
-        ref.cond_asymptotic(CouplerParams(R=0.5, e_y=0.1))
+        cond_asymptotic(CouplerParams(R=0.5, e_y=0.1))
 
 
 @pytest.mark.parametrize("ey", [0.05, 0.1])
 def test_table2_axes_are_the_zero_pitch_screws(ey):
     p = CouplerParams(e_y=ey)
-    an = ref.analyse_jacobian(ref.single_jacobian(p), np.array([0.0, ey, 0.0]))
+    an = analyse_jacobian(single_jacobian(p), np.array([0.0, ey, 0.0]))
     assert an.rank == 4 - 0 and an.null_space.shape[1] == 2
     zp = analysis.zero_pitch_pair(an.principal_screws)
     y1, y2, h_paper, _ = analysis.TABLE2[ey]
@@ -83,7 +100,7 @@ def test_table2_axes_are_the_zero_pitch_screws(ey):
         assert abs(abs(s.axis[0]) - math.sqrt(0.5)) < 1e-12
     # Table 2's +-pitches come from a basis turned by theta away from the zero-pitch pair
     th = 0.5 * math.asin(h_paper / (d / 2))
-    h1, h2 = ref.pitch_of_mixed_basis(zp[0], zp[1], th)
+    h1, h2 = pitch_of_mixed_basis(zp[0], zp[1], th)
     assert abs(h1) == pytest.approx(h_paper, rel=1e-9) and h1 == pytest.approx(-h2, rel=1e-9)
     # null vectors really are free motions: J t = 0
     assert np.max(np.abs(an.J @ an.null_space)) < 1e-12
@@ -91,9 +108,9 @@ def test_table2_axes_are_the_zero_pitch_screws(ey):
 
 def test_single_fpp_full_revolution_continuation_largest_misalignment():
     p = CouplerParams(e_y=0.1)
-    rev = ref.single_revolution(p, 0.07, 0.02, n=91)
+    rev = single_revolution(p, 0.07, 0.02, n=91)
     for phi, u in zip(rev.phi_a, rev.u, strict=True):
-        assert np.max(np.abs(ref.single_residual(p, phi, 0.07, 0.02, u))) < 1e-12
+        assert np.max(np.abs(single_residual(p, phi, 0.07, 0.02, u))) < 1e-12
     # no branch jump: the pose after a full turn is the starting pose with phi_b advanced by exactly 2 pi
     assert rev.u[-1, 0] - rev.u[0, 0] == pytest.approx(2 * math.pi, abs=1e-10)
     np.testing.assert_allclose(rev.u[-1, 1:], rev.u[0, 1:], atol=1e-10)
@@ -139,9 +156,9 @@ def test_double_homokinetic_at_phibc_0_not_at_pi_2():
 
 def test_double_fpp_revolution_phibc_90_no_jump():
     p = CouplerParams(phi_bc=math.pi / 2)
-    rev = ref.double_revolution(p, 0.02, -0.01, 0.03, 0.05, n=61)
+    rev = double_revolution(p, 0.02, -0.01, 0.03, 0.05, n=61)
     for phi, u in zip(rev.phi_a, rev.u, strict=True):
-        assert np.max(np.abs(ref.double_residual(p, np.r_[phi, rev.inputs], u))) < 1e-12
+        assert np.max(np.abs(double_residual(p, np.r_[phi, rev.inputs], u))) < 1e-12
     assert rev.u[-1, 0] - rev.u[0, 0] == pytest.approx(2 * math.pi, abs=1e-10)
     np.testing.assert_allclose(rev.u[-1, 1:5], rev.u[0, 1:5], atol=1e-10)
 
@@ -150,11 +167,11 @@ def test_quasi_static_forces_balance_the_load():
     """Virtual work: T_in = T_load dphi_c/dphi_a; links of each coupler alternate tension/compression."""
     p = CouplerParams(phi_bc=math.pi / 2)
     inp = np.array([0.3, 0.0, 0.0, 0.0, 0.06])
-    u = ref._ramp_double(p, inp)
-    f, t_in = ref.double_quasi_static(p, inp, u, 1000.0)
+    u = ramp_double(p, inp)
+    f, t_in = double_quasi_static(p, inp, u, 1000.0)
     h = 1e-6
-    up = ref.solve_double(p, inp + [h, 0, 0, 0, 0], u)
-    um = ref.solve_double(p, inp - [h, 0, 0, 0, 0], u)
+    up = solve_double(p, inp + [h, 0, 0, 0, 0], u)
+    um = solve_double(p, inp - [h, 0, 0, 0, 0], u)
     assert t_in == pytest.approx(1000.0 * (up[0] - um[0]) / (2 * h), rel=1e-7)
     assert np.all(np.sign(f[:4]) == [1, -1, 1, -1])
 
@@ -176,10 +193,10 @@ def test_bad_input_errors():
     # tests/coupler/test_checks.py::test_admissibility_boundary
     # e_y = 0.03 with alpha = 0.05: the inclination ramp reaches the boundary at alpha_bx = 0.03125 rad
     with pytest.raises(GeometryError, match=r"alpha_bx = 0\.03125 rad.*link 1's axial component -0\.00518 l <= 0"):
-        ref.single_revolution(CouplerParams(e_y=0.03), 0.05, 0.0, n=31)
+        single_revolution(CouplerParams(e_y=0.03), 0.05, 0.0, n=31)
     # Gauss-Newton non-convergence reported with the residual
     with pytest.raises(SolverError, match=r"residual \|r\|_inf = [0-9.e+-]+"):
-        ref.gauss_newton(lambda u: np.array([u[0] ** 2 + 1.0]), lambda u: np.array([[2 * u[0]]]), np.array([0.3]))
+        gauss_newton(lambda u: np.array([u[0] ** 2 + 1.0]), lambda u: np.array([[2 * u[0]]]), np.array([0.3]))
 
 
 def test_jacobian_report_no_warning_when_regular():
@@ -192,7 +209,7 @@ def test_jacobian_report_no_warning_when_regular():
 def test_inclination_about_z_equals_about_x_up_to_phase():
     """alpha_b may be applied about x or z: same c1, x- and z-ranges of O_b swap (the platform turns through both)."""
     p = CouplerParams()
-    rx = ref.single_revolution(p, 0.05, 0.0, 121)
-    rz = ref.single_revolution(p, 0.0, 0.05, 121)
+    rx = single_revolution(p, 0.05, 0.0, 121)
+    rz = single_revolution(p, 0.0, 0.05, 121)
     assert np.ptp(rx.phi_a - rx.u[:, 0]) == pytest.approx(np.ptp(rz.phi_a - rz.u[:, 0]), rel=1e-9)
     assert np.ptp(rx.u[:, 1]) == pytest.approx(np.ptp(rz.u[:, 3]), rel=1e-9)

@@ -11,9 +11,11 @@ import pytest
 
 from mbsuite.errors import ModelFileError
 from mbsuite.models.coupler import modelfiles as mf
-from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.jacobian import single_jacobian
+from mbsuite.models.coupler.mujoco import mjspec_variant
 from mbsuite.models.coupler.params import CouplerParams
 from mbsuite.models.coupler.pinocchio import PinCoupler, load_model, pin_variant
+from mbsuite.models.coupler.single import ramp_single
 from mbsuite.paths import mjcf_path, urdf_path
 
 VARIANT = CouplerParams(gamma=0.11, e_y=0.2, l_b=3.0, phi_bc=math.pi / 2, R=1.3)
@@ -39,12 +41,12 @@ def test_shipped_files_equal_generated_baseline(kind):
     p = CouplerParams()
     assert urdf_path(f"coupler_{kind}").read_text() == mf.urdf_text(p, kind)
     assert mjcf_path(f"coupler_{kind}").read_text() == mf.mjcf_text(p, kind)
-    _compare(mujoco.MjModel.from_xml_path(str(mjcf_path(f"coupler_{kind}"))), mf.mjspec_variant(p, kind).compile())
+    _compare(mujoco.MjModel.from_xml_path(str(mjcf_path(f"coupler_{kind}"))), mjspec_variant(p, kind).compile())
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_mjspec_edit_equals_generated_variant(kind):
-    edited = mf.mjspec_variant(VARIANT, kind).compile()
+    edited = mjspec_variant(VARIANT, kind).compile()
     generated = mujoco.MjModel.from_xml_string(mf.mjcf_text(VARIANT, kind))
     _compare(edited, generated)
     # and the variant differs from the baseline (the edit did something)
@@ -74,11 +76,11 @@ def test_pinocchio_edit_equals_generated_variant(kind):
 def test_variant_kinematics_pinocchio_matches_reference():
     p = VARIANT
     pc = PinCoupler.build("single", p, edit=True)
-    sp = ref._ramp_single(p, 1.1, 0.08, 0.05)
+    sp = ramp_single(p, 1.1, 0.08, 0.05)
     q = pc.q_of({"phi_a": 1.1, "alpha_bx": 0.08, "alpha_bz": 0.05,
                  **dict(zip(("phi_b", "x_b", "y_b", "z_b"), sp.u, strict=True))})
     assert np.max(np.abs(pc.residual(q))) < 1e-12
-    assert np.max(np.abs(pc.mechanism_jacobian(q) - ref.single_jacobian(p, sp))) < 1e-14  # measured 2.2e-16
+    assert np.max(np.abs(pc.mechanism_jacobian(q) - single_jacobian(p, sp))) < 1e-14  # measured 2.2e-16
 
 
 def test_urdf_states_every_closure_by_named_frames():
@@ -141,7 +143,7 @@ def test_platform_discs_follow_the_design(kind):
     """Each platform carries a disc of radius DISC_RADIUS x R whose face lies in the platform's joint plane (all four
     joint sites of that platform at distance R from the disc axis, on its face), also for an MjSpec variant."""
     for p in (CouplerParams(), VARIANT):
-        m = mf.mjspec_variant(p, kind).compile()
+        m = mjspec_variant(p, kind).compile()
         d = mujoco.MjData(m)
         mujoco.mj_kinematics(m, d)
         names = {"A": "platform_a_disc"} | ({"B": "platform_b_disc"} if kind == "single" else

@@ -14,9 +14,28 @@ import pytest
 import mbsuite
 from mbsuite.errors import GeometryError, SolverError
 from mbsuite.models.coupler import mujoco as cm
-from mbsuite.models.coupler import reference as ref
-from mbsuite.models.coupler.modelfiles import phi_c_offset
+from mbsuite.models.coupler import reference
+from mbsuite.models.coupler.double import (
+    DOUBLE_TURN,
+    double_residual,
+    double_residual_batch,
+    double_residual_jac,
+    double_residual_jac_batch,
+    ramp_double,
+    solve_double,
+)
+from mbsuite.models.coupler.geometry import phi_c_offset
 from mbsuite.models.coupler.params import CouplerParams
+from mbsuite.models.coupler.reference import (
+    kinematic_derivatives,
+    kinematic_output,
+    kinematic_pose,
+    kinematic_rates,
+    revolution_guess,
+    shaft_b_energy,
+    shaft_b_energy_batch,
+)
+from mbsuite.models.coupler.scenario import ramp, scene_inputs
 from mbsuite.scenes import load_scene
 
 
@@ -24,14 +43,14 @@ def continuation_poses(p: CouplerParams, inp: dict, phi_a: np.ndarray) -> np.nda
     """Full FPP poses (N, 8) one sample after the other (the readable path of `kinematic_output`, all 8 unknowns)."""
     rest = [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]
     k0 = round(phi_a[0] / (2 * math.pi))
-    u = ref._ramp_double(p, np.array([phi_a[0] - 2 * math.pi * k0, *rest])) + k0 * ref.DOUBLE_TURN
+    u = ramp_double(p, np.array([phi_a[0] - 2 * math.pi * k0, *rest])) + k0 * DOUBLE_TURN
     out = np.empty((phi_a.size, 8))
     for i, pa in enumerate(phi_a):
         g = u.copy()
         if i:
             g[[0, 5]] += pa - phi_a[i - 1]
         k = round(pa / (2 * math.pi))
-        u = ref.solve_double(p, np.array([pa - 2 * math.pi * k, *rest]), g - k * ref.DOUBLE_TURN) + k * ref.DOUBLE_TURN
+        u = solve_double(p, np.array([pa - 2 * math.pi * k, *rest]), g - k * DOUBLE_TURN) + k * DOUBLE_TURN
         out[i] = u
     return out
 
@@ -48,10 +67,10 @@ def test_batched_equations_equal_the_readable_ones():
         inp = np.column_stack([rng.uniform(-700, 700, n), rng.uniform(-0.04, 0.04, (n, 2)),
                                rng.uniform(-0.06, 0.06, (n, 2))])
         u = rng.normal(size=(n, 8)) * 0.2
-        r = np.array([ref.double_residual(p, x, v) for x, v in zip(inp, u, strict=True)])
-        J = np.array([ref.double_residual_jac(p, x, v) for x, v in zip(inp, u, strict=True)])
-        np.testing.assert_allclose(ref.double_residual_batch(p, inp, u), r, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(ref.double_residual_jac_batch(p, inp, u), J, rtol=0, atol=1e-12)
+        r = np.array([double_residual(p, x, v) for x, v in zip(inp, u, strict=True)])
+        J = np.array([double_residual_jac(p, x, v) for x, v in zip(inp, u, strict=True)])
+        np.testing.assert_allclose(double_residual_batch(p, inp, u), r, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(double_residual_jac_batch(p, inp, u), J, rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("params, inp, phi", [
@@ -68,20 +87,20 @@ def test_batched_fpp_equals_per_sample_continuation(params, inp, phi):
     phi_a = np.linspace(*phi)
     U_ref = continuation_poses(p, inp, phi_a)
     guess = U_ref + np.random.default_rng(3).normal(scale=1e-3, size=U_ref.shape)
-    U = cm.kinematic_pose(p, inp, phi_a, guess)
+    U = kinematic_pose(p, inp, phi_a, guess)
     assert np.max(np.abs(U - U_ref)) < 1e-12
     assert U[-1, 0] - U[0, 0] - (phi_a[-1] - phi_a[0]) == pytest.approx(0.0, abs=1e-10)  # whole turns: closes
     if phi[0] == 0.0:  # the model's readable reference, continuation from the initial pose
-        assert np.max(np.abs(cm.kinematic_output(p, inp, phi_a, U_ref[0]) - U[:, 0])) < 1e-12
+        assert np.max(np.abs(kinematic_output(p, inp, phi_a, U_ref[0]) - U[:, 0])) < 1e-12
 
 
 def test_batched_fpp_on_a_simulated_run_equals_continuation():
     """On the samples of a MuJoCo run (phi_bc = pi/2, start-up ramp included), started from the simulated poses."""
     sc = load_scene("coupler/double_phibc90").replace(solver={"duration": 0.6})
     res = mbsuite.run(sc)
-    p, inp = sc.build_params(), cm._inputs(sc)
-    u0 = ref._ramp_double(p, np.array([0.0, inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]))
-    np.testing.assert_allclose(res["phi_c_kin"], cm.kinematic_output(p, inp, res["phi_a"], u0), rtol=0, atol=1e-12)
+    p, inp = sc.build_params(), scene_inputs(sc)
+    u0 = ramp_double(p, np.array([0.0, inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]))
+    np.testing.assert_allclose(res["phi_c_kin"], kinematic_output(p, inp, res["phi_a"], u0), rtol=0, atol=1e-12)
 
 
 def test_non_converging_sample_is_named_by_its_time():
@@ -93,15 +112,15 @@ def test_non_converging_sample_is_named_by_its_time():
     bad = guess.copy()
     bad[2, 0] = np.nan
     with pytest.raises(SolverError, match=r"non-finite residual at t = 0\.02 s"):
-        cm.kinematic_pose(p, inp, phi_a, bad, times=t)
+        kinematic_pose(p, inp, phi_a, bad, times=t)
     bad = guess.copy()
     bad[3, [0, 5]] += 1.0  # far off: Gauss-Newton diverges
     with pytest.raises(SolverError, match=r"did not converge in 50 iterations at t = 0\.03 s"):
-        cm.kinematic_pose(p, inp, phi_a, bad, times=t)
+        kinematic_pose(p, inp, phi_a, bad, times=t)
     bad = guess.copy()
     bad[1, 3], bad[1, 1] = -2 * p.e_y, -4 * p.e_y  # shaft b pushed through platform A: converges to a crossed pose
     with pytest.raises(GeometryError, match=r"at t = 0\.01 s .*cross platform A"):
-        cm.kinematic_pose(p, inp, phi_a, bad, times=t)
+        kinematic_pose(p, inp, phi_a, bad, times=t)
 
 
 def test_pose_far_from_the_simulated_one_is_an_error(monkeypatch):
@@ -111,24 +130,24 @@ def test_pose_far_from_the_simulated_one_is_an_error(monkeypatch):
     phi_a = np.linspace(0.0, 1.0, 5)
     guess = continuation_poses(p, inp, phi_a)
     guess[4, 2] += 1e-6
-    cm.kinematic_pose(p, inp, phi_a, guess)  # 1e-6 is the same branch
-    monkeypatch.setattr(cm, "BRANCH_TOL", 1e-7)
+    kinematic_pose(p, inp, phi_a, guess)  # 1e-6 is the same branch
+    monkeypatch.setattr(reference, "BRANCH_TOL", 1e-7)
     with pytest.raises(SolverError, match=r"t = 0\.4 s .*another assembly branch"):
-        cm.kinematic_pose(p, inp, phi_a, guess, times=np.arange(5) / 10)
+        kinematic_pose(p, inp, phi_a, guess, times=np.arange(5) / 10)
 
 
 def test_batched_rates_and_energy_equal_the_readable_ones():
     p = CouplerParams(phi_bc=math.pi / 2)
     inp = _inp(alpha_cx=0.02, z_c=0.06)
     phi_a = np.linspace(0.0, 2 * math.pi, 61)
-    u0 = ref._ramp_double(p, np.array([0.0, 0.02, 0.0, 0.0, 0.06]))
-    U0, D0, _ = cm.kinematic_derivatives(p, inp, phi_a, u0)
-    U, D = cm.kinematic_rates(p, inp, phi_a, cm.revolution_guess(p, inp, phi_a))
+    u0 = ramp_double(p, np.array([0.0, 0.02, 0.0, 0.0, 0.06]))
+    U0, D0, _ = kinematic_derivatives(p, inp, phi_a, u0)
+    U, D = kinematic_rates(p, inp, phi_a, revolution_guess(p, inp, phi_a))
     # measured 3.1e-15 (poses) and 1.7e-11 (du/dphi_a by central differences of poses solved to 1e-13); bounds ~6x
     assert np.max(np.abs(U - U0)) < 2e-14 and np.max(np.abs(D - D0)) < 1e-10
     rates = D * 4.0
-    e0 = np.array([cm.shaft_b_energy(p, u, du) for u, du in zip(U, rates, strict=True)])
-    np.testing.assert_allclose(cm.shaft_b_energy_batch(p, U, rates), e0, rtol=1e-13)
+    e0 = np.array([shaft_b_energy(p, u, du) for u, du in zip(U, rates, strict=True)])
+    np.testing.assert_allclose(shaft_b_energy_batch(p, U, rates), e0, rtol=1e-13)
 
 
 # ------------------------------------------------------------------------------------------------ the MuJoCo path
@@ -139,11 +158,11 @@ def test_recorded_signals_equal_a_python_replay():
     sc = load_scene("coupler/double_lateral").replace(effects={"friction": True},
                                                      solver={"duration": 0.3, "t_settle": 0.1})
     res = mbsuite.run(sc)
-    p, inp, sv = sc.build_params(), cm._inputs(sc), sc.solver
+    p, inp, sv = sc.build_params(), scene_inputs(sc), sc.solver
     m, d, _ = cm.build(p, dict(sc.effects), inp, sv.timestep, sv.integrator)
     n, every = int(round(sv.duration / sv.timestep)), int(round(sv.sample_dt / sv.timestep))
-    ctrl = np.array([[inp["omega"] * cm.ramp(k * sv.timestep, inp["t_ramp"]),
-                      -inp["load_torque"] * cm.ramp(k * sv.timestep, inp["t_ramp"])] for k in range(n)])
+    ctrl = np.array([[inp["omega"] * ramp(k * sv.timestep, inp["t_ramp"]),
+                      -inp["load_torque"] * ramp(k * sv.timestep, inp["t_ramp"])] for k in range(n)])
     J, E, B = mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_EQUALITY, mujoco.mjtObj.mjOBJ_BODY
     eqs = [mujoco.mj_name2id(m, E, f"link{k + 1}") for k in range(8)]
     links = [mujoco.mj_name2id(m, B, f"link{k + 1}") for k in range(8)]
@@ -210,7 +229,7 @@ def test_servo_too_weak_for_the_load_is_named():
                                                      solver={"duration": 0.5, "t_settle": 0.3})
     with pytest.raises(SolverError, match=r"torque_in = .* outside its plausible range \[-500, 500\].*kv_drive"):
         mbsuite.run(sc)
-    assert cm.servo_bound(sc.build_params(), cm._inputs(sc)) == 500.0
+    assert cm.servo_bound(sc.build_params(), scene_inputs(sc)) == 500.0
 
 
 def test_coupler_and_pantograph_in_threads_equal_each_alone():

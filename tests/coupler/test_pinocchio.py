@@ -8,7 +8,14 @@ import mujoco
 import numpy as np
 import pytest
 
-from mbsuite.models.coupler import reference as ref
+from mbsuite.models.coupler.double import (
+    DOUBLE_INPUTS,
+    DOUBLE_UNKNOWNS,
+    double_residual_jac,
+    double_revolution,
+    ramp_double,
+)
+from mbsuite.models.coupler.jacobian import single_jacobian
 from mbsuite.models.coupler.params import CouplerParams
 from mbsuite.models.coupler.pinocchio import (
     PinCoupler,
@@ -16,6 +23,7 @@ from mbsuite.models.coupler.pinocchio import (
     pin_to_mujoco_qpos,
     single_revolution_pin,
 )
+from mbsuite.models.coupler.single import ramp_single, single_residual_jac, single_revolution
 from mbsuite.paths import mjcf_path
 
 # largest measured difference 3.5e-13 (the double FPP pose, which stops at |r| <= 1e-13 R^2); bound 8.5x
@@ -34,7 +42,7 @@ def double():
 
 def test_single_fpp_over_revolution_matches(single):
     p = CouplerParams()
-    rev = ref.single_revolution(p, 0.06, -0.02, n=49)
+    rev = single_revolution(p, 0.06, -0.02, n=49)
     pr = single_revolution_pin(single, 0.06, -0.02, rev.phi_a, rev.u[0])
     assert np.max(np.abs(pr - rev.u)) < TOL
 
@@ -43,33 +51,33 @@ def test_single_fpp_over_revolution_matches(single):
 def test_single_jacobians_match(single, pose):
     p = CouplerParams()
     phi_a, ax, az = pose
-    sp = ref._ramp_single(p, phi_a, ax, az)
+    sp = ramp_single(p, phi_a, ax, az)
     q = single.q_of({"phi_a": phi_a, "alpha_bx": ax, "alpha_bz": az,
                      **dict(zip(("phi_b", "x_b", "y_b", "z_b"), sp.u, strict=True))})
     assert np.max(np.abs(single.residual(q))) < 1e-12
     # mechanism Jacobian (4 x 6) and the FPP Jacobian (each row l_hat^T (J_b - J_a))
-    assert np.max(np.abs(single.mechanism_jacobian(q) - ref.single_jacobian(p, sp))) < TOL
+    assert np.max(np.abs(single.mechanism_jacobian(q) - single_jacobian(p, sp))) < TOL
     single.update(q)
     K = single.constraint_jacobian()[:, [single.iv[n] for n in single.unknowns]]
-    Kh = ref.single_residual_jac(p, phi_a, ax, az, sp.u) / (2 * p.link_length)
+    Kh = single_residual_jac(p, phi_a, ax, az, sp.u) / (2 * p.link_length)
     assert np.max(np.abs(K - Kh)) < TOL
 
 
 def test_double_fpp_and_jacobian_match(double):
     p = CouplerParams()
-    rev = ref.double_revolution(p, 0.02, 0.01, -0.02, 0.05, n=13)
-    q = double.q_of({"phi_a": 0.0, **dict(zip(ref.DOUBLE_INPUTS[1:], rev.inputs, strict=True)),
-                     **dict(zip(ref.DOUBLE_UNKNOWNS, rev.u[0], strict=True))})
+    rev = double_revolution(p, 0.02, 0.01, -0.02, 0.05, n=13)
+    q = double.q_of({"phi_a": 0.0, **dict(zip(DOUBLE_INPUTS[1:], rev.inputs, strict=True)),
+                     **dict(zip(DOUBLE_UNKNOWNS, rev.u[0], strict=True))})
     prev = 0.0
     for phi, u in zip(rev.phi_a, rev.u, strict=True):
         for name in ("phi_b", "phi_c"):  # predictor: both shafts follow the input
             q[double.iq[name]] += phi - prev
         prev = phi
-        q = double.fpp({"phi_a": phi, **dict(zip(ref.DOUBLE_INPUTS[1:], rev.inputs, strict=True))}, q)
+        q = double.fpp({"phi_a": phi, **dict(zip(DOUBLE_INPUTS[1:], rev.inputs, strict=True))}, q)
         assert np.max(np.abs(double.coords(q) - u)) < TOL
         double.update(q)
         K = double.constraint_jacobian()[:, [double.iv[n] for n in double.unknowns]]
-        Kh = ref.double_residual_jac(p, np.r_[phi, rev.inputs], u) / (2 * p.link_length)
+        Kh = double_residual_jac(p, np.r_[phi, rev.inputs], u) / (2 * p.link_length)
         assert np.max(np.abs(K - Kh)) < TOL
 
 
@@ -92,7 +100,7 @@ def test_mjcf_in_pinocchio_and_mujoco_same_kinematics(kind):
     if kind == "single":
         inp = {"phi_a": 0.8, "alpha_bx": 0.04, "alpha_bz": -0.02}
         qm = pm.fpp_ramp(inp)
-        u = ref._ramp_single(p, 0.8, 0.04, -0.02).u
+        u = ramp_single(p, 0.8, 0.04, -0.02).u
         c = pm.shaft_coords(qm, "b")
         got = np.array([c[5] - math.pi / 2, c[0], c[1], c[2]])
         np.testing.assert_allclose(c[3:5], [-0.02, 0.04], atol=1e-14)
@@ -102,8 +110,8 @@ def test_mjcf_in_pinocchio_and_mujoco_same_kinematics(kind):
         assert np.max(np.abs(pc.coords(qu) - got)) < TOL
     else:
         x = np.array([0.8, 0.02, 0.01, -0.02, 0.05])
-        qm = pm.fpp_ramp(dict(zip(ref.DOUBLE_INPUTS, x, strict=True)))
-        u = ref._ramp_double(p, x)
+        qm = pm.fpp_ramp(dict(zip(DOUBLE_INPUTS, x, strict=True)))
+        u = ramp_double(p, x)
         b, c = pm.shaft_coords(qm, "b"), pm.shaft_coords(qm, "c")
         got = np.array([c[5] + p.phi_bc, c[1], b[0], b[1], b[2], b[5] - math.pi / 2, b[4], b[3]])
     assert np.max(np.abs(got - u)) < TOL

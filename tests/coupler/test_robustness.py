@@ -9,7 +9,7 @@ from mbsuite.cli import main
 from mbsuite.engines import mujoco_engine as me
 from mbsuite.engines import pinocchio_engine as pe
 from mbsuite.errors import ModelFileError
-from mbsuite.models.coupler.modelfiles import check_model_file
+from mbsuite.models.coupler.filechecks import check_model_file
 from mbsuite.paths import mjcf_path, urdf_path
 
 L = "0.944253246252565"  # the shipped link length, as written in the files

@@ -9,9 +9,9 @@ import pytest
 
 import mbsuite
 from mbsuite.models.coupler import analysis
-from mbsuite.models.coupler import reference as ref
 from mbsuite.models.coupler.params import CouplerParams
 from mbsuite.models.coupler.pinocchio import PinCoupler, single_revolution_pin
+from mbsuite.models.coupler.single import single_revolution
 from mbsuite.scenes import load_scene
 
 pytestmark = pytest.mark.slow
@@ -48,7 +48,7 @@ def test_full_criteria_grid_trends():
 
 def test_dense_revolution_pinocchio_widest_platform_largest_inclination():
     p = CouplerParams(gamma=0.391, e_y=0.1)
-    rev = ref.single_revolution(p, 0.07, 0.0, n=361)
+    rev = single_revolution(p, 0.07, 0.0, n=361)
     pr = single_revolution_pin(PinCoupler.build("single", p), 0.07, 0.0, rev.phi_a, rev.u[0])
     assert np.max(np.abs(pr - rev.u)) < 3e-12  # measured 4.1e-13
 

@@ -1,7 +1,8 @@
 """Single and double 4-link (SS-link) couplers of low-floor tram drives (Maniowski & Czauderna).
 
-Kinematics hand-derived (reference.py) and in Pinocchio (pinocchio.py), cross-checked; double-coupler dynamics in
-MuJoCo (mujoco.py). See README.md in this package.
+Kinematics hand-derived (single.py, double.py, jacobian.py) and in Pinocchio (pinocchio.py), cross-checked;
+double-coupler runs on two paths: MuJoCo (mujoco.py) and the rigid kinematic solution (reference.py). See README.md in
+this package (its "Files" table says where everything is).
 """
 
 from __future__ import annotations
@@ -10,13 +11,15 @@ from pathlib import Path
 
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from .mujoco import INPUTS, OUTPUTS, run, view_model
+from .mujoco import run_mujoco, view_model
 from .params import CouplerParams
+from .reference import run_reference
+from .scenario import INPUTS, OUTPUTS
 
 
 def _check_file(path: Path, engine: str, model: object) -> None:
     """The loaders' check of a shipped coupler model file (closures at the stated lengths, inertias, names)."""
-    from .modelfiles import check_model_file
+    from .filechecks import check_model_file
 
     check_model_file(path, engine, model)
 
@@ -36,10 +39,12 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).resolve().parent / "scenes",
     default_scene="double_lateral",
     paths={
-        "mujoco": RunPath(run, "mujoco", "MuJoCo: the double coupler's dynamics (S joints as balls, closures as "
-                                         "equalities)"),
-        "reference": RunPath(run, "kinematic", "the hand-derived kinematic solution (quasi-static, Maniowski & "
-                                               "Czauderna)"),
+        "mujoco": RunPath(run=run_mujoco, label="mujoco",
+                          what="MuJoCo: the double coupler's dynamics (S joints as balls, SS links closed by soft "
+                               "equalities)"),
+        "reference": RunPath(run=run_reference, label="kinematic",
+                             what="the kinematic solution (hand-derived FPP of the rigid mechanism, Maniowski & "
+                                  "Czauderna; torque from the power balance)"),
     },
     cases="mbsuite.models.coupler.cases",
     solver=SolverSettings(integrator="implicitfast", timestep=5e-4, duration=2.0, t_settle=0.5, sample_dt=2e-3),

@@ -23,8 +23,28 @@ import numpy as np
 
 from ...errors import GeometryError, ParameterError
 from ...results import Report, format_table, write_csv
-from . import reference as ref
+from .double import DOUBLE_TURN, double_revolution, solve_double
+from .geometry import NEXT, rot_y
+from .jacobian import (
+    RANK_RTOL,
+    Screw,
+    analyse_jacobian,
+    cond_asymptotic,
+    paper_eq15_layout,
+    screw_to_twist,
+    single_jacobian,
+    twist_to_screw,
+)
 from .params import GAMMAS_PAPER, CouplerParams
+from .single import (
+    SINGLE_UNKNOWNS,
+    SinglePose,
+    SingleRevolution,
+    ramp_single,
+    single_points,
+    single_revolution,
+    solve_single,
+)
 
 TABLE2 = {  # the paper's Table 2: e_y -> (S1 point y, S2 point y, |pitch|, chi)
     0.0: (0.0, 0.0, 0.0, 3e5),
@@ -41,9 +61,10 @@ class SingularityWarning(UserWarning):
 
 
 def _closed_form_or_none(p: CouplerParams) -> float | None:
-    """The closed-form aligned-pose condition number, or None where it does not exist (small R, see reference)."""
+    """The closed-form aligned-pose condition number, or None where it does not exist (small R,
+    `jacobian.cond_asymptotic`)."""
     try:
-        return ref.cond_asymptotic(p)
+        return cond_asymptotic(p)
     except ParameterError:
         return None
 
@@ -60,16 +81,16 @@ def _z(x: float) -> float:
     return 0.0 if abs(x) < 5e-15 else float(x)
 
 
-def zero_pitch_pair(principal: list[ref.Screw]) -> list[ref.Screw] | None:
+def zero_pitch_pair(principal: list[Screw]) -> list[Screw] | None:
     """For a 2-system of finite-pitch screws with principal pitches of opposite sign, the two zero-pitch members of the
     cylindroid (the basis in which Table 2 lists its axes). None otherwise."""
     fin = [s for s in principal if math.isfinite(s.pitch)]
     if len(fin) != 2 or fin[0].pitch * fin[1].pitch >= 0:
         return None
 
-    t1, t2 = ref.screw_to_twist(fin[0]), ref.screw_to_twist(fin[1])  # unit omegas, orthogonal, zero cross-pitch
+    t1, t2 = screw_to_twist(fin[0]), screw_to_twist(fin[1])  # unit omegas, orthogonal, zero cross-pitch
     th = math.atan(math.sqrt(-fin[0].pitch / fin[1].pitch))
-    out = [ref.twist_to_screw(math.cos(th) * t1 + sgn * math.sin(th) * t2, np.zeros(3)) for sgn in (1, -1)]
+    out = [twist_to_screw(math.cos(th) * t1 + sgn * math.sin(th) * t2, np.zeros(3)) for sgn in (1, -1)]
     out.sort(key=lambda sc: int(np.argmax(np.abs(sc.axis))))
     return out
 
@@ -82,24 +103,24 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
 
         raise SceneError(f"unknown engine {engine!r}; valid: ['reference', 'pinocchio']")
     if p.e_y == 0.0 and not (alpha_bx or alpha_bz):
-        pose = ref.SinglePose(phi_a, 0.0, 0.0, np.array([phi_a - math.pi / 2, 0.0, 0.0, 0.0]))
+        pose = SinglePose(phi_a, 0.0, 0.0, np.array([phi_a - math.pi / 2, 0.0, 0.0, 0.0]))
     else:
-        pose = ref._ramp_single(p, phi_a, alpha_bx, alpha_bz)
-    _, _, ob, _ = ref.single_points(p, pose.phi_a, alpha_bx, alpha_bz, pose.u)
+        pose = ramp_single(p, phi_a, alpha_bx, alpha_bz)
+    _, _, ob, _ = single_points(p, pose.phi_a, alpha_bx, alpha_bz, pose.u)
     if engine == "pinocchio":
         from .pinocchio import PinCoupler
 
         pc = PinCoupler.build("single", p)
         q = pc.q_of({"phi_a": phi_a, "alpha_bx": alpha_bx, "alpha_bz": alpha_bz,
-                     **dict(zip(ref.SINGLE_UNKNOWNS, pose.u, strict=True))})
+                     **dict(zip(SINGLE_UNKNOWNS, pose.u, strict=True))})
         J = pc.mechanism_jacobian(q)
     else:
-        J = ref.single_jacobian(p, pose)
-    an = ref.analyse_jacobian(J, ob)
+        J = single_jacobian(p, pose)
+    an = analyse_jacobian(J, ob)
     ratio = an.singular_values[-1] / an.singular_values[0]
     if an.rank < 4:
         warnings.warn(f"coupler Jacobian is rank {an.rank} < 4 at e_y = {p.e_y:g} (coplanar singularity): "
-                      f"condition number infinite (sigma_min/sigma_max = {ratio:.1e} <= rtol {ref.RANK_RTOL:g})",
+                      f"condition number infinite (sigma_min/sigma_max = {ratio:.1e} <= rtol {RANK_RTOL:g})",
                       SingularityWarning, stacklevel=2)
     elif an.cond > COND_WARN:
         warnings.warn(f"coupler Jacobian is nearly singular at e_y = {p.e_y:g}: condition number {an.cond:.3g} > "
@@ -110,8 +131,8 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
                                          "phi_b": pose.u[0], "x_b": pose.u[1], "y_b": pose.u[2], "z_b": pose.u[3]},
         "engine": engine,
         "J": J, "J_columns": list(J_COLUMNS), "J_units": list(J_UNITS),
-        "J_paper_layout": ref.paper_eq15_layout(J),
-        "singular_values": an.singular_values, "rank": an.rank, "rank_rtol": ref.RANK_RTOL,
+        "J_paper_layout": paper_eq15_layout(J),
+        "singular_values": an.singular_values, "rank": an.rank, "rank_rtol": RANK_RTOL,
         "cond": an.cond, "cond_closed_form": _closed_form_or_none(p),
         "principal_screws": [s.as_dict() for s in an.principal_screws],
         "zero_pitch_screws": [s.as_dict() for s in zp] if zp else None,
@@ -136,7 +157,7 @@ def jacobian_report(p: CouplerParams, phi_a: float = 0.0, alpha_bx: float = 0.0,
                             [[f"{k + 1}", *(_z(x) for x in J[k])] for k in range(J.shape[0])], ".5f")
              + "\n\n" + format_table(["singular value", "value [units of J]"],
                                       [[f"sigma_{k + 1}", float(v)] for k, v in enumerate(an.singular_values)], ".6g")
-             + f"\nrank {an.rank} (relative tolerance {ref.RANK_RTOL:g}); condition number {an.cond:.6g} [-];\n"
+             + f"\nrank {an.rank} (relative tolerance {RANK_RTOL:g}); condition number {an.cond:.6g} [-];\n"
              f"closed form R^2 cos(2 gamma)/e_y = {'n/a (R too small)' if cf is None else f'{cf:.6g}'} [-]"
              "\n\nfree motions (null space of J) as screws: a = unit axis, p = point of the axis nearest to O_b,\n"
              "h = pitch (inf = translation)\n"
@@ -169,14 +190,14 @@ def link_angles(R_P: np.ndarray, lhat: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return np.arctan2(u[:, 2], u[:, 0]), np.arcsin(np.clip(u[:, 1], -1, 1))
 
 
-def single_angles(p: CouplerParams, rev: ref.SingleRevolution) -> tuple[np.ndarray, np.ndarray]:
+def single_angles(p: CouplerParams, rev: SingleRevolution) -> tuple[np.ndarray, np.ndarray]:
     """beta1, beta2 over the revolution: arrays (n, 8) = 4 links x (end A, end B)."""
     b1, b2 = [], []
     for phi, u in zip(rev.phi_a, rev.u, strict=True):
-        a, b, _, Rb = ref.single_points(p, phi, rev.alpha_bx, rev.alpha_bz, u)
-        lv = b[ref.NEXT] - a
+        a, b, _, Rb = single_points(p, phi, rev.alpha_bx, rev.alpha_bz, u)
+        lv = b[NEXT] - a
         lh = lv / np.linalg.norm(lv, axis=1)[:, None]
-        x1, x2 = link_angles(ref.rot_y(phi), lh)
+        x1, x2 = link_angles(rot_y(phi), lh)
         y1, y2 = link_angles(Rb, lh)
         b1.append(np.r_[x1, y1])
         b2.append(np.r_[x2, y2])
@@ -229,8 +250,8 @@ def _fluctuation(g, phis: np.ndarray, d: np.ndarray, guess_at) -> dict:
 def single_criteria(p: CouplerParams, alpha_b: float, n: int = 181) -> dict:
     """c1-c4 of the single coupler for inclination alpha_b (= alpha_bx) over one revolution; c1 with its extrema
     refined between samples (`refined_extremum`), c2-c4 the sampled extremes."""
-    rev = ref.single_revolution(p, alpha_b, 0.0, n)
-    nom = ref.single_revolution(p, 0.0, 0.0, 3)
+    rev = single_revolution(p, alpha_b, 0.0, n)
+    nom = single_revolution(p, 0.0, 0.0, 3)
     b10, b20 = single_angles(p, nom)
     b1, b2 = single_angles(p, rev)
     d = rev.phi_a - rev.u[:, 0]
@@ -241,7 +262,7 @@ def single_criteria(p: CouplerParams, alpha_b: float, n: int = 181) -> dict:
         return rev.u[i] + np.array([x - rev.phi_a[i], 0.0, 0.0, 0.0])
 
     def g(x: float, guess: np.ndarray) -> float:
-        return x - ref.solve_single(p, x, alpha_b, 0.0, guess).u[0]
+        return x - solve_single(p, x, alpha_b, 0.0, guess).u[0]
 
     fl = _fluctuation(g, rev.phi_a, d, guess_at)
     return {
@@ -258,18 +279,18 @@ def double_c5(p: CouplerParams, z_c: float, alpha_cx: float = 0.0, alpha_cz: flo
     n samples by continuation, then both extrema of phi_a - phi_c refined between samples (`refined_extremum`; at
     phi_bc = pi/2 the peaks sit at phi_a = k 45 deg). Also the sampled value `c5_sampled`, the peak-to-peak
     fluctuation, the mean (`periodic_mean`), the input angle of the extremum, and the intermediate shaft's c1."""
-    rev = ref.double_revolution(p, alpha_cx, alpha_cz, x_c, z_c, n)
+    rev = double_revolution(p, alpha_cx, alpha_cz, x_c, z_c, n)
     rest = np.array([alpha_cx, alpha_cz, x_c, z_c], float)
     d = rev.phi_a - rev.u[:, 0]
     db = rev.phi_a - rev.u[:, 5]
-    slope = ref.DOUBLE_TURN / (2 * math.pi)
+    slope = DOUBLE_TURN / (2 * math.pi)
 
     def guess_at(x: float) -> np.ndarray:
         i = int(np.argmin(np.abs(rev.phi_a - x)))
         return rev.u[i] + (x - rev.phi_a[i]) * slope
 
     def g(x: float, guess: np.ndarray) -> float:
-        return x - ref.solve_double(p, np.concatenate([[x], rest]), guess)[0]
+        return x - solve_double(p, np.concatenate([[x], rest]), guess)[0]
 
     fl = _fluctuation(g, rev.phi_a, d, guess_at)
     return {"c5": fl["c"], "c5_pp": fl["pp"], "c5_sampled": fl["c_sampled"], "mean": fl["mean"],
@@ -349,7 +370,7 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
 
 def fpp_report(p: CouplerParams, alpha_bx: float, alpha_bz: float, n: int, engine: str = "reference") -> Report:
     """Single-coupler pose over one revolution (continuation), optionally cross-checked with Pinocchio."""
-    rev = ref.single_revolution(p, alpha_bx, alpha_bz, n)
+    rev = single_revolution(p, alpha_bx, alpha_bz, n)
     data = {"phi_a": rev.phi_a, "phi_b": rev.u[:, 0], "x_b": rev.u[:, 1], "y_b": rev.u[:, 2], "z_b": rev.u[:, 3],
             "params": p.geometry(), "alpha_bx": alpha_bx, "alpha_bz": alpha_bz}
     if engine == "pinocchio":

@@ -19,6 +19,12 @@ from ...analysis.workprecision import Setting, Study, _rel
 from ...errors import GeometryError, SceneError, SolverError
 from ...hardcases import Checker, HardCase
 from ...scenes import Scene
+from . import analysis
+from .double import double_residual, double_residual_jac, double_revolution, ramp_double, solve_double
+from .jacobian import analyse_jacobian, single_jacobian
+from .params import CouplerParams
+from .scenario import scene_inputs
+from .single import ramp_single, single_revolution, solve_single
 
 
 def _error_of(fn: Callable[[], Any]) -> BaseException | None:
@@ -47,16 +53,12 @@ def _coupler_ey_to_zero(ck: Checker) -> None:
     rotations about x and z through the centre)."""
     import warnings
 
-    from . import analysis
-    from . import reference as ref
-    from .params import CouplerParams
-
     conds, worst = {}, 0.0
     for ey in (1e-1, 5e-2, 1e-2, 1e-4, 1e-6, 1e-8):
         p = CouplerParams(e_y=ey)
-        J = ref.single_jacobian(p, ref.solve_single(p, 0.0))
+        J = single_jacobian(p, solve_single(p, 0.0))
         s = np.linalg.svd(J, compute_uv=False)
-        an = ref.analyse_jacobian(J, np.zeros(3))
+        an = analyse_jacobian(J, np.zeros(3))
         l = p.link_length
         err = max(abs(an.cond / (p.R**2 * math.cos(2 * p.gamma) / ey) - 1), abs(s[-1] / (2 * ey / l) - 1),
                   abs(s[0] / (2 * p.R * math.cos(math.pi / 4 - p.gamma) * p.l0 / l) - 1))
@@ -78,7 +80,7 @@ def _coupler_ey_to_zero(ck: Checker) -> None:
         issubclass(x.category, analysis.SingularityWarning) and "nearly singular" in str(x.message) for x in w),
             [str(x.message)[:60] for x in w])
     p0 = CouplerParams(e_y=0.0)
-    an0 = ref.analyse_jacobian(ref.single_jacobian(p0), np.zeros(3))
+    an0 = analyse_jacobian(single_jacobian(p0), np.zeros(3))
     ck.true("e_y = 0: rank 3 detected, cond = inf", an0.rank == 3 and math.isinf(an0.cond), (an0.rank, an0.cond))
     s0 = np.linalg.svd(an0.J, compute_uv=False)
     # measured 4.4e-16
@@ -96,18 +98,15 @@ def _coupler_ey_to_zero(ck: Checker) -> None:
 
 
 def _coupler_ey_below_alpha(ck: Checker) -> None:
-    from . import reference as ref
-    from .params import CouplerParams
-
     p = CouplerParams(e_y=0.02)
     cause = ("no physical pose", "platform B would cross platform A", "e_y = 0.02 m is too small")
-    _raises_exactly(ck, "single FPP with e_y = 0.02 < R alpha = 0.07", lambda: ref._ramp_single(p, 0.0, 0.07, 0.0),
+    _raises_exactly(ck, "single FPP with e_y = 0.02 < R alpha = 0.07", lambda: ramp_single(p, 0.0, 0.07, 0.0),
                     GeometryError, cause)
     _raises_exactly(ck, "single revolution with e_y = 0.02, alpha = 0.07",
-                    lambda: ref.single_revolution(p, 0.07, n=37), GeometryError, cause)
-    _raises_exactly(ck, "e_y = 0 with any inclination", lambda: ref.solve_single(CouplerParams(e_y=0.0), 0.0, 0.01),
+                    lambda: single_revolution(p, 0.07, n=37), GeometryError, cause)
+    _raises_exactly(ck, "e_y = 0 with any inclination", lambda: solve_single(CouplerParams(e_y=0.0), 0.0, 0.01),
                     GeometryError, ("alpha_bx = 0.01 rad", "e_y = 0 (coplanar"))
-    ok = ref.single_revolution(CouplerParams(e_y=0.1), 0.07, n=73)
+    ok = single_revolution(CouplerParams(e_y=0.1), 0.07, n=73)
     ck.le("e_y = 0.1 > R alpha: closes after a turn |phi_b(2 pi) - phi_b(0) - 2 pi|",
           abs(ok.u[-1, 0] - ok.u[0, 0] - 2 * math.pi), 1e-9)
 
@@ -115,11 +114,7 @@ def _coupler_ey_below_alpha(ck: Checker) -> None:
 def _coupler_phibc90(ck: Checker) -> None:
     from mbsuite import load_scene, run
 
-    from . import analysis
-    from . import reference as ref
-    from .params import CouplerParams
-
-    rev = ref.double_revolution(CouplerParams(phi_bc=math.pi / 2), z_c=0.08, n=73)
+    rev = double_revolution(CouplerParams(phi_bc=math.pi / 2), z_c=0.08, n=73)
     ck.le("FPP revolution closes: |phi_c(2 pi) - phi_c(0) - 2 pi|", abs(rev.u[-1, 0] - rev.u[0, 0] - 2 * math.pi),
           1e-9)
     res = run(load_scene("coupler/double_phibc90").replace(solver={"duration": 1.0}))
@@ -247,10 +242,8 @@ class CouplerStudy(Study):
 
     def __init__(self, scene: Scene, quick: bool = False):
         super().__init__(scene, quick)
-        from .mujoco import _inputs
-
         self.p = scene.build_params()
-        self.inp = _inputs(scene)
+        self.inp = scene_inputs(scene)
         T = 0.5 if quick else 1.0
         # the study measures errors: results past a health bound are kept (with their warning), not refused
         self.base = scene.replace(solver={"duration": T, "t_settle": 0.3 if quick else 0.5, "sample_dt": 2e-3,
@@ -262,15 +255,13 @@ class CouplerStudy(Study):
     # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
     def fpp(self, tol: float, n: int) -> np.ndarray:
         """Double-coupler FPP over one revolution with Gauss-Newton tolerance `tol` and `n` continuation steps."""
-        from . import reference as ref
-
         phis = np.linspace(0.0, 2 * math.pi, n)
-        u = ref._ramp_double(self.p, np.r_[0.0, self.rest])
+        u = ramp_double(self.p, np.r_[0.0, self.rest])
         out = [u]
         du = np.zeros_like(u)
         for ph in phis[1:]:
             g = u + du
-            u_new = ref.solve_double(self.p, np.r_[ph, self.rest], g, tol=tol)
+            u_new = solve_double(self.p, np.r_[ph, self.rest], g, tol=tol)
             du = u_new - u
             u = u_new
             out.append(u)
@@ -280,14 +271,12 @@ class CouplerStudy(Study):
         """The same revolution solved by scipy `least_squares` (trf) to 1e-15: the FPP reference."""
         from scipy.optimize import least_squares
 
-        from . import reference as ref
-
         u = self.fpp(1e-13, n)
         out = []
         for ph, g in zip(np.linspace(0.0, 2 * math.pi, n), u, strict=True):
             x = np.r_[ph, self.rest]
-            sol = least_squares(lambda v, x=x: ref.double_residual(self.p, x, v), g,
-                                jac=lambda v, x=x: ref.double_residual_jac(self.p, x, v), method="trf",
+            sol = least_squares(lambda v, x=x: double_residual(self.p, x, v), g,
+                                jac=lambda v, x=x: double_residual_jac(self.p, x, v), method="trf",
                                 xtol=1e-15, ftol=1e-15, gtol=1e-15)
             out.append(sol.x)
         return np.array(out)
@@ -341,13 +330,11 @@ class CouplerStudy(Study):
 
     def physics_error(self, res, ref):
         """Physics error of one setting and its parts (the class's `physics_doc`)."""
-        from . import reference as cref
-
         kind, n, r = res
         if kind == "fpp":
             uref = self._fpp_ref[n]
             phis = np.linspace(0.0, 2 * math.pi, n)
-            resid = max(float(np.max(np.abs(cref.double_residual(self.p, np.r_[ph, self.rest], u))))
+            resid = max(float(np.max(np.abs(double_residual(self.p, np.r_[ph, self.rest], u))))
                         for ph, u in zip(phis, r, strict=True)) / self.p.R**2
             det = {"phi_c_err_rad": float(np.max(np.abs(r[:, 0] - uref[:, 0]))),
                    "c5_err_rad": abs(self._c5(r, n) - self._c5(uref, n)), "closure_residual": resid}

@@ -2,7 +2,7 @@
 torque and an imposed misalignment (inclination alpha_cx, alpha_cz and lateral offset x_c, z_c), intermediate shaft b
 floating on its 8 SS links (soft <connect> equalities).
 
-The model is the shipped `mjcf/coupler_double.xml` edited through MjSpec (`modelfiles.mjspec_variant` for the design,
+The model is the shipped `mjcf/coupler_double.xml` edited through MjSpec (`mjspec_variant` for the design,
 then here): shaft c keeps only its axial slide y_c (along the base y axis) and its spin phi_c, its body is placed at the
 misaligned pose; a velocity actuator drives phi_a, a motor applies the load on phi_c. Effects (scene [effects]):
 gravity (on/off), link_inertia ("real" | "massless": link mass and inertia scaled by `massless_factor`), friction
@@ -13,12 +13,13 @@ precomputed input array, every `sample_dt` the core records the joint coordinate
 8 closure equalities (position residual and force) and the two end points of every link, all at the state of that
 instant; the servo's stability is a plausibility bound on the drive torque (`servo_bound`). Afterwards, in numpy and
 for all samples at once: the closure residuals, the link tensions, and the kinematic output phi_c,kin by the batched
-FPP (`kinematic_pose`, Gauss-Newton started from the simulated pose of every sample).
+FPP (`reference.kinematic_pose`, Gauss-Newton started from the simulated pose of every sample).
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -26,39 +27,89 @@ import numpy as np
 from ... import results
 from ...engines import core
 from ...engines import mujoco_engine as me
-from ...errors import GeometryError, SceneError, SolverError
-from ...health import Figure
-from ...limits import Limit
+from ...errors import ModelFileError, SceneError
+from ...paths import mjcf_path
 from ...results import SimResult
-from . import reference as ref
-from .modelfiles import PHI_B_OFFSET, _mounted, _quat_z_to, link_inertia, mjspec_variant, phi_c_offset, raise_on_gaps
+from .double import ramp_double, solve_double
+from .filechecks import load_checked_mjcf
+from .geometry import NEXT, PHI_B_OFFSET, closures, mounted_points, phi_c_offset, raise_on_gaps, rot_x, rot_z
+from .modelfiles import DISC_RADIUS, link_inertia, platform_discs, quat_z_to, scene_layout
 from .params import CouplerParams
-
-#: the scene input of type "constant_speed": valid range, unit, meaning and the default used when a scene omits the
-#: key (the scene loader fills it in, so every output shows the value the run used)
-INPUTS: dict[str, Limit] = {
-    "omega": Limit(lo=0.0, lo_open=True, hi=1000.0, unit="rad/s", default=4 * math.pi,
-                   doc="input shaft speed after the ramp"),
-    "load_torque": Limit(lo=-1e7, hi=1e7, unit="N m", default=1000.0,
-                         doc="load torque on the output shaft, opposing its rotation"),
-    "alpha_cx": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about x"),
-    "alpha_cz": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about z"),
-    "x_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along x"),
-    "z_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along z"),
-    "t_ramp": Limit(lo=0.0, hi=1e3, unit="s", default=0.25,
-                    doc="duration of the smooth speed and load ramp from rest"),
-}
-INPUT_KEYS = tuple(INPUTS)
-INPUT_DEFAULTS = {k: lim.default for k, lim in INPUTS.items()}
+from .reference import kinematic_pose
+from .scenario import closure_figure, ramp, scene_inputs
 
 
-def _inputs(scene) -> dict[str, float]:
-    """The run's inputs: the scene's (checked and completed with the declared defaults by the scene loader), checked
-    again here for scenes built without it."""
-    inp = {**INPUT_DEFAULTS, **{k: v for k, v in scene.input.items() if k != "type"}}
-    return {k: INPUTS[k].check(f"coupler input {k}", inp[k], SceneError) for k in INPUT_KEYS}
+# -------------------------------------------------------------------------------------------- MjSpec design edits
+def mjspec_variant(p: CouplerParams, kind: str, base: str | Path | None = None):
+    """Design variant by editing the shipped MJCF through mujoco.MjSpec: platform sites, link bodies (pose, inertia,
+    geometry, end site), shaft offsets (e_y, l_b) and the <connect> anchors. The file is checked first as it is
+    (`load_checked_mjcf`: names, closures at q = 0, inertias). Returns the edited MjSpec."""
+    path, _ = load_checked_mjcf(kind, base or mjcf_path(f"coupler_{kind}"))
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except Exception as exc:  # mujoco raises ValueError with the parser message
+        raise ModelFileError(f"MuJoCo cannot read {path}: {exc}") from exc
+    pts = mounted_points(p, kind)
+    l = p.link_length
+    it, ia = link_inertia(p, p.m_link)
+
+    def set_sites(prefix: str) -> None:
+        for k in range(4):
+            spec.site(f"{prefix}_S{k + 1}").pos = pts[prefix][k]
+
+    def set_link(name: str, start: np.ndarray, end: np.ndarray) -> None:
+        b = spec.body(name)
+        b.pos = start
+        b.quat = quat_z_to(end - start)
+        b.ipos = [0, 0, l / 2]
+        b.mass = p.m_link
+        b.inertia = [it, it, ia]
+        g = spec.geom(f"{name}_rod")
+        g.pos = [0, 0, l / 2]
+        g.size = [p.link_radius, l / 2, 0]
+        spec.site(f"{name}_end").pos = [0, 0, l]
+        spec.joint(f"{name}_ball").damping = [p.joint_damping, 0.0, 0.0]
+
+    set_sites("A")
+    driven = "B" if kind == "single" else "BA"
+    set_sites(driven)
+    eB = pts[driven] + np.array([0.0, p.e_y, 0.0])
+    for k in range(4):
+        set_link(f"link{k + 1}", pts["A"][k], eB[NEXT[k]])
+    if kind == "single":
+        spec.body("platform_b").pos = [0, p.e_y, 0]
+    else:
+        spec.body("shaft_b").pos = [0, p.e_y, 0]
+        spec.body("shaft_b").ipos = [0, p.l_b / 2, 0]
+        spec.body("shaft_b").mass = p.m_shaft_b
+        spec.body("shaft_b").inertia = [p.i_shaft_b_trans, p.i_shaft_b_axial, p.i_shaft_b_trans]
+        spec.geom("shaft_b_geom").fromto = [0, 0, 0, 0, p.l_b, 0]
+        set_sites("BC")
+        set_sites("C")
+        yc = 2 * p.e_y + p.l_b
+        spec.body("shaft_c").pos = [0, yc, 0]
+        eBC = pts["BC"] + np.array([0.0, p.e_y - yc, 0.0])
+        for k in range(4):
+            set_link(f"link{k + 5}", pts["C"][k], eBC[NEXT[k]])
+    for name, (_, y0, y1) in platform_discs(p, kind).items():  # visual only
+        g = spec.geom(name)
+        g.fromto = [0, y0, 0, 0, y1, 0]
+        g.size = [DISC_RADIUS * p.R, 0, 0]
+    lay = scene_layout(p, kind)
+    spec.geom("floor").pos = lay["floor_pos"]
+    spec.geom("floor").size = lay["floor_size"]
+    spec.light("key").pos = lay["light_pos"]
+    spec.camera("overview").pos = lay["camera_pos"]
+    spec.camera("overview").alt.xyaxes = lay["camera_xyaxes"]
+    for c in closures(p, kind):
+        eq = spec.equality(c.name)
+        data = np.array(eq.data)
+        data[:3] = [0, 0, l]
+        eq.data = data
+    return spec
 
 
+# ------------------------------------------------------------------------------------------ the scene's dynamics model
 def _id(m, kind, name: str) -> int:
     return mujoco.mj_name2id(m, kind, name)
 
@@ -85,7 +136,7 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
     # shaft c: only y_c (base y) and phi_c remain; its body sits at the imposed misalignment
     for name in ("x_c", "z_c", "alpha_cz", "alpha_cx"):
         spec.delete(spec.joint(name))
-    Rc = ref.rot_z(inp["alpha_cz"]) @ ref.rot_x(inp["alpha_cx"])
+    Rc = rot_z(inp["alpha_cz"]) @ rot_x(inp["alpha_cx"])
     bc = spec.body("shaft_c")
     bc.pos = [inp["x_c"], 2 * p.e_y + p.l_b, inp["z_c"]]
     w = math.sqrt(max(0.0, 1.0 + np.trace(Rc))) / 2
@@ -106,10 +157,10 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
     m = me.load_model(spec)
     me.set_integrator(m, integrator, timestep)
     # connect anchors on shaft b: the driven joint points (MuJoCo would take them from the unassembled qpos0)
-    pts = _mounted(p, "double")
+    pts = mounted_points(p, "double")
     for k in range(8):
         e = _id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"link{k + 1}")
-        m.eq_data[e, 3:6] = (pts["BA"] if k < 4 else pts["BC"])[ref.NEXT[k % 4]]
+        m.eq_data[e, 3:6] = (pts["BA"] if k < 4 else pts["BC"])[NEXT[k % 4]]
         m.eq_solref[e] = [p.solref_timeconst, p.solref_dampratio]
     d = mujoco.MjData(m)
     u = assemble(p, m, d, inp, 0.0)
@@ -128,7 +179,7 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
 def assemble(p: CouplerParams, m, d, inp: dict[str, float], phi_a: float, guess=None) -> np.ndarray:
     """Set qpos to the exact kinematic pose (reference FPP) at phi_a, links aligned with their closures."""
     x = np.array([phi_a, inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]])
-    u = ref._ramp_double(p, x) if guess is None else ref.solve_double(p, x, guess)
+    u = ramp_double(p, x) if guess is None else solve_double(p, x, guess)
     phi_c, yc, xb, yb, zb, phi_b, abx, abz = u
 
     def q(name: str) -> int:
@@ -155,18 +206,10 @@ def assemble(p: CouplerParams, m, d, inp: dict[str, float], phi_a: float, guess=
         Rb = np.zeros(9)
         mujoco.mju_quat2Mat(Rb, qb)
         dloc = Rb.reshape(3, 3).T @ Rpar.T @ (end - start)
-        d.qpos[q(f"link{k + 1}_ball"):q(f"link{k + 1}_ball") + 4] = _quat_z_to(dloc)
+        d.qpos[q(f"link{k + 1}_ball"):q(f"link{k + 1}_ball") + 4] = quat_z_to(dloc)
     d.qvel[:] = 0.0
     mujoco.mj_forward(m, d)
     return u
-
-
-def ramp(t, t_ramp: float):
-    """Smooth 0 -> 1 (C1: s^2 (3 - 2 s), s = t / t_ramp) over t_ramp; a float or an array of times."""
-    t = np.asarray(t, dtype=float)
-    s = np.clip(t / t_ramp, 0.0, 1.0) if t_ramp > 0 else np.ones_like(t)
-    y = np.where(s >= 1.0, 1.0, s * s * (3 - 2 * s))
-    return float(y) if y.ndim == 0 else y
 
 
 def servo_tol(inp: dict[str, float]) -> float:
@@ -232,17 +275,16 @@ def servo_hint(p: CouplerParams, inp: dict[str, float]) -> str:
 def view_model(scene) -> tuple[mujoco.MjModel, mujoco.MjData]:
     """The scene's double coupler as MuJoCo runs it (`mbsuite view`): its effects, assembled at the start pose."""
     p: CouplerParams = scene.build_params()
-    m, d, _ = build(p, dict(scene.effects), _inputs(scene), scene.solver.timestep, scene.solver.integrator)
+    m, d, _ = build(p, dict(scene.effects), scene_inputs(scene), scene.solver.timestep, scene.solver.integrator)
     mujoco.mj_forward(m, d)
     return m, d
 
 
-def run(scene) -> SimResult:
-    """Time simulation of the double coupler (MuJoCo or the kinematic/quasi-static reference)."""
+def run_mujoco(scene) -> SimResult:
+    """The `mujoco` path: time simulation of the double coupler in MuJoCo on mbsuite's native core (module
+    docstring)."""
     p: CouplerParams = scene.build_params()
-    inp = _inputs(scene)
-    if scene.solver.engine == "reference":
-        return run_reference(scene, p, inp)
+    inp = scene_inputs(scene)
     sv = scene.solver
     what = f"coupler scene {scene.name or '(unnamed)'} (MuJoCo)"
     m, d, _ = build(p, dict(scene.effects), inp, sv.timestep, sv.integrator)
@@ -256,24 +298,6 @@ def run(scene) -> SimResult:
               integrator=sv.integrator, timestep=sv.timestep)
     return results.assemble(scene, tr.t, signals, engine="mujoco", stats=st, always=("phi_c_err",),
                             health=[closure_figure(st["closure_residual_max_all"], p)])
-
-
-#: bound of the MuJoCo closure residual over a whole run (start-up ramp included), relative to the link length: the
-#: shipped scenes reach 4.4e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.3e-5 m in steady
-#: rotation), so 5e-3 l (5x the largest) flags closures torn open by a too-soft solref or a bad model
-CLOSURE_BOUND_REL = 5e-3
-#: the rigid reference solves every sample's FPP to |r| <= 1e-13 R^2 (a gap ~1e-14 l): 1e-9 l flags a failed solve
-CLOSURE_BOUND_REL_REFERENCE = 1e-9
-
-
-def closure_figure(value: float, p: CouplerParams, reference: bool = False) -> Figure:
-    """The health figure `closure_residual`: the largest loop-closure gap over the run [m] against its bound
-    (CLOSURE_BOUND_REL x link length; CLOSURE_BOUND_REL_REFERENCE for the rigid reference)."""
-    rel = CLOSURE_BOUND_REL_REFERENCE if reference else CLOSURE_BOUND_REL
-    fix = ("" if reference else "lower params.solref_timeconst (stiffer closures) or lengthen input.t_ramp (a gentler "
-           "start-up)")
-    return Figure("closure_residual", float(value), rel * p.link_length, "m",
-                  f"largest SS-link closure gap over the run, bound {rel:g} x link length {p.link_length:.4g} m", fix)
 
 
 def simulated_pose(p: CouplerParams, tr: core.Trajectory) -> np.ndarray:
@@ -303,54 +327,6 @@ def signals_of(p: CouplerParams, inp: dict[str, float], tr: core.Trajectory, wha
     return sig
 
 
-#: largest distance (rad for angles, R for lengths) between the simulated pose and the kinematic pose of a sample that
-#: still counts as the same assembly branch; the soft closures keep them ~1e-4 apart (1e-3 in the start-up ramp)
-BRANCH_TOL = 0.1
-
-
-def kinematic_pose(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray, guess: np.ndarray,
-                   times: np.ndarray | None = None, what: str = "coupler") -> np.ndarray:
-    """The FPP pose (N, 8) at every sampled phi_a, all samples at once (`reference.solve_double_wrapped_batch`),
-    Gauss-Newton started from `guess` (the simulated pose). Same solutions as the per-sample continuation
-    `kinematic_output` (tested to 1e-12); a sample that does not converge, or converges to a pose farther than
-    BRANCH_TOL from its guess (another assembly branch), raises SolverError naming its time."""
-    rest = np.array([inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]])
-    try:
-        U = ref.solve_double_wrapped_batch(p, phi_a, rest, guess, times=times)
-    except (SolverError, GeometryError) as exc:
-        raise type(exc)(f"{what}: kinematic reference: {exc}") from exc
-    dev = np.max(np.abs(U - guess) / np.array([1, p.R, p.R, p.R, p.R, 1, 1, 1]), axis=1)
-    far = np.flatnonzero(~(dev <= BRANCH_TOL))
-    if far.size:
-        i = int(far[0])
-        at = f"t = {times[i]:.6g} s" if times is not None else f"sample {i}"
-        raise SolverError(f"{what}: the kinematic pose at {at} (phi_a = {phi_a[i]:.6g} rad) is {dev[i]:.3g} away from "
-                          f"the simulated one (more than {BRANCH_TOL:g}: another assembly branch, or closures torn "
-                          f"open; {far.size} of {dev.size} samples)")
-    return U
-
-
-def kinematic_output(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray, u0: np.ndarray) -> np.ndarray:
-    """phi_c from the double-coupler FPP at each sampled phi_a, one sample after the other by continuation from the
-    initial pose u0 (the readable reference of `kinematic_pose`)."""
-    out = np.empty_like(phi_a)
-    u = u0
-    rest = [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]
-    turn = np.zeros(8)
-    turn[[0, 5]] = 2 * math.pi  # phi_c and phi_b advance with phi_a
-    for i, pa in enumerate(phi_a):
-        guess = u.copy()
-        if i:
-            guess[0] += pa - phi_a[i - 1]
-            guess[5] += pa - phi_a[i - 1]
-        # solve at phi_a wrapped to one turn: the FPP's absolute tolerance cannot be met by sin/cos of an angle of
-        # 1000 rad (long runs), and the pose is 2 pi-periodic in phi_a, phi_b, phi_c
-        k = round(pa / (2 * math.pi))
-        u = ref.solve_double(p, np.array([pa - 2 * math.pi * k, *rest]), guess - k * turn) + k * turn
-        out[i] = u[0]
-    return out
-
-
 def stats(t: np.ndarray, s: dict[str, np.ndarray], t_settle: float, inp: dict[str, float]) -> dict:
     """Headline numbers over the settled window t >= max(t_settle, t_ramp)."""
     w = t >= max(t_settle, inp["t_ramp"])
@@ -373,112 +349,3 @@ def stats(t: np.ndarray, s: dict[str, np.ndarray], t_settle: float, inp: dict[st
         "link_force_max_abs": float(np.max(np.abs(f))),
         "link_force_mean": [float(x) for x in np.mean(f, axis=1)],
     }
-
-
-def kinematic_derivatives(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray, u0: np.ndarray,
-                          h: float = 1e-4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """FPP solution u (n, 8) along phi_a and its first and second derivatives du/dphi_a, d2u/dphi_a2 (central
-    differences of converged FPP solutions, step h), one sample after the other by continuation from u0 (the readable
-    reference of `kinematic_rates`)."""
-    rest = [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]]
-    U, D1, D2 = (np.empty((phi_a.size, 8)) for _ in range(3))
-    u = u0
-    for i, pa in enumerate(phi_a):
-        g = u.copy()
-        if i:
-            g[[0, 5]] += pa - phi_a[i - 1]
-        u = ref.solve_double(p, np.array([pa, *rest]), g)
-        up = ref.solve_double(p, np.array([pa + h, *rest]), u)
-        um = ref.solve_double(p, np.array([pa - h, *rest]), u)
-        U[i], D1[i], D2[i] = u, (up - um) / (2 * h), (up - 2 * u + um) / h**2
-    return U, D1, D2
-
-
-def shaft_b_energy(p: CouplerParams, u: np.ndarray, du: np.ndarray) -> float:
-    """Kinetic energy of shaft b (mass m_shaft_b at (0, l_b/2, 0), inertia diag(I_t, I_a, I_t) in its frame) for
-    coordinates u and rates du (DOUBLE_UNKNOWNS order)."""
-    _, _, xd, yd, zd, phd, axd, azd = du
-    _, _, _, _, _, ph, ax, az = u
-    Rz, Rx = ref.rot_z(az), ref.rot_x(ax)
-    R = Rz @ Rx @ ref.rot_y(ph)
-    w = azd * np.array([0.0, 0.0, 1.0]) + axd * (Rz @ np.array([1.0, 0.0, 0.0])) + phd * (Rz @ Rx @ ref.EY)
-    v = np.array([xd, yd, zd]) + np.cross(w, R @ np.array([0.0, p.l_b / 2, 0.0]))
-    Ib = R @ np.diag([p.i_shaft_b_trans, p.i_shaft_b_axial, p.i_shaft_b_trans]) @ R.T
-    return 0.5 * p.m_shaft_b * float(v @ v) + 0.5 * float(w @ Ib @ w)
-
-
-def shaft_b_energy_batch(p: CouplerParams, U: np.ndarray, dU: np.ndarray) -> np.ndarray:
-    """`shaft_b_energy` for N samples (U, dU (N, 8)), vectorised: with b = R e_y the shaft axis,
-    w = alpha_bz' e_z + alpha_bx' R_z e_x + phi_b' b, v = (x_b', y_b', z_b') + w x (l_b/2) b and
-    E = m |v|^2 / 2 + (I_t |w|^2 + (I_a - I_t) (w . b)^2) / 2."""
-    cx, sx, cz, sz = np.cos(U[:, 6]), np.sin(U[:, 6]), np.cos(U[:, 7]), np.sin(U[:, 7])
-    b = np.column_stack([-sz * cx, cz * cx, sx])
-    w = (dU[:, 7, None] * np.array([0.0, 0.0, 1.0]) + dU[:, 6, None] * np.column_stack([cz, sz, np.zeros_like(cz)])
-         + dU[:, 5, None] * b)
-    v = dU[:, 2:5] + np.cross(w, 0.5 * p.l_b * b)
-    It, Ia = p.i_shaft_b_trans, p.i_shaft_b_axial
-    wb = np.einsum("ni,ni->n", w, b)
-    rot = It * np.einsum("ni,ni->n", w, w) + (Ia - It) * wb**2
-    return 0.5 * p.m_shaft_b * np.einsum("ni,ni->n", v, v) + 0.5 * rot
-
-
-def revolution_guess(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray, n: int = 37) -> np.ndarray:
-    """A guess (N, 8) of the FPP pose at any phi_a: one revolution by continuation (`reference.double_revolution`,
-    n samples, branch jumps detected), whose 2 pi-periodic part (phi_b and phi_c less phi_a) is interpolated linearly
-    at phi_a mod 2 pi (within ~1e-5 of the pose for n = 37)."""
-    rev = ref.double_revolution(p, inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"], n=n)
-    slope = ref.DOUBLE_TURN / (2 * math.pi)
-    per = rev.u[:-1] - rev.phi_a[:-1, None] * slope
-    G = np.column_stack([np.interp(phi_a, rev.phi_a[:-1], per[:, j], period=2 * math.pi) for j in range(8)])
-    return G + phi_a[:, None] * slope
-
-
-def kinematic_rates(p: CouplerParams, inp: dict[str, float], phi_a: np.ndarray, guess: np.ndarray, h: float = 1e-4,
-                    times: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """FPP pose U (N, 8) along phi_a and du/dphi_a by central differences of converged poses (step h), all samples at
-    once (the batched twin of `kinematic_derivatives`)."""
-    rest = np.array([inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]])
-    U = ref.solve_double_wrapped_batch(p, phi_a, rest, guess, times=times)
-    up = ref.solve_double_wrapped_batch(p, phi_a + h, rest, U, times=times)
-    um = ref.solve_double_wrapped_batch(p, phi_a - h, rest, U, times=times)
-    return U, (up - um) / (2 * h)
-
-
-def run_reference(scene, p: CouplerParams, inp: dict[str, float]) -> SimResult:
-    """Rigid-shaft reference: phi_a(t) from the ramped speed, all coordinates from the FPP, and the input torque from
-    the power balance with massless links and no gravity or friction:
-    T_in phi_a' = d/dt (E_b + I_c phi_c'^2 / 2) + T_load phi_c' (+ I_a phi_a'' phi_a'), E_b shaft b's kinetic energy.
-    The FPP is solved for all samples at once, started from one revolution of continuation (`revolution_guess`)."""
-    sv = scene.solver
-    dt = sv.sample_dt or 10 * sv.timestep
-    t = np.arange(0.0, sv.duration + 0.5 * dt, dt)
-    s = ramp(t, inp["t_ramp"])
-    om = inp["omega"] * s
-    al = np.gradient(om, t)
-    phi_a = np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t))])
-    U, D1 = kinematic_rates(p, inp, phi_a, revolution_guess(p, inp, phi_a), times=t)
-    rates = D1 * om[:, None]
-    energy = shaft_b_energy_batch(p, U, rates) + 0.5 * p.i_shaft_c * rates[:, 0] ** 2
-    tl = inp["load_torque"] * s
-    power = np.gradient(energy, t) + tl * rates[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_in = np.where(om > 0, power / np.where(om > 0, om, 1.0), tl * D1[:, 0]) + p.i_shaft_a * al
-    # closure gap of the rigid reference: |r_k| = ||l_k|^2 - l^2| at the solved poses, as a length |r_k| / (2 l)
-    gap = np.max(np.abs(ref.double_residual_batch(p, np.column_stack(
-        [phi_a - 2 * math.pi * np.round(phi_a / (2 * math.pi)), np.broadcast_to(
-            [inp["alpha_cx"], inp["alpha_cz"], inp["x_c"], inp["z_c"]], (t.size, 4))]),
-        U - np.round(phi_a / (2 * math.pi))[:, None] * ref.DOUBLE_TURN)), axis=1) / (2 * p.link_length)
-    signals = {"phi_a": phi_a, "phi_c": U[:, 0], "phi_c_kin": U[:, 0], "phi_c_err": np.zeros_like(t),
-               "omega_c": rates[:, 0], "torque_in": t_in, "torque_out": tl, "closure_residual": gap}
-    w = t >= max(sv.t_settle, inp["t_ramp"])
-    st = {"torque_in_mean": float(np.mean(t_in[w])), "torque_in_ripple_pp": float(np.ptp(t_in[w])),
-          "torque_in_ripple_quasi_static_pp": float(np.ptp(tl[w] * D1[w, 0])),
-          "speed_ratio_min": float(np.min(D1[w, 0])), "speed_ratio_max": float(np.max(D1[w, 0])),
-          "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max_all": float(gap.max())}
-    return results.assemble(scene, t, signals, engine="reference", stats=st, always=("phi_c_err",),
-                            health=[closure_figure(st["closure_residual_max_all"], p, reference=True)])
-
-
-OUTPUTS = {"phi_a": "rad", "phi_c": "rad", "phi_c_kin": "rad", "phi_c_err": "rad", "omega_c": "rad/s",
-           "torque_in": "N m", "torque_out": "N m", "closure_residual": "m",
-           **{f"link_force_{k + 1}": "N" for k in range(8)}}

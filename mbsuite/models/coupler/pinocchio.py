@@ -9,7 +9,6 @@ chain joints (columns restricted to them).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,18 +18,12 @@ import pinocchio as pin
 from ...engines import pinocchio_engine as pe
 from ...errors import ModelFileError, SolverError
 from ...paths import urdf_path
-from .modelfiles import (
-    PHI_B_OFFSET,
-    Closure,
-    _mounted,
-    closures,
-    closures_from_urdf,
-    phi_c_offset,
-    raise_on_gaps,
-    urdf_text,
-)
+from .double import DOUBLE_UNKNOWNS
+from .fpp import check_physical
+from .geometry import PHI_B_OFFSET, Closure, closures, mounted_points, phi_c_offset, raise_on_gaps
+from .modelfiles import closures_from_urdf, urdf_text
 from .params import CouplerParams
-from .reference import DOUBLE_UNKNOWNS, SINGLE_UNKNOWNS, check_physical
+from .single import SINGLE_UNKNOWNS
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -50,7 +43,7 @@ def pin_variant(model: pin.Model, p: CouplerParams, kind: str) -> tuple[pin.Mode
     """Design variant by editing a (baseline) Pinocchio model: joint-point frame placements (gamma, R, phi_bc, l_b)
     and the placements of the shaft chains (e_y, l_b). Returns a new model and the variant's closures."""
     m = model.copy()
-    pts = _mounted(p, kind)
+    pts = mounted_points(p, kind)
     for prefix, q in pts.items():
         for k in range(4):
             for name in (f"{prefix}_S{k + 1}", f"{prefix}_S{k + 1}_mount"):
@@ -64,7 +57,7 @@ def pin_variant(model: pin.Model, p: CouplerParams, kind: str) -> tuple[pin.Mode
 
 @dataclass
 class PinCoupler:
-    """A coupler spanning tree in Pinocchio with its closures; coordinates are the paper's (see modelfiles)."""
+    """A coupler spanning tree in Pinocchio with its closures; coordinates are the paper's (see geometry)."""
 
     kind: str
     p: CouplerParams
@@ -198,11 +191,6 @@ class PinCoupler:
         K = self.constraint_jacobian()[:, cols]
         JP = pin.getFrameJacobian(self.model, self.data, pe.frame_id(self.model, "platform_b"), LWA)[:, cols]
         return K @ np.linalg.inv(JP)
-
-    def platform_origin(self, q: np.ndarray, frame: str = "platform_b") -> np.ndarray:
-        """Origin of `frame` (default platform B) in base coordinates at q."""
-        pin.framesForwardKinematics(self.model, self.data, q)
-        return self.data.oMf[pe.frame_id(self.model, frame)].translation.copy()
 
 
 def single_revolution_pin(pc: PinCoupler, alpha_bx: float, alpha_bz: float, phis: np.ndarray,
@@ -342,8 +330,3 @@ def pin_to_mujoco_qpos(pm: pin.Model, q: np.ndarray, mj_model) -> np.ndarray:
         else:
             qpos[adr] = seg[0]
     return qpos
-
-
-def rad_wrap(x: np.ndarray) -> np.ndarray:
-    """Angles wrapped to [-pi, pi)."""
-    return (np.asarray(x) + math.pi) % (2 * math.pi) - math.pi

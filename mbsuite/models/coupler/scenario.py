@@ -1,0 +1,70 @@
+"""What a double-coupler run is given and gives back, the same on every path (`mujoco`, `reference`): the scene
+input `constant_speed` (speed, load, misalignment of the output shaft, start-up ramp), the output signals, the smooth
+start-up ramp and the health figure of the SS-link closures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...errors import SceneError
+from ...health import Figure
+from ...limits import Limit
+from .params import CouplerParams
+
+#: the scene input of type "constant_speed": valid range, unit, meaning and the default used when a scene omits the
+#: key (the scene loader fills it in, so every output shows the value the run used)
+INPUTS: dict[str, Limit] = {
+    "omega": Limit(lo=0.0, lo_open=True, hi=1000.0, unit="rad/s", default=4 * math.pi,
+                   doc="input shaft speed after the ramp"),
+    "load_torque": Limit(lo=-1e7, hi=1e7, unit="N m", default=1000.0,
+                         doc="load torque on the output shaft, opposing its rotation"),
+    "alpha_cx": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about x"),
+    "alpha_cz": Limit(lo=-0.5, hi=0.5, unit="rad", default=0.0, doc="output shaft inclination about z"),
+    "x_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along x"),
+    "z_c": Limit(lo=-1e3, hi=1e3, unit="m", default=0.0, doc="output shaft lateral offset along z"),
+    "t_ramp": Limit(lo=0.0, hi=1e3, unit="s", default=0.25,
+                    doc="duration of the smooth speed and load ramp from rest"),
+}
+INPUT_KEYS = tuple(INPUTS)
+INPUT_DEFAULTS = {k: lim.default for k, lim in INPUTS.items()}
+
+
+def scene_inputs(scene) -> dict[str, float]:
+    """The run's inputs: the scene's (checked and completed with the declared defaults by the scene loader), checked
+    again here for scenes built without it."""
+    inp = {**INPUT_DEFAULTS, **{k: v for k, v in scene.input.items() if k != "type"}}
+    return {k: INPUTS[k].check(f"coupler input {k}", inp[k], SceneError) for k in INPUT_KEYS}
+
+
+def ramp(t, t_ramp: float):
+    """Smooth 0 -> 1 (C1: s^2 (3 - 2 s), s = t / t_ramp) over t_ramp; a float or an array of times."""
+    t = np.asarray(t, dtype=float)
+    s = np.clip(t / t_ramp, 0.0, 1.0) if t_ramp > 0 else np.ones_like(t)
+    y = np.where(s >= 1.0, 1.0, s * s * (3 - 2 * s))
+    return float(y) if y.ndim == 0 else y
+
+
+#: bound of the MuJoCo closure residual over a whole run (start-up ramp included), relative to the link length: the
+#: shipped scenes reach 4.4e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.3e-5 m in steady
+#: rotation), so 5e-3 l (5x the largest) flags closures torn open by a too-soft solref or a bad model
+CLOSURE_BOUND_REL = 5e-3
+#: the rigid reference solves every sample's FPP to |r| <= 1e-13 R^2 (a gap ~1e-14 l): 1e-9 l flags a failed solve
+CLOSURE_BOUND_REL_REFERENCE = 1e-9
+
+
+def closure_figure(value: float, p: CouplerParams, reference: bool = False) -> Figure:
+    """The health figure `closure_residual`: the largest loop-closure gap over the run [m] against its bound
+    (CLOSURE_BOUND_REL x link length; CLOSURE_BOUND_REL_REFERENCE for the rigid reference)."""
+    rel = CLOSURE_BOUND_REL_REFERENCE if reference else CLOSURE_BOUND_REL
+    fix = ("" if reference else "lower params.solref_timeconst (stiffer closures) or lengthen input.t_ramp (a gentler "
+           "start-up)")
+    return Figure("closure_residual", float(value), rel * p.link_length, "m",
+                  f"largest SS-link closure gap over the run, bound {rel:g} x link length {p.link_length:.4g} m", fix)
+
+
+#: the output signals of a run (both paths) and their SI units
+OUTPUTS = {"phi_a": "rad", "phi_c": "rad", "phi_c_kin": "rad", "phi_c_err": "rad", "omega_c": "rad/s",
+           "torque_in": "N m", "torque_out": "N m", "closure_residual": "m",
+           **{f"link_force_{k + 1}": "N" for k in range(8)}}

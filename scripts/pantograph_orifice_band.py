@@ -16,7 +16,8 @@ import numpy as np
 
 from mbsuite import load_scene, run
 from mbsuite.models.pantograph import orifice_band
-from mbsuite.models.pantograph.analysis import config_of, operating_height, stiffest_pole
+from mbsuite.models.pantograph.inputs import config_of, operating_height
+from mbsuite.models.pantograph.linearise import stiffest_pole
 from mbsuite.results import format_table
 
 

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from mbsuite import load_scene
+from mbsuite.models.pantograph.equations import PantographODE
 from mbsuite.models.pantograph.params import PantographParams
-from mbsuite.models.pantograph.reference import PantographODE
 
 
 @pytest.fixture(scope="session")

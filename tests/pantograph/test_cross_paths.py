@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from mbsuite.engines.mujoco_engine import callbacks, full_inertia
+from mbsuite.models.pantograph.equations import PantographConfig, PantographODE
 from mbsuite.models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.pinocchio import PinocchioPantograph, reference_in_q
 from mbsuite.models.pantograph.python_effects import PythonEffects
-from mbsuite.models.pantograph.reference import PantographConfig, PantographODE
 
 REL = 1e-10
 
@@ -81,7 +81,7 @@ def test_mujoco_accelerations_match_hand_derived(random_thetas, cylinder, elbow_
 @pytest.mark.parametrize("cylinder", ["linear", "nonlinear", "constant"])
 def test_equilibrium_same_in_three_paths(lab_scene, cylinder):
     """Operating height 1.58 m, supply pressure of Table 3-I: theta agree to 1e-8 rad."""
-    from mbsuite.models.pantograph.analysis import equilibrium_all_paths
+    from mbsuite.models.pantograph.reports import equilibrium_all_paths
 
     paths = equilibrium_all_paths(lab_scene.replace(effects={"cylinder": cylinder}))
     assert set(paths) == {"reference", "mujoco", "pinocchio"}
@@ -107,7 +107,7 @@ def test_equilibrium_physics(ode, params):
 
 def test_rigid_elbow_equilibrium_mujoco_vs_reference():
     """Rigid elbow: MuJoCo's quartic joint equality vs the exact reduced coordinates: within the fit error."""
-    from mbsuite.models.pantograph.mujoco import rigid_elbow_fit
+    from mbsuite.models.pantograph.modelfiles import rigid_elbow_fit
 
     cfg = PantographConfig(elbow="rigid")
     ode = PantographODE(config=cfg)

@@ -6,18 +6,11 @@ import numpy as np
 import pytest
 
 from mbsuite.analysis.sweep import run_sweep
-from mbsuite.models.pantograph.analysis import (
-    FR_SIGNALS,
-    MODES_TIMESTEP,
-    _point,
-    linear_response,
-    linearize,
-    modes_from_eigs,
-    mujoco_modes,
-    operating_height,
-)
-from mbsuite.models.pantograph.mujoco import MujocoPantograph
-from mbsuite.models.pantograph.reference import PantographODE
+from mbsuite.models.pantograph.equations import PantographODE
+from mbsuite.models.pantograph.freqresp import FR_SIGNALS, _point
+from mbsuite.models.pantograph.inputs import operating_height
+from mbsuite.models.pantograph.linearise import linear_response, linearize, modes_from_eigs
+from mbsuite.models.pantograph.mujoco import MODES_TIMESTEP, MujocoPantograph, mujoco_modes
 
 
 @pytest.fixture(scope="module")

@@ -11,9 +11,10 @@ import pytest
 from mbsuite import ModelFileError, SceneError
 from mbsuite.engines.mujoco_engine import load_model
 from mbsuite.engines.pinocchio_engine import load_mjcf, load_urdf
+from mbsuite.models.pantograph.equations import PantographConfig, PantographODE
 from mbsuite.models.pantograph.modelfiles import E_THETA_Q, q_to_theta, theta_to_q
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
-from mbsuite.models.pantograph.reference import PantographConfig, PantographODE, simulate
+from mbsuite.models.pantograph.reference import simulate
 
 
 def test_energy_drift_without_damping_and_friction():

@@ -11,15 +11,12 @@ import pytest
 from mbsuite import AccuracyError, ParameterError, SceneError, SolverError, load_scene, run, scene_from_dict
 from mbsuite.health import InaccurateResultWarning
 from mbsuite.limits import undeclared
-from mbsuite.models.pantograph.analysis import (
-    STABILITY_FRACTION,
-    linear_model,
-    omega_max,
-    operating_height,
-)
 from mbsuite.models.pantograph.cases import PantographStudy
+from mbsuite.models.pantograph.equations import PantographConfig
+from mbsuite.models.pantograph.health import STABILITY_FRACTION
+from mbsuite.models.pantograph.inputs import operating_height
+from mbsuite.models.pantograph.linearise import linear_model, omega_max
 from mbsuite.models.pantograph.params import PantographParams
-from mbsuite.models.pantograph.reference import PantographConfig
 
 
 def test_every_parameter_declares_its_range():
@@ -74,7 +71,7 @@ def test_bad_input_is_a_scene_error_naming_the_key(inp, key):
 
 
 def test_modes_height_is_checked(lab_scene):
-    from mbsuite.models.pantograph.analysis import modes_report
+    from mbsuite.models.pantograph.reports import modes_report
 
     with pytest.raises(SceneError, match="height = nan"):
         modes_report(lab_scene, height=math.nan)
@@ -127,7 +124,7 @@ def test_diverging_setting_allowed_is_still_an_error_not_garbage():
 
 
 def test_excursion_flags_a_linkage_out_of_its_working_range():
-    from mbsuite.models.pantograph.analysis import excursion
+    from mbsuite.models.pantograph.health import excursion
 
     th0 = np.array([0.4237, 0.4190, -0.0363])
     ok = excursion(th0 + np.array([[0.01, -0.01, 0.02]]), th0)

@@ -17,7 +17,7 @@ import pytest
 
 from mbsuite import load_scene
 from mbsuite.engines.mujoco_engine import callbacks
-from mbsuite.models.pantograph.analysis import config_of, input_of
+from mbsuite.models.pantograph.inputs import config_of, input_of
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
 from mbsuite.models.pantograph.python_effects import PythonEffects
 from mbsuite.scenes import shipped_scenes

@@ -9,9 +9,9 @@ import pytest
 from mbsuite import SceneError, load_scene, run, scene_from_dict
 from mbsuite.engines import native
 from mbsuite.engines.core import Channel, Stepper
-from mbsuite.models.pantograph.analysis import InputSignal
+from mbsuite.models.pantograph.equations import PantographConfig
+from mbsuite.models.pantograph.inputs import InputSignal
 from mbsuite.models.pantograph.mujoco import MujocoPantograph
-from mbsuite.models.pantograph.reference import PantographConfig
 from mbsuite.paths import mjcf_path
 
 

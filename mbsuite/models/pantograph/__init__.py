@@ -1,8 +1,8 @@
-"""Brecknell-Willis asymmetric pantograph (Eppinger 1984): three cross-checked paths.
+"""Brecknell-Willis asymmetric pantograph (Eppinger 1984): three cross-checked paths (README "Files").
 
-- `reference`: hand-derived equations (numpy/scipy), event-exact stick/slip;
-- `pinocchio`: M(q), gravity, frame Jacobians from the URDF/MJCF;
-- `mujoco`: time-domain dynamics with custom actuator callbacks (cylinder) and the elbow torque.
+- `reference` (label `equations`): hand-derived equations (`equations.py`), event-exact stick/slip (`reference.py`);
+- `mujoco`: the MJCF of the scene's effects, cylinder and elbow as engine plugins, on the native core (`mujoco.py`);
+- Pinocchio (`pinocchio.py`): M(q), gravity, frame Jacobians from the URDF/MJCF, for the equilibrium and cross-checks.
 """
 
 from __future__ import annotations
@@ -11,16 +11,14 @@ from pathlib import Path
 
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import analysis
+from .freqresp import freqresp
+from .inputs import INPUTS
+from .mujoco import run_mujoco, view_model
+from .outputs import UNITS
 from .params import PantographParams
-
-
-def _under_wire(params: dict, effects: dict, engine: str, timestep: float):
-    """This pantograph under the catenary's static / trial / commit protocol (`under_wire.py`)."""
-    from .under_wire import make
-
-    return make(params, effects, engine, timestep)
-
+from .reference import run_reference
+from .reports import equilibrium_report, modes_report
+from .under_wire import make as under_wire
 
 SPEC = ModelSpec(
     name="pantograph",
@@ -37,21 +35,22 @@ SPEC = ModelSpec(
                           "joint Coulomb friction: event-exact stick/slip (reference) / frictionloss (MuJoCo)"),
         "contact": Effect(("bilateral", "unilateral"), "bilateral", "ram attached (both ways) or push-only wire"),
     },
-    inputs=analysis.INPUTS,
-    outputs=analysis.UNITS,
+    inputs=INPUTS,
+    outputs=UNITS,
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="lab",
     paths={
-        "mujoco": RunPath(analysis.run, "mujoco", "MuJoCo: the MJCF of the scene's effects, cylinder and elbow as "
-                                                  "engine plugins, the native core's loop"),
-        "reference": RunPath(analysis.run, "equations", "hand-derived equations (numpy/scipy, Eppinger Ch. 3), "
-                                                        "event-exact stick/slip"),
+        "mujoco": RunPath(run=run_mujoco, label="mujoco",
+                          what="MuJoCo: the MJCF of the scene's effects, cylinder and elbow as engine plugins, the "
+                               "native core's loop"),
+        "reference": RunPath(run=run_reference, label="equations",
+                             what="hand-derived equations (numpy/scipy, Eppinger Ch. 3), event-exact stick/slip"),
     },
-    equilibrium=analysis.equilibrium_report,
-    modes=analysis.modes_report,
-    freqresp=analysis.freqresp,
-    under_wire=_under_wire,
-    mujoco_model=analysis.mujoco_model,
+    equilibrium=equilibrium_report,
+    modes=modes_report,
+    freqresp=freqresp,
+    under_wire=under_wire,
+    mujoco_model=view_model,
     cases="mbsuite.models.pantograph.cases",
     # defaults chosen from scripts/pantograph_workprecision.py: RK4 at 1e-3 s reaches 3e-5 relative physics error
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.

@@ -66,7 +66,7 @@ def _pantograph_orifice_dp0(ck: Checker) -> None:
 
 
 def _pantograph_orifice_choked(ck: Checker) -> None:
-    from .reference import PantographODE
+    from .equations import PantographODE
 
     ode = PantographODE(cylinder="nonlinear")
     p = ode.p
@@ -156,9 +156,9 @@ def _pantograph_big_step(ck: Checker) -> None:
 
 
 def _pantograph_energy_100s(ck: Checker) -> None:
+    from .equations import PantographConfig, PantographODE
     from .modelfiles import E_THETA_Q, q_to_theta, theta_to_q
     from .mujoco import MujocoPantograph
-    from .reference import PantographConfig, PantographODE
 
     cfg = PantographConfig(cylinder="constant", viscous=False, coulomb=False)
     ode = PantographODE(config=cfg)

@@ -30,9 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from ...paths import models_root
+from .elbow import Elbow
+from .equations import PantographConfig, PantographODE
 from .params import PantographParams
 
 AXIS = "0 -1 0"
+RIGID_FIT_RANGE = (0.15, 0.75)  # theta_1 range (rad) of the rigid-elbow polynomial fit
 #: depth of the (visual) floor plane below the base hinge, m; the floor takes part in no contact
 FLOOR_DEPTH = 0.28
 
@@ -127,16 +130,18 @@ def urdf_text(p: PantographParams | None = None) -> str:
     )
 
 
-def _cfg_default():
-    from .reference import PantographConfig
+def rigid_elbow_fit(p: PantographParams, exact: bool = False) -> tuple[np.ndarray, float]:
+    """Quartic coefficients (ascending) of q2(q1) = pi - q1 - theta_e(q1) and the max fit error (rad) on the range."""
+    el = Elbow(p, exact)
+    q1 = np.linspace(*RIGID_FIT_RANGE, 201)
+    q2 = np.array([math.pi - a - el(a).theta_e for a in q1])
+    c = np.polynomial.polynomial.polyfit(q1, q2, 4)
+    err = float(np.max(np.abs(np.polynomial.polynomial.polyval(q1, c) - q2)))
+    return c, err
 
-    return PantographConfig()
 
-
-def _operating_state(p: PantographParams, cfg) -> tuple[np.ndarray, list[float]]:
+def _operating_state(p: PantographParams, cfg: PantographConfig) -> tuple[np.ndarray, list[float]]:
     """(qpos, act) of the static equilibrium at y_op (hand-derived path); act holds the cylinder state at rest."""
-    from .reference import PantographConfig, PantographODE
-
     ode = PantographODE(p, PantographConfig(**{**cfg.__dict__, "elbow": "compliant"}))
     x = ode.equilibrium()
     if cfg.elbow == "compliant":
@@ -159,7 +164,7 @@ def _config(values: dict[str, object]) -> str:
 
 
 def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None = None, timestep: float = 5e-4,
-              cfg=None, plugins: bool = True) -> str:
+              cfg: PantographConfig | None = None, plugins: bool = True) -> str:
     """The MJCF of the pantograph with exactly the effects of `cfg` (a `PantographConfig`; default: the lab scene's
     compliant elbow, linear cylinder, gravity, viscous and Coulomb friction, bilateral contact). The shipped
     `mjcf/pantograph.xml` is this text for the Table 3-I parameters and the default effects.
@@ -176,7 +181,7 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
     (`python_effects.py`, the readable reference of the plugins): no plugin, the cylinder a `user`-dynamics actuator
     on the lever site (force gain * act + bias), the elbow spring left to a passive callback."""
     p = p or PantographParams()
-    cfg = cfg or _cfg_default()
+    cfg = cfg or PantographConfig()
     lx, lz = lever_local(p)
     q_key, act_key = _operating_state(p, cfg)
     if q_operating is not None:
@@ -224,8 +229,6 @@ def mjcf_text(p: PantographParams | None = None, q_operating: np.ndarray | None 
     limit = ' forcelimited="true" forcerange="-1e+15 0"' if cfg.contact == "unilateral" else ""
     equality = ""
     if cfg.elbow == "rigid":
-        from .mujoco import rigid_elbow_fit
-
         coef, _ = rigid_elbow_fit(p, cfg.elbow_kinematics == "exact")
         equality = (f'  <equality>\n    <joint name="rigid_elbow" joint1="knuckle_joint" joint2="base_joint"\n'
                     f'           polycoef="{" ".join(_f(c) for c in coef)}" solref="{sf} 1"/>\n  </equality>\n')

@@ -33,25 +33,21 @@ from scipy.optimize import fsolve
 
 from ...engines import core, native
 from ...engines import mujoco_engine as mje
-from ...errors import GeometryError
-from .elbow import Elbow
-from .modelfiles import E_THETA_Q, mjcf_text, theta_to_q
+from ...errors import GeometryError, SceneError
+from ...health import judge
+from ...results import SimResult, assemble
+from ...scenes import Scene
+from .equations import PantographConfig, PantographODE
+from .health import excursion, step_figures
+from .inputs import Start, config_of, input_of, start_of
+from .linearise import modes_from_eigs
+from .modelfiles import E_THETA_Q, mjcf_text, rigid_elbow_fit, theta_to_q
+from .outputs import contact_losses, signals
 from .params import PantographParams
-from .reference import PantographConfig, PantographODE
 
-RIGID_FIT_RANGE = (0.15, 0.75)  # theta_1 range (rad) of the rigid-elbow polynomial fit
 #: plausibility bound on every joint angle (rad): the URDF's joint limits. A state beyond it is garbage, not physics.
 JOINT_BOUND = 2.0 * math.pi
-
-
-def rigid_elbow_fit(p: PantographParams, exact: bool = False) -> tuple[np.ndarray, float]:
-    """Quartic coefficients (ascending) of q2(q1) = pi - q1 - theta_e(q1) and the max fit error (rad) on the range."""
-    el = Elbow(p, exact)
-    q1 = np.linspace(*RIGID_FIT_RANGE, 201)
-    q2 = np.array([math.pi - a - el(a).theta_e for a in q1])
-    c = np.polynomial.polynomial.polyfit(q1, q2, 4)
-    err = float(np.max(np.abs(np.polynomial.polynomial.polyval(q1, c) - q2)))
-    return c, err
+MODES_TIMESTEP = 1e-4  # MuJoCo's discrete-time linearisation is mapped to continuous time by log(mu)/h
 
 
 @functools.lru_cache(maxsize=64)
@@ -176,15 +172,86 @@ class MujocoPantograph:
                             allow_callbacks=not self.plugins)
 
     def simulate(self, y_w: Callable[[np.ndarray], np.ndarray], t_end: float, q0: np.ndarray | None = None, *,
-                 every: int = 1, what: str = "pantograph (MuJoCo)", data: mujoco.MjData | None = None,
-                 guess: np.ndarray | None = None) -> core.Trajectory:
+                 every: int = 1, what: str = "pantograph (MuJoCo)",
+                 data: mujoco.MjData | None = None) -> core.Trajectory:
         """Step from the static equilibrium (or q0) at rest for t_end seconds under the ram y_w (vectorised callable
-        of time), recording every `every` steps; `guess` starts the equilibrium's Newton iteration. Failures raise
-        SolverError. With `data` (and q0) given, nothing of this object is touched: runs in several threads share
-        the model."""
+        of time), recording every `every` steps. Failures raise SolverError. With `data` (and q0) given, nothing of
+        this object is touched: runs in several threads share the model."""
         nstep = int(round(t_end / self.model.opt.timestep))
         y0 = float(np.asarray(y_w(np.zeros(1))).ravel()[0])
-        self.set_static(self.equilibrium(y0, guess) if q0 is None else q0, y0, data)
+        self.set_static(self.equilibrium(y0) if q0 is None else q0, y0, data)
         d = self.data if data is None else data
         d.time = 0.0
         return self.stepper(every, what, d).run(nstep, ctrl=self.ram_input(y_w, nstep), ctrl_idx=[self.i_cat])
+
+    def start_q(self, start: Start, y0: float) -> np.ndarray:
+        """Joint positions of a run's start (`inputs.start_of`) at ram height y0 = y_w(0): MuJoCo's own static
+        equilibrium (Newton from the hand-derived one) or the thesis' FORTRAN start as it stands."""
+        if start.at_rest:
+            return self.equilibrium(y0, theta_to_q(start.theta0))
+        return theta_to_q(start.x0[:3])
+
+
+def mujoco_modes(mp: MujocoPantograph, q0: np.ndarray, y_w: float) -> list[dict]:
+    """Modes from MuJoCo's own finite-difference linearisation (mjd_transitionFD) at rest at joint positions q0 under
+    ram height y_w, mapped to continuous time."""
+    m, d = mp.model, mp.data  # the MujocoPantograph's own copy of the model: edited here, restored after
+    if m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:  # mjd_transitionFD does not support RK4
+        raise SceneError("MuJoCo modes: mjd_transitionFD does not support the rk4 integrator; use another integrator")
+    nx = 2 * m.nv + m.na
+    A = np.zeros((nx, nx))
+    saved = m.dof_frictionloss.copy()
+    m.dof_frictionloss[:] = 0.0  # Coulomb friction is not linearisable: excluded, as in the reference linearisation
+    try:
+        mp.set_static(q0, y_w)
+        mujoco.mjd_transitionFD(m, d, 1e-7, True, A, None, None, None)
+    finally:
+        m.dof_frictionloss[:] = saved
+    mu = np.linalg.eigvals(A)
+    lam = np.log(mu.astype(complex)) / m.opt.timestep
+    return modes_from_eigs(lam)
+
+
+def run_mujoco(scene: Scene) -> SimResult:
+    """The MuJoCo path's run: the MJCF of exactly the scene's effects (module docstring) with the scene's integrator
+    and timestep, stepped by the native core under the ram input (sine/step/static), recorded every `sample_dt`.
+
+    Health figures: `stability_margin`, `nyquist_ratio` (sine input) and `excursion`. The first two are known before
+    stepping: a setting past its bound raises `AccuracyError` without running, unless `solver.allow_inaccurate`."""
+    p = scene.build_params()
+    cfg = config_of(scene)
+    ode = PantographODE(p, cfg)
+    u = input_of(scene, p)
+    s = scene.solver
+    start = start_of(scene, ode, u)
+    what = f"pantograph scene {scene.name or '(unnamed)'} (MuJoCo)"
+    pre = step_figures(scene, p, cfg, u)
+    if not s.allow_inaccurate:
+        judge(pre, what=what)  # raises AccuracyError before any step is taken
+    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
+    q0 = mp.start_q(start, u(0.0))
+    every = max(int(round((s.sample_dt or s.timestep) / s.timestep)), 1)
+    tr = mp.simulate(u, s.duration, q0, every=every, what=what)
+    P = tr["act"].reshape(tr.t.size, -1)[:, 0] if mp.model.na else None
+    th = thetas(tr["qpos"])
+    sig = signals(ode, th, u(tr.t), P)
+    ev = contact_losses(tr.t, sig["contact_force"]) if cfg.contact == "unilateral" else []
+    return assemble(scene, tr.t, sig, engine="mujoco", events=ev,
+                    stats={"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep,
+                           "warnings": tr.warnings}, health=[*pre, excursion(th, start.theta0)])
+
+
+def view_model(scene: Scene) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """The `mujoco_model` hook (`mbsuite view`): the compiled MuJoCo model of exactly the scene's effects with the
+    scene's integrator and timestep, and its data in the state a MuJoCo run starts from: the static equilibrium at
+    the ram height y_w(0) (or the scene's `initial = "fortran"` start), at rest, cylinder at rest,
+    ctrl[catenary] = y_w(0), after mj_forward."""
+    p = scene.build_params()
+    cfg = config_of(scene)
+    u = input_of(scene, p)
+    s = scene.solver
+    mp = MujocoPantograph(p, cfg, s.integrator, s.timestep)
+    y0 = u(0.0)
+    mp.set_static(mp.start_q(start_of(scene, PantographODE(p, cfg), u), y0), y0)
+    mp.data.time = 0.0
+    return mp.model, mp.data

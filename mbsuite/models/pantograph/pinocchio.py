@@ -17,9 +17,9 @@ from ...engines.pinocchio_engine import frame_id, load_mjcf, load_urdf
 from ...errors import GeometryError
 from ...paths import mjcf_path, urdf_path
 from .elbow import Elbow
-from .modelfiles import q_to_theta, theta_to_q
+from .equations import PantographConfig, PantographODE
+from .modelfiles import E_THETA_Q, q_to_theta, theta_to_q
 from .params import PantographParams
-from .reference import PantographConfig, PantographODE
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -108,8 +108,7 @@ class PinocchioPantograph:
 
 def reference_in_q(ode: PantographODE, q: np.ndarray) -> dict[str, np.ndarray]:
     """The hand-derived M, gravity force and contact Jacobian mapped to joint coordinates q (for cross-checks)."""
-    from .modelfiles import E_THETA_Q as E
-
+    E = E_THETA_Q
     th = q_to_theta(q)
     return {
         "M": E.T @ ode.mass_matrix_theta(th) @ E,

@@ -4,6 +4,7 @@ Plot functions return a `matplotlib.figure.Figure` (made with `mbsuite.plotting.
 chosen); write one with `mbsuite.plotting.save(fig, path)`. Symbols (defined on every figure):
 IN = y_w, the ram (input) height; F1 = l1 sin(theta_1), the lower arm's share of the contact height; F2 = l2
 sin(theta_2), the upper arm's; HD = lh sin(theta_h), the head's; y_d = F1 + F2 + HD, the contact-point height.
+The figures draw only the data they are given (curves and runs come from `freqresp.py`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from matplotlib.figure import Figure
 
 from ...plotting import figure
 
-THESIS_FREQS = (2.0, 3.5, 4.5, 6.5, 8.5, 10.0)
 THESIS_RESONANCES = (4.25, 8.75, 19.5)
 COLORS = {"linear": "k", "reference": "tab:blue", "mujoco": "tab:orange", "mujoco_no_coulomb": "tab:green"}
 STYLES = {"linear": "-", "reference": "o", "mujoco": "x", "mujoco_no_coulomb": "+"}
@@ -85,10 +85,3 @@ def plot_time_histories(runs: Mapping[float, object], window: float = 1.0) -> Fi
     fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))
     return fig
 
-
-def time_history_runs(scene, freqs: tuple[float, ...] = THESIS_FREQS) -> dict[float, object]:
-    """MuJoCo runs of `scene` under a sine ram at each frequency (outputs y_w, HD, F2, F1) for `plot_time_histories`."""
-    from .analysis import run
-
-    return {f: run(scene.replace(input={"type": "sine", "frequency": f}, solver={"engine": "mujoco"},
-                                 outputs=["y_w", "HD", "F2", "F1"])) for f in freqs}

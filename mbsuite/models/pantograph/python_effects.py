@@ -15,8 +15,8 @@ from collections.abc import Callable
 import mujoco
 
 from .elbow import Elbow
+from .equations import PantographConfig, PantographODE
 from .params import PantographParams
-from .reference import PantographConfig, PantographODE
 
 
 class PythonEffects:

@@ -1,5 +1,6 @@
 """This pantograph under a catenary: two adapters that implement the catenary's pantograph protocol, one per engine
-path, made by `make(params, effects, engine, timestep)` (the model's `ModelSpec.under_wire`).
+path (`PATHS`, keyed like the model's path table `SPEC.paths`), made by `make(params, effects, engine, timestep)` (the
+model's `ModelSpec.under_wire`).
 
 The protocol (defined by the catenary, met here by structure only; this module imports no catenary code). The
 catenary advances its wire with the trapezoidal rule, so over one step of length dt the contact force f (>= 0 pushes
@@ -37,6 +38,7 @@ catenary's penalty spring and its own `contact` law (unilateral or bilateral); t
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import Any
 
 import mujoco
@@ -45,24 +47,19 @@ import numpy as np
 from ...engines import core
 from ...engines.mujoco_engine import warnings_raised
 from ...errors import ParameterError, SceneError, SolverError
+from .equations import PantographConfig, PantographODE
 from .modelfiles import q_to_theta
 from .mujoco import MujocoPantograph
 from .params import PantographParams
-from .reference import PantographConfig, PantographODE
-
-ENGINES = ("reference", "mujoco")
 
 
-def config(effects: dict[str, Any] | None, engine: str) -> PantographConfig:
+def config(effects: dict[str, Any] | None, coulomb_law: Callable[[bool | str], bool | str]) -> PantographConfig:
     """The pantograph's effects under the wire for an engine path (module docstring): the model's defaults for the
     effects not given, the ram contact bilateral (the catenary owns the contact law), Coulomb friction as the path can
-    integrate it at a fixed step (reference: smooth law; MuJoCo: frictionloss)."""
+    integrate it at a fixed step (`coulomb_law` of the path's adapter)."""
     eff = {**dataclasses.asdict(PantographConfig()), **(effects or {})}
     eff["contact"] = "bilateral"
-    if engine == "reference" and eff["coulomb"] is True:
-        eff["coulomb"] = "smooth"
-    elif engine == "mujoco" and eff["coulomb"] == "smooth":
-        eff["coulomb"] = True  # MuJoCo's frictionloss is its own regularised Coulomb law
+    eff["coulomb"] = coulomb_law(eff["coulomb"])
     return PantographConfig(**eff)
 
 
@@ -84,11 +81,21 @@ class EppingerReference:
                  name: str = "eppinger"):
         self.name = name
         self.params = PantographParams(**(params or {}))
-        self.cfg = config(effects, "reference")
+        self.cfg = config(effects, self.coulomb_law)
         self.ode = PantographODE(self.params, self.cfg)
         self.y_op = self.params.y_op
         self.x = np.zeros(self.ode.n)
         self._pending = None
+
+    @classmethod
+    def build(cls, params: dict[str, Any], effects: dict[str, Any], timestep: float) -> EppingerReference:
+        """`make`'s constructor: RK4 takes each step the catenary asks for, whatever its length."""
+        return cls(params, effects)
+
+    @staticmethod
+    def coulomb_law(coulomb: bool | str) -> bool | str:
+        """Coulomb friction at the catenary's fixed step: `true` is read as the smooth law (module docstring)."""
+        return "smooth" if coulomb is True else coulomb
 
     def static(self, y_wire: float, k_wire: float) -> float:
         """Static equilibrium under the wire at height y_w; returns the contact force."""
@@ -139,7 +146,7 @@ class EppingerMujoco:
                  timestep: float = 1e-4, integrator: str = "implicitfast", name: str = "eppinger"):
         self.name = name
         self.params = PantographParams(**(params or {}))
-        self.cfg = config(effects, "mujoco")
+        self.cfg = config(effects, self.coulomb_law)
         self.sim = MujocoPantograph(self.params, self.cfg, integrator=integrator, timestep=timestep)
         m, d = self.m, self.d = self.sim.model, self.sim.data
         self.y_op = self.params.y_op
@@ -158,6 +165,16 @@ class EppingerMujoco:
         self._state = np.empty(n)
         self._pending = np.empty(n)
         self._holds = None  # which state the data holds with its kinematics: "committed", "trial" or None
+
+    @classmethod
+    def build(cls, params: dict[str, Any], effects: dict[str, Any], timestep: float) -> EppingerMujoco:
+        """`make`'s constructor: the model is built with the catenary's time step."""
+        return cls(params, effects, timestep=timestep)
+
+    @staticmethod
+    def coulomb_law(coulomb: bool | str) -> bool | str:
+        """MuJoCo's frictionloss is its own regularised Coulomb law: `smooth` is read as `true`."""
+        return True if coulomb == "smooth" else coulomb
 
     def _height(self) -> float:
         mujoco.mj_kinematics(self.m, self.d)
@@ -237,14 +254,17 @@ class EppingerMujoco:
         return warnings_raised(self.d)
 
 
+#: the pantograph under the wire on each engine path, keyed like the model's path table `SPEC.paths`
+PATHS: dict[str, type[EppingerReference] | type[EppingerMujoco]] = {"reference": EppingerReference,
+                                                                      "mujoco": EppingerMujoco}
+
+
 def make(params: dict[str, Any], effects: dict[str, Any], engine: str, timestep: float):
     """The Eppinger pantograph under the wire on an engine path: `params` overrides `PantographParams`, `effects` are
     this model's (defaults for the rest), `timestep` the catenary's step (s)."""
-    if engine == "reference":
-        return EppingerReference(params, effects)
-    if engine == "mujoco":
-        return EppingerMujoco(params, effects, timestep=timestep)
-    raise SceneError(f"the pantograph has no engine path {engine!r} under the wire; valid: {list(ENGINES)}")
+    if engine not in PATHS:
+        raise SceneError(f"the pantograph has no engine path {engine!r} under the wire; valid: {list(PATHS)}")
+    return PATHS[engine].build(params, effects, timestep)
 
 
 def static_force(params: dict[str, Any] | None = None, k_contact: float = 5.0e4) -> float:

@@ -16,7 +16,7 @@ import mbsuite
 from mbsuite.cli import main
 from mbsuite.errors import GeometryError, ModelFileError
 from mbsuite.limits import undeclared
-from mbsuite.models.coupler import analysis
+from mbsuite.models.coupler import analysis, criteria
 from mbsuite.models.coupler.double import solve_double_wrapped_batch
 from mbsuite.models.coupler.params import CouplerParams
 from mbsuite.models.coupler.reference import revolution_guess
@@ -76,7 +76,7 @@ def test_admissibility_boundary(e_y):
 @pytest.mark.parametrize("l_b", [2.0, 4.0])
 def test_c5_extremum_converged_against_brute_force(l_b):
     p = CouplerParams(l_b=l_b, phi_bc=math.pi / 2)
-    c = analysis.double_c5(p, 0.1, n=61)
+    c = criteria.double_c5(p, 0.1, n=61)
     # brute force: 4096 samples over [0, 2 pi) (no closing sample) by the batched FPP, a different solver path
     N = 4096
     phi = np.arange(N) * 2 * math.pi / N
@@ -96,12 +96,12 @@ def test_c5_extremum_converged_against_brute_force(l_b):
     assert c["c5"] == pytest.approx(y1 - 0.25 * (y0 - y2) * x, rel=1e-9)
     assert c["mean"] == pytest.approx(mean, abs=1e-13)  # trapezoid-free periodic mean
     assert (c["c5"] - c["c5_sampled"]) / c["c5"] > 5e-3  # 61 samples alone under-read by 0.53-0.55 %
-    assert analysis.double_c5(p, 0.1, n=31)["c5"] == pytest.approx(c["c5"], rel=1e-9)  # independent of the grid
+    assert criteria.double_c5(p, 0.1, n=31)["c5"] == pytest.approx(c["c5"], rel=1e-9)  # independent of the grid
 
 
 def test_periodic_mean_counts_the_closing_sample_once():
     x = np.linspace(0, 2 * math.pi, 7)
-    assert analysis.periodic_mean(1.0 + np.cos(x)) == pytest.approx(1.0, abs=1e-15)  # closed-grid mean: 1.142857
+    assert criteria.periodic_mean(1.0 + np.cos(x)) == pytest.approx(1.0, abs=1e-15)  # closed-grid mean: 1.142857
 
 
 def test_regression_criteria_table_double_c5(capsys):

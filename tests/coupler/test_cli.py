@@ -85,10 +85,10 @@ def test_figures_draw_on_given_axes():
     """Plot functions return a Figure, or draw on the Axes they are given (no pyplot)."""
     from matplotlib.figure import Figure
 
-    from mbsuite.models.coupler import plots
+    from mbsuite.models.coupler import criteria, plots
 
     p = CouplerParams()
-    revs = plots.revolutions(p, alphas=(0.035,), n=25)
+    revs = criteria.revolutions(p, alphas=(0.035,), n=25)
     fig = Figure()
     ax = fig.subplots()
     assert plots.fig6(p, revs, ax=ax) is ax and len(ax.lines) == 2  # the curve and the zero line

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mbsuite.errors import GeometryError, ParameterError, SolverError
-from mbsuite.models.coupler import analysis
+from mbsuite.models.coupler import analysis, criteria
 from mbsuite.models.coupler.double import (
     double_quasi_static,
     double_residual,
@@ -119,13 +119,13 @@ def test_single_fpp_full_revolution_continuation_largest_misalignment():
 
 def test_c1_quadratic_in_alpha_period_pi_independent_of_ey():
     p = CouplerParams(e_y=0.1)
-    c = [analysis.single_criteria(p, a, 121) for a in (0.02, 0.04)]
+    c = [criteria.single_criteria(p, a, 121) for a in (0.02, 0.04)]
     # parabolic in alpha (Sect. 3.4): ratio 4 (1 + O(alpha^2)), measured 4.0008; bound 5x the deviation
     assert c[1]["c1"] / c[0]["c1"] == pytest.approx(4.0, rel=1e-3)
     d = c[1]["rev"].phi_a[:-1] - c[1]["rev"].u[:-1, 0]
     spec = np.abs(np.fft.rfft(d - d.mean()))
     assert int(np.argmax(spec)) == 2  # two oscillations per revolution (not one, as Sect. 3.4 says of Fig 6)
-    c3 = analysis.single_criteria(CouplerParams(e_y=0.3), 0.04, 121)
+    c3 = criteria.single_criteria(CouplerParams(e_y=0.3), 0.04, 121)
     assert c3["c1"] == pytest.approx(c[1]["c1"], rel=1e-9)  # "virtually not influenced by e_y" (Sect. 3.4): measured 0
     # c2 "proportional to" alpha (Sect. 3.4): measured ratio 1.9655 for doubling alpha (1.7 % below 2); bound 3x
     assert c[1]["c2"] / c[0]["c2"] == pytest.approx(2.0, rel=0.05)
@@ -136,13 +136,13 @@ def test_c1_quadratic_in_alpha_period_pi_independent_of_ey():
 
 
 def test_c1_improves_with_slimmer_platform():
-    c = [analysis.single_criteria(CouplerParams(gamma=g), 0.05, 61)["c1"] for g in (0.11, 0.297, 0.391)]
+    c = [criteria.single_criteria(CouplerParams(gamma=g), 0.05, 61)["c1"] for g in (0.11, 0.297, 0.391)]
     assert c[0] < c[1] < c[2]
 
 
 def test_double_homokinetic_at_phibc_0_not_at_pi_2():
-    c0 = analysis.double_c5(CouplerParams(), 0.08, n=37)
-    c90 = analysis.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=37)
+    c0 = criteria.double_c5(CouplerParams(), 0.08, n=37)
+    c90 = criteria.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=37)
     # phi_bc = 0: full homokineticity (Sect. 4.3) although the intermediate shaft fluctuates (measured 1.7e-16
     # vs 5.0e-4)
     assert c0["c5"] < 1e-12 < 1e-4 < c0["c1_intermediate"]
@@ -150,8 +150,8 @@ def test_double_homokinetic_at_phibc_0_not_at_pi_2():
     assert c90["c5"] == pytest.approx(2 * c90["c1_intermediate"], rel=0.05)
     # inclined output shaft: shaft b barely tilts, coupler 2 takes the whole angle, so c5 is the single coupler's c1 at
     # alpha = 0.03 (a different FPP, 4 unknowns): measured 2.2 % below it; bound 4.5x
-    ci = analysis.double_c5(CouplerParams(), 0.0, alpha_cx=0.03, n=37)
-    assert ci["c5"] == pytest.approx(analysis.single_criteria(CouplerParams(), 0.03, 121)["c1"], rel=0.1)
+    ci = criteria.double_c5(CouplerParams(), 0.0, alpha_cx=0.03, n=37)
+    assert ci["c5"] == pytest.approx(criteria.single_criteria(CouplerParams(), 0.03, 121)["c1"], rel=0.1)
 
 
 def test_double_fpp_revolution_phibc_90_no_jump():

@@ -20,6 +20,7 @@ from ...errors import GeometryError, SceneError, SolverError
 from ...hardcases import Checker, HardCase
 from ...scenes import Scene
 from . import analysis
+from .criteria import double_c5
 from .double import double_residual, double_residual_jac, double_revolution, ramp_double, solve_double
 from .jacobian import analyse_jacobian, single_jacobian
 from .params import CouplerParams
@@ -126,7 +127,7 @@ def _coupler_phibc90(ck: Checker) -> None:
     ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-4)
     # the simulated output fluctuation is the paper's criterion: p-p of phi_a - phi_c over the settled revolution vs
     # 2 c5 from the continuation FPP with c5 located between samples (a different solver path); measured 3.9e-4 rel.
-    c5 = analysis.double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=19)
+    c5 = double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=19)
     w = res.t >= res.stats["window_start"]
     ck.le("MuJoCo p-p(phi_a - phi_c) vs the FPP's 2 c5 (relative)",
           abs(np.ptp(res["phi_a"][w] - res["phi_c"][w]) / c5["c5_pp"] - 1), 2e-3)

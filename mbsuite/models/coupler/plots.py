@@ -1,12 +1,13 @@
-"""Figures of the coupler analyses, in the style of Maniowski & Czauderna's Figs 6-10, plus the FPP revolution and
-the double-coupler dynamics run.
+"""Figures of the coupler analyses, in the style of Maniowski & Czauderna's Figs 6-10, plus the FPP revolution and the
+double-coupler dynamics run.
 
-Every function draws on the `Axes` it is given or returns a new `matplotlib.figure.Figure` (`mbsuite.plotting`);
-none selects a backend or touches pyplot. Lengths are in metres (the paper's non-dimensional model is R = 1 m),
-angles in radians. Symbols (defined again on each figure): phi_a, phi_b, phi_c the spin angles of shafts a, b, c;
-O_b = (x_b, y_b, z_b) the centre of platform B; alpha_b its imposed inclination; gamma the platform proportion angle;
-e_y the axial shift between the platforms; beta1 (azimuth in the platform plane) and beta2 (elevation out of it) the
-direction of a link seen from a platform, index 0 = aligned pose; c1-c5 the quality criteria (Eqs 16-20).
+Every function draws only the data it is given (no solving), on the `Axes` it is given or on a new
+`matplotlib.figure.Figure` (`mbsuite.plotting`); none selects a backend or touches pyplot. Lengths are in metres (the
+paper's non-dimensional model is R = 1 m), angles in radians. Symbols (defined again on each figure): phi_a, phi_b,
+phi_c the spin angles of shafts a, b, c; O_b = (x_b, y_b, z_b) the centre of platform B; alpha_b its imposed
+inclination; gamma the platform proportion angle; e_y the axial shift between the platforms; beta1 (azimuth in the
+platform plane) and beta2 (elevation out of it) the direction of a link seen from a platform, index 0 = aligned pose;
+c1-c5 the quality criteria (Eqs 16-20).
 """
 
 from __future__ import annotations
@@ -21,9 +22,6 @@ from matplotlib.figure import Figure
 
 from ...plotting import figure, save
 from .params import CouplerParams
-
-#: inclinations alpha_b [rad] of Figs 6-8 (1, 2 and 3 degrees)
-FIG_ALPHAS = (0.0175, 0.035, 0.0525)
 
 _PI_TICKS = ([0.0, math.pi / 2, math.pi, 1.5 * math.pi, 2 * math.pi], ["0", "π/2", "π", "3π/2", "2π"])
 
@@ -44,16 +42,9 @@ def _target(ax: Any, size: tuple[float, float]) -> tuple[Figure | None, Any]:
     return figure(1, 1, size=size)
 
 
-def revolutions(p: CouplerParams, alphas: Sequence[float] = FIG_ALPHAS, n: int = 181) -> list[dict]:
-    """`analysis.single_criteria` at each inclination alpha_b (the data of Figs 6-8)."""
-    from .analysis import single_criteria
-
-    return [single_criteria(p, a, n) | {"alpha_b": a} for a in alphas]
-
-
 def fig6(p: CouplerParams, revs: list[dict], ax: Any = None) -> Figure | Any:
     """Fig 6: output-angle fluctuation phi_a - phi_b - pi/2 over one revolution (its largest |.| about the mean is c1,
-    Eq 16)."""
+    Eq 16). `revs` as `criteria.revolutions` (so are Figs 7 and 8's)."""
     fig, ax = _target(ax, (8.0, 4.2))
     for c in revs:
         rev = c["rev"]
@@ -248,8 +239,8 @@ def dynamics_figure(res: Any) -> Figure:
     return fig
 
 
-def figs678(p: CouplerParams, out: Path) -> list[Path]:
-    """Write Figs 6-8 (fig6_phi_difference.png, fig7_centre_path.png, fig8_link_angles.png) for geometry `p`."""
-    revs = revolutions(p)
+def figs678(p: CouplerParams, revs: list[dict], out: Path) -> list[Path]:
+    """Write Figs 6-8 (fig6_phi_difference.png, fig7_centre_path.png, fig8_link_angles.png) of geometry `p` from the
+    revolutions `revs` (`criteria.revolutions`)."""
     return [save(fig6(p, revs), out / "fig6_phi_difference.png"), save(fig7(p, revs), out / "fig7_centre_path.png"),
             save(fig8(p, revs), out / "fig8_link_angles.png")]

@@ -26,8 +26,8 @@ from mujoco import rollout
 import mbsuite
 from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.model import reference_signal
-from mbsuite.models.drives.mujoco_path import MujocoRotorSim
+from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.models.drives.scene_run import reference_signal
 from mbsuite.paths import mjcf_path
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene, shipped_scenes

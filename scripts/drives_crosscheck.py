@@ -14,7 +14,7 @@ import sys
 import numpy as np
 
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.model import simulate_scene
+from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
 

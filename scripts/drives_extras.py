@@ -10,15 +10,10 @@ import numpy as np
 
 from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.friction import (
-    Friction,
-    Part,
-    RotorSystem,
-    Spring,
-    simulate_reference,
-    simulate_velocity_band,
-)
-from mbsuite.models.drives.model import simulate_scene
+from mbsuite.models.drives.analysis import simulate_scene
+from mbsuite.models.drives.event_exact import simulate_reference
+from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Spring
+from mbsuite.models.drives.velocity_band import simulate_velocity_band
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
 

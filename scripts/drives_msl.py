@@ -10,8 +10,8 @@ import argparse
 import json
 
 from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.friction import simulate_reference
-from mbsuite.models.drives.mujoco_path import MujocoRotorSim
+from mbsuite.models.drives.event_exact import simulate_reference
+from mbsuite.models.drives.mujoco import MujocoRotorSim
 from mbsuite.paths import mjcf_path
 from mbsuite.results import format_table
 

@@ -11,8 +11,8 @@ import json
 import numpy as np
 
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.analysis import efficiency_point
-from mbsuite.models.drives.model import reference_signal, simulate_scene
+from mbsuite.models.drives.analysis import efficiency_point, simulate_scene
+from mbsuite.models.drives.scene_run import reference_signal
 from mbsuite.results import format_table, to_jsonable
 from mbsuite.scenes import load_scene
 

@@ -1,7 +1,7 @@
 """The PWM storage time in controller samples: the step-up drive at duty 0.35, t_l = 0.2 s (hand path).
 
 At 500 Hz the storage phase is duty x t_l x fs = 35 samples; 0.35 * 0.2 * 500 = 34.99999999999999 in binary floating
-point, which a plain int() truncates to 34. `friction.time_to_samples` rounds a duration to the nearest sample.
+point, which a plain int() truncates to 34. `commands.time_to_samples` rounds a duration to the nearest sample.
 Prints the storage count the controller uses and the mean motor speed, load/motor speed ratio and input energy.
 
 Usage: .venv/bin/python scripts/drives_storage_time.py [--json FILE]   (about 20 s)
@@ -15,7 +15,7 @@ import json
 import numpy as np
 
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.model import simulate_scene
+from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.scenes import load_scene
 
 

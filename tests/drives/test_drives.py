@@ -11,7 +11,7 @@ from mbsuite.engines import mujoco_engine
 from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.drives import controllers as C
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.model import simulate_scene
+from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.registry import get_model
 from mbsuite.scenes import load_scene
 
@@ -27,7 +27,7 @@ def _sim(name, **solver):
 
 def test_spec_and_scenes_registered():
     spec = get_model("drives")
-    assert spec.run is not None
+    assert spec.paths and all(path.run is not None for path in spec.paths.values())
     assert {"coupled_clutches", "step_up_pwm", "susd_100w_design", "susd_500w_step"} <= set(spec.scene_files())
 
 
@@ -318,7 +318,7 @@ def test_bad_parameter_combinations():
 
 def test_delay_samples_one_conversion():
     """0.3 ms at 10 kHz is 3 samples everywhere (int(0.0003 * 10000) = 2 in binary floating point)."""
-    from mbsuite.models.drives.friction import CommandQueue, delay_samples
+    from mbsuite.models.drives.commands import CommandQueue, delay_samples
 
     assert int(0.0003 * 10000) == 2  # the trap
     assert delay_samples(0.0003, 10000.0) == 3
@@ -384,7 +384,8 @@ def test_velocity_band_scheme_compares():
     (measured 6.2e-3 rad/s) stays below 2e-2 (3.2x) and is at least 10x that of the event-exact hand path on the same
     grid (measured 6.0e-5: 103x) - the scheme creeps where the exact path holds."""
     from mbsuite.models.drives import coupled_clutches as cc
-    from mbsuite.models.drives.friction import simulate_reference, simulate_velocity_band
+    from mbsuite.models.drives.event_exact import simulate_reference
+    from mbsuite.models.drives.velocity_band import simulate_velocity_band
 
     band = simulate_velocity_band(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
     exact = simulate_reference(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
@@ -406,7 +407,7 @@ def test_storage_time_nearest_sample_over_grid():
     arithmetic (decimal strings as fractions; ties up), over a grid of duty x t_l x fs, through the controller."""
     from fractions import Fraction
 
-    from mbsuite.models.drives.friction import time_to_samples
+    from mbsuite.models.drives.commands import time_to_samples
 
     q = w = np.zeros(3)
     n_trap = 0

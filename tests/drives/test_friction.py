@@ -10,8 +10,9 @@ import pytest
 
 from mbsuite.errors import ParameterError
 from mbsuite.models.drives import coupled_clutches as cc
-from mbsuite.models.drives.friction import Friction, Part, RotorSystem, Source, Spring, simulate_reference
-from mbsuite.models.drives.mujoco_path import MujocoRotorSim
+from mbsuite.models.drives.event_exact import simulate_reference
+from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Source, Spring
 from mbsuite.paths import mjcf_path
 
 

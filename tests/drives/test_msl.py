@@ -21,9 +21,9 @@ from scipy.optimize import brentq
 
 from mbsuite.errors import ParameterError
 from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.friction import simulate_reference
-from mbsuite.models.drives.model import simulate_scene
-from mbsuite.models.drives.mujoco_path import MujocoRotorSim
+from mbsuite.models.drives.analysis import simulate_scene
+from mbsuite.models.drives.event_exact import simulate_reference
+from mbsuite.models.drives.mujoco import MujocoRotorSim
 from mbsuite.paths import mjcf_path
 from mbsuite.scenes import load_scene
 

@@ -13,16 +13,10 @@ from mbsuite.engines.signals import Pulse, Step
 from mbsuite.errors import ParameterError, SceneError, SolverError
 from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.friction import (
-    Friction,
-    Part,
-    ReferenceSimulator,
-    RotorSystem,
-    Source,
-    simulate_reference,
-)
-from mbsuite.models.drives.model import simulate_scene
-from mbsuite.models.drives.mujoco_path import MujocoRotorSim
+from mbsuite.models.drives.analysis import simulate_scene
+from mbsuite.models.drives.event_exact import ReferenceSimulator, simulate_reference
+from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Source
 from mbsuite.paths import mjcf_path
 from mbsuite.scenes import load_scene
 
@@ -219,7 +213,7 @@ def test_bad_input_named():
 
 def test_rotor_stepper_step_and_advance():
     """The Python twin as a step object: advancing in pieces (and single steps) is the run in one go."""
-    from mbsuite.models.drives.mujoco_path import RotorRun
+    from mbsuite.models.drives.rotor_run import RotorRun
     from mbsuite.models.drives.stepper import RotorStepper
 
     sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=DT)
@@ -246,3 +240,22 @@ def test_reference_simulator_step_object():
     res = sim.advance(cc.T_END).result()
     assert sim.done and res.events == whole.events and np.array_equal(res.w, whole.w)
     assert res.stats == whole.stats
+
+
+def test_step_objects_meet_the_protocol():
+    """The hand path's `ReferenceSimulator` and the Python twin `RotorStepper` are `mbsuite.stepping.StepObject`s;
+    `run(t_end)` steps to t_end and `status` says when the run is finished."""
+    from mbsuite.models.drives.rotor_run import RotorRun
+    from mbsuite.models.drives.stepper import RotorStepper
+    from mbsuite.stepping import StepObject
+
+    ref = ReferenceSimulator(cc.build_system(), cc.Q0, cc.W0, 0.2, sample_dt=5e-4)
+    sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=DT)
+    twin = RotorStepper(RotorRun(sim, cc.Q0, cc.W0, 0.2, sample_dt=1e-3))
+    for obj in (ref, twin):
+        assert isinstance(obj, StepObject)
+        assert obj.status == "running" and obj.t == 0.0
+        obj.run(0.1)
+        assert obj.t >= 0.1 - 1e-12 and obj.status == "running"
+        obj.run(0.2)
+        assert obj.status == "finished"

@@ -8,7 +8,7 @@ import pytest
 from mbsuite.cli import main
 from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.drives import design as D
-from mbsuite.models.drives.model import check_profile
+from mbsuite.models.drives.scene_run import check_profile
 
 SUSD = ('model = "drives"\n[effects]\nmechanism = "step_up_down"\nparam_set = "design_100w"\n'
         'controller = "energy_packet"\nclosed_loop = true\n[input]\ntype = "reference"\nprofile = {profile}\n'

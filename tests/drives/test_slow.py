@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from mbsuite.models.drives import drive
-from mbsuite.models.drives.analysis import efficiency_point
-from mbsuite.models.drives.model import reference_signal, simulate_scene
+from mbsuite.models.drives.analysis import efficiency_point, simulate_scene
+from mbsuite.models.drives.scene_run import reference_signal
 from mbsuite.scenes import load_scene
 
 pytestmark = pytest.mark.slow

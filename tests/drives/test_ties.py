@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from mbsuite.models.drives import drive
-from mbsuite.models.drives import friction as F
-from mbsuite.models.drives.model import DRIVE_ENERGY_BOUND, simulate_scene
+from mbsuite.models.drives import event_exact as F
+from mbsuite.models.drives.analysis import simulate_scene
+from mbsuite.models.drives.scene_run import DRIVE_ENERGY_BOUND
 from mbsuite.scenes import load_scene
 
 RESIDUE = 1e-11  # rad/s: the size of the residues seen at located events (|slip| 1e-12 ... 1e-11)

@@ -1,9 +1,10 @@
 """Switched-mode mechanical drives (Oldaker 1997): step-up and step-up/step-down three-mass models with event-exact
 clutches, switching controllers, losses and Chapter 5 design tools; plus Modelica's CoupledClutches as an outside check.
 
-Two independent paths: the hand-derived event-exact stick/slip simulation (`friction.simulate_reference`) and MuJoCo
-(`mujoco_path.MujocoRotorSim`, hinge rotors with real equality locks, its state machine a native stepper of mbsuite's
-C core). Suite declarations (hard cases, work-precision study, random inputs) in `cases.py`. See README.md.
+Two independent paths (`SPEC.paths`): the hand-derived event-exact stick/slip simulation (`equations.run` on
+`event_exact.simulate_reference`) and MuJoCo (`mujoco.run` on `mujoco.MujocoRotorSim`, hinge rotors with real equality
+locks, its state machine a native stepper of mbsuite's C core). Suite declarations (hard cases, work-precision study,
+random inputs) in `cases.py`. See README.md (its Files table says where everything is).
 """
 
 from __future__ import annotations
@@ -13,8 +14,9 @@ from pathlib import Path
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from .model import SIGNALS, run
+from . import equations, mujoco
 from .params import PARAM_SETS, DriveParams
+from .scene_run import SIGNALS
 
 SPEC = ModelSpec(
     name="drives",
@@ -52,9 +54,11 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="step_up_pwm",
     paths={
-        "reference": RunPath(run, "equations", "hand-derived equations (Oldaker Ch. 3), event-exact stick/slip "
-                                               "(scipy DOP853 between events)"),
-        "mujoco": RunPath(run, "mujoco", "MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
+        "reference": RunPath(run=equations.run, label="equations",
+                             what="hand-derived equations (Oldaker Ch. 3), event-exact stick/slip (scipy DOP853 "
+                                  "between events)"),
+        "mujoco": RunPath(run=mujoco.run, label="mujoco",
+                          what="MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
     },
     cases="mbsuite.models.drives.cases",
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),

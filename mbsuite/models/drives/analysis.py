@@ -1,4 +1,5 @@
-"""Analyses returning `Report`s: efficiency sweeps (Eqs 3.21-3.24 corrected), path cross-checks, design tables."""
+"""Analyses of drives scenes: a scene on its path keeping the controller and the rotor system (`simulate_scene`),
+efficiency sweeps (Eqs 3.21-3.24 corrected), the CoupledClutches check of both paths, the design tables."""
 
 from __future__ import annotations
 
@@ -10,11 +11,23 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
+from ...paths import mjcf_path
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
+from . import coupled_clutches as cc
 from . import design as D
-from . import drive
-from .model import simulate_scene
+from . import drive, equations, mujoco
+from .event_exact import simulate_reference
+from .rotor_system import RefResult, RotorSystem
+
+#: each path's simulation of a scene, returning (result, controller, rotor system) for the analyses: the runs behind
+#: `SPEC.paths` ("reference" = `equations.run`, "mujoco" = `mujoco.run`) before their `SimResult` is assembled
+SIMULATE = {"reference": equations.simulate, "mujoco": mujoco.simulate}
+
+
+def simulate_scene(scene: Scene) -> tuple[RefResult, Any, RotorSystem]:
+    """Run a scene on its path (`SIMULATE`); returns (result, controller, rotor system)."""
+    return SIMULATE[scene.solver.engine](scene)
 
 
 def steady_window(scene: Scene) -> float:
@@ -160,3 +173,31 @@ def design_tables() -> Report:
         return [write_csv(out / "design_tables.csv", cols), save(fig, out / "design_tables.png")]
 
     return Report(data, table + "\n'ours' and 'thesis' are in the unit of the row.", write)
+
+
+def coupled_clutches_table(timestep: float = 1e-4) -> dict[str, Any]:
+    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s (MuJoCo at
+    `timestep`)."""
+    ref = cc.load_reference()
+    rev = cc.reference_events(ref)
+    out: dict[str, Any] = {"reference_events": rev}
+    system = cc.build_system()
+    grid = np.round(np.arange(0.0, cc.T_END + 1e-9, 0.1), 10)
+    j_ref = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
+    out["grid"] = grid.tolist()
+    out["w_ref"] = ref["w"][:, j_ref].T.tolist()
+    runs = {"reference": lambda: simulate_reference(system, cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3),
+            "mujoco": lambda: mujoco.MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=timestep).run(
+                cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)}
+    for eng, simulate in runs.items():
+        res = simulate()
+        ev = cc.events_as_codes(res.events)
+        rows = cc.match_events(ev, rev)
+        idx = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
+        w = res.w[:, idx].T
+        dts = [r["t"] - r["t_ref"] for r in rows if r["t"] is not None and r["t_ref"] is not None]
+        out[eng] = {"events": rows, "w": w.tolist(),
+                    "same_sequence": all(r["t"] is not None and r["t_ref"] is not None for r in rows),
+                    "max_event_dt": float(max(abs(x) for x in dts)) if dts else math.nan,
+                    "max_w_err": float(np.max(np.abs(w - np.asarray(out["w_ref"]))))}
+    return out

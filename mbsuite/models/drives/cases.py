@@ -16,8 +16,9 @@ from ...hardcases import Checker, HardCase
 from ...paths import mjcf_path
 from ...scenes import Scene
 from . import coupled_clutches as cc
-from .friction import Friction, Part, RotorSystem, Source, Spring, simulate_reference
-from .mujoco_path import MujocoRotorSim
+from .event_exact import simulate_reference
+from .mujoco import MujocoRotorSim
+from .rotor_system import Friction, Part, RotorSystem, Source, Spring
 
 
 # ================================================================================================ hard cases

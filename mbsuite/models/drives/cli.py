@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import textwrap
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +15,11 @@ from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene
+from . import coupled_clutches as cc
 from . import design as D
+from .analysis import coupled_clutches_table, design_tables, efficiency, simulate_scene
 from .plots import cadjs_figure, coupled_clutches_figure, loss_label, run_figure
+from .scene_run import sim_result
 
 #: names and units of the cycle statistics of a drive run (`drive.cycle_stats`)
 CYCLE_QUANTITIES = {"n_cycles": ("energy cycles in the window t >= t_settle", ""),
@@ -110,14 +114,15 @@ def _check_steps(flag: str, duration: float, dt: float) -> None:
 def _csv_writer(name: str, columns: list[tuple[str, str, list]], figure=None):
     """A `Report.write`: `name`.csv from `(column, unit, values)` and, if `figure` (a callable returning a Figure)
     is given, `name`.png."""
+    return partial(_write_csv, name, columns, figure)
 
-    def write(out: Path) -> list[Path]:
-        files = [write_csv(Path(out) / f"{name}.csv", columns)]
-        if figure is not None:
-            files.append(save(figure(), Path(out) / f"{name}.png"))
-        return files
 
-    return write
+def _write_csv(name: str, columns: list[tuple[str, str, list]], figure, out: Path) -> list[Path]:
+    """The files of a design command's `--out`: `name`.csv and, with a figure, `name`.png."""
+    files = [write_csv(Path(out) / f"{name}.csv", columns)]
+    if figure is not None:
+        files.append(save(figure(), Path(out) / f"{name}.png"))
+    return files
 
 
 def _quantity_table(items: list[tuple[str, str, float | str, str]]) -> str:
@@ -126,10 +131,10 @@ def _quantity_table(items: list[tuple[str, str, float | str, str]]) -> str:
                         [[k, m, (f"{v:.6g}" if isinstance(v, float) else v), u] for k, m, v, u in items])
 
 
-def register(sub, add_common, emit) -> None:
+def register(sub, add_common, emit) -> str:
     """Add the `drive` command group (alias `drives`) to the top-level parser: design tools, scene runs, efficiency
-    sweeps and the CoupledClutches check. Every command prints a table with units; `--out DIR` writes CSV (SI units
-    in the header), a PNG where a figure makes sense and summary.json."""
+    sweeps and the CoupledClutches check; returns the group's command name. Every command prints a table with units;
+    `--out DIR` writes CSV (SI units in the header), a PNG where a figure makes sense and summary.json."""
     p = sub.add_parser("drive", aliases=["drives"],
                        help="switched-mode drives: design tools, runs, efficiency, CoupledClutches")
     dsub = p.add_subparsers(dest="drive_command", required=True)
@@ -140,23 +145,13 @@ def register(sub, add_common, emit) -> None:
 
     q = ds.add_parser("tables", help="reproduce Tables 5.2 and 6.2 and the controller gains")
     add_common(q)
-    q.set_defaults(func=lambda a: emit(__import__(f"{__package__}.analysis", fromlist=["x"]).design_tables(), a, None))
+    q.set_defaults(func=partial(design_tables_cmd, emit))
 
     q = ds.add_parser("srmin", help="Eq 5.1: minimum switching rate")
     for k in ("P", "wmin", "wrip", "Jl"):
         q.add_argument(f"--{k}", type=float, required=True)
     add_common(q)
-
-    def _srmin(a):
-        _check_options(a, "--P", "--wmin", "--wrip", "--Jl")
-        v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
-        items = [("P", "drive power", a.P, "W"), ("w_min", "lowest load speed", a.wmin, "rad/s"),
-                 ("w_rip", "allowed speed ripple", a.wrip, "rad/s"), ("J_l", "load inertia", a.Jl, "kg m^2"),
-                 ("Sr_min", "minimum switching rate (Eq 5.1)", v, "1/s")]
-        emit(Report({"Sr_min": v}, _quantity_table(items),
-                    _csv_writer("srmin", [(k, u, [x]) for k, _, x, u in items])), a, None)
-
-    q.set_defaults(func=_srmin)
+    q.set_defaults(func=partial(srmin_cmd, emit))
 
     q = ds.add_parser("cadjs", help="CADJS: K, clutch torque, x_max, Sr_max per J_s (Eqs 5.9-5.13 corrected)")
     q.add_argument("--P", type=float, required=True)
@@ -167,29 +162,7 @@ def register(sub, add_common, emit) -> None:
     q.add_argument("--js", type=_floats("--js"), default=None, help="comma list (default 1e-5 ... 1e-4)")
     q.add_argument("--tau-c", type=float, default=None, help="read the family at this clutch torque")
     add_common(q)
-
-    def _cadjs(a):
-        _check_options(a, "--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c")
-        _check_speed_range(a.wmin, a.wmax)
-        rows, data = [], []
-        for sr in a.srmin:
-            ds_ = ([D.at_clutch_torque(a.P, sr, a.wmin, a.wmax, a.vm, a.tau_c)] if a.tau_c
-                   else D.cadjs(a.P, sr, a.wmin, a.wmax, a.vm, a.js))
-            for d in ds_:
-                rows.append([sr, d.J_s, d.K, d.tau_c, d.x_max, d.Sr_max, d.capacity])
-                data.append({"Sr_min": sr, "J_s": d.J_s, "K": d.K, "tau_c": d.tau_c, "x_max": d.x_max,
-                             "Sr_max": d.Sr_max, "capacity": d.capacity})
-        units = ["1/s", "kg m^2", "N m/rad", "N m", "rad", "1/s", "J"]
-        names = ["Sr_min", "J_s", "K", "tau_c", "x_max", "Sr_max", "capacity"]
-        table = format_table([f"{n} [{u}]" for n, u in zip(names, units, strict=True)], rows, ".4g")
-        table += "\n" + textwrap.fill(
-            "Sr_min/Sr_max: lowest/highest switching rate; J_s: spring-system inertia; K: spring rate; tau_c: clutch "
-            "torque; x_max: largest spring twist; capacity: spring energy 1/2 K x_max^2 (Eqs 5.9-5.13 corrected).", 100)
-        fig = (lambda: cadjs_figure(data)) if len(data) > len(a.srmin) else None
-        cols = [(n, u, [r[i] for r in rows]) for i, (n, u) in enumerate(zip(names, units, strict=True))]
-        emit(Report({"designs": data}, table, _csv_writer("cadjs", cols, fig)), a, None)
-
-    q.set_defaults(func=_cadjs)
+    q.set_defaults(func=partial(cadjs_cmd, emit))
 
     q = ds.add_parser("springsz", help="SPRINGSZ: wire diameter, D*N and volume (Eqs 5.14-5.21)")
     q.add_argument("--K", type=float, required=True)
@@ -199,21 +172,7 @@ def register(sub, add_common, emit) -> None:
                    help="ultimate tensile stress, Pa (default: calibrated to the thesis' 1.58e-4 m^3, not a material)")
     q.add_argument("--E", type=float, default=D.E_TABLE_6_3, help="Young's modulus, Pa (default: implied by Table 6.3)")
     add_common(q)
-
-    def _spr(a):
-        _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
-        r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
-        items = [("K", "spring rate", a.K, "N m/rad"), ("x_max", "largest twist", a.xmax, "rad"),
-                 ("fatigue", "allowed / ultimate tensile stress", a.fatigue, "1"),
-                 ("sigma_uts", "ultimate tensile stress", a.sigma_uts, "Pa"), ("E", "Young's modulus", a.E, "Pa"),
-                 ("d", "wire diameter (Eq 5.21)", r["d"], "m"),
-                 ("DN", "coil diameter x number of turns (Eq 5.14)", r["DN"], "m"),
-                 ("V", "spring volume (Eq 5.19)", r["V"], "m^3"),
-                 ("V_check", "pi^2 DN d^2 (same volume from d, DN)", r["V_check"], "m^3")]
-        emit(Report(r, _quantity_table(items), _csv_writer("springsz", [(k, u, [x]) for k, _, x, u in items])),
-             a, None)
-
-    q.set_defaults(func=_spr)
+    q.set_defaults(func=partial(springsz_cmd, emit))
 
     q = ds.add_parser("gains", help="gain selection (Eqs 5.32-5.37) and stability line (5.36)")
     for k in ("Jl", "ts", "taul", "w0"):
@@ -221,30 +180,7 @@ def register(sub, add_common, emit) -> None:
     q.add_argument("--btotal", type=float, default=None, help="default: Eq 5.38 from --P")
     q.add_argument("--P", type=float, default=None)
     add_common(q)
-
-    def _gains(a):
-        _check_options(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
-        if a.btotal is None:
-            if a.P is None:
-                raise SceneError("give --btotal or --P (Eq 5.38)")
-            a.btotal = D.b_total(a.P, a.w0, a.taul)
-        kp, ki = D.gains(a.Jl, a.ts, a.btotal, a.taul, a.w0)
-        poles = D.closed_loop_poles(kp, ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
-        kp_crit = D.stability_kp(ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
-        data = {"B_total": a.btotal, "Kp": kp, "KI": ki, "poles": [complex(x).real for x in poles],
-                "Kp_stability_line": kp_crit}
-        items = [("J_l", "load inertia", a.Jl, "kg m^2"), ("t_s", "energy-cycle period", a.ts, "s"),
-                 ("tau_l", "load torque", a.taul, "N m"), ("w0", "operating speed", a.w0, "rad/s"),
-                 ("B_total", "total viscous coefficient (Eq 5.38 if not given)", a.btotal, "N m s"),
-                 ("Kp", "proportional gain (Eqs 5.32-5.37)", kp, "kg m^2"),
-                 ("KI", "integral gain", ki, "kg m^2/s")]
-        items += [(f"pole_{i + 1}", "closed-loop pole in z (real part)", float(x), "1")
-                  for i, x in enumerate(data["poles"])]
-        items += [("Kp_stability_line", "K_p on the stability line (Eq 5.36)", kp_crit, "kg m^2")]
-        emit(Report(data, _quantity_table(items), _csv_writer("gains", [(k, u, [x]) for k, _, x, u in items])),
-             a, None)
-
-    q.set_defaults(func=_gains)
+    q.set_defaults(func=partial(gains_cmd, emit))
 
     # -- run / efficiency ----------------------------------------------------------------------------------------
     q = dsub.add_parser("run", help="simulate a drive scene: cycle statistics, energy balance, lock events")
@@ -252,29 +188,7 @@ def register(sub, add_common, emit) -> None:
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
     add_common(q)
-
-    def _run(a):
-        sc = _scene(a)
-        res = sc.spec.run(sc)
-        eb = res.stats["energy_balance"]
-        cyc = res.stats.get("cycles", {})
-        rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
-                ["events", "clutch/brake mode changes", len(res.events), ""]]
-        rows += [[k, *CYCLE_QUANTITIES.get(k, (k, ""))[:1], v, CYCLE_QUANTITIES.get(k, (k, ""))[1]]
-                 for k, v in cyc.items()]
-        rows += [["E_in", "input energy", eb["input"], "J"], ["E_out", "output energy", eb["output"], "J"],
-                 ["stored", "change of stored energy", eb["stored"], "J"],
-                 ["balance", "energy residual / turnover", eb["relative"], "1"]]
-        rows += [[f"loss_{k}", loss_label(k), v, "J"] for k, v in eb["losses"].items()]
-
-        def write(out: Path) -> list[Path]:
-            return [res.write_csv(Path(out) / "timeseries.csv"), save(run_figure(res), Path(out) / "run.png")]
-
-        rep = Report({"summary": res.summary(), "stats": res.stats}, _quantity_table(
-            [(k, m, float(v) if isinstance(v, float | np.floating) else str(v), u) for k, m, v, u in rows]), write)
-        emit(rep, a, sc.to_dict())
-
-    q.set_defaults(func=_run)
+    q.set_defaults(func=partial(run_cmd, emit))
 
     q = dsub.add_parser("efficiency", help="open-loop efficiency vs steady load speed over load torques")
     q.add_argument("scene")
@@ -282,61 +196,166 @@ def register(sub, add_common, emit) -> None:
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
     add_common(q)
-
-    def _eff(a):
-        from .analysis import efficiency
-
-        _check_options(a, "--loads")
-        sc = _scene(a)
-        loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
-        emit(efficiency(sc, loads, engine=a.engine), a, sc.to_dict())
-
-    q.set_defaults(func=_eff)
+    q.set_defaults(func=partial(efficiency_cmd, emit))
 
     q = dsub.add_parser("coupled-clutches", help="Modelica CoupledClutches: both paths vs the Dymola reference")
     q.add_argument("--timestep", type=float, default=1e-4)
     add_common(q)
+    q.set_defaults(func=partial(coupled_clutches_cmd, emit))
+    return "drive"
 
-    def _cc(a):
-        from . import coupled_clutches as cc
-        from .model import coupled_clutches_table
 
-        _check_options(a, "--timestep")
-        _check_steps("--timestep", cc.T_END, a.timestep)
-        d = coupled_clutches_table(timestep=a.timestep)
-        mode = {v: k for k, v in cc.MODE_CODE.items()}
-        rows = []
-        for i, r in enumerate(d["reference"]["events"]):
-            m = d["mujoco"]["events"][i]
-            rows.append([r["element"], mode.get(r["from"], r["from"]), mode.get(r["to"], r["to"]), r["t_ref"],
-                         r["t"], m["t"], None if r["t"] is None else r["t"] - r["t_ref"],
-                         None if m["t"] is None or r["t"] is None else m["t"] - r["t"]])
-        t1 = format_table(["clutch", "from", "to", "t_Dymola [s]", "t_hand [s]", "t_MuJoCo [s]", "hand-Dym [s]",
-                           "MuJoCo-hand [s]"], [r[:6] + [_e(x) for x in r[6:]] for r in rows], ".10g")
-        w_ref, w_h, w_m = (np.asarray(x) for x in (d["w_ref"], d["reference"]["w"], d["mujoco"]["w"]))
-        rows2 = [[g, *(np.round(wr, 6) + 0.0), _e(np.max(np.abs(wh - wr))), _e(np.max(np.abs(wm - wh)))]
-                 for g, wr, wh, wm in zip(d["grid"], w_ref, w_h, w_m, strict=True)]
-        t2 = format_table(["t [s]"] + [f"w{k} [rad/s]" for k in range(1, 5)]
-                          + ["dw hand-Dym [rad/s]", "dw MuJoCo-hand [rad/s]"], rows2, ".6g")
-        t2 += ("\nw1..w4: speeds of the inertias J1..J4 (Dymola reference, rounded to 1e-6); dw: largest"
-               " |difference|\nover w1..w4 (every path's values: --out DIR, coupled_clutches_w.csv).")
-        ev_cols = [("clutch", "", [r[0] for r in rows]), ("from", "", [r[1] for r in rows]),
-                   ("to", "", [r[2] for r in rows])]
-        ev_cols += [(n, "s", [_nan(r[i]) for r in rows]) for i, n in enumerate(
-            ("t_dymola", "t_hand", "t_mujoco", "hand_minus_dymola", "mujoco_minus_hand"), start=3)]
-        w_cols = [("t", "s", d["grid"])] + [(f"{src}_w{k + 1}", "rad/s", w[:, k]) for src, w in
-                                            (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
+# ---- the commands (each takes the top-level `emit` and the parsed arguments) -----------------------------------------
+def design_tables_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive design tables`: Tables 5.2 and 6.2 and the controller gains (`analysis.design_tables`)."""
+    emit(design_tables(), a, None)
 
-        def write(out: Path) -> list[Path]:
-            ref = cc.load_reference()
-            fig = coupled_clutches_figure(d, ref["t"], ref["w"])
-            return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
-                    write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),
-                    save(fig, Path(out) / "coupled_clutches.png")]
 
-        emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2, write), a, None)
+def srmin_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive design srmin`: Eq 5.1."""
+    _check_options(a, "--P", "--wmin", "--wrip", "--Jl")
+    v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
+    items = [("P", "drive power", a.P, "W"), ("w_min", "lowest load speed", a.wmin, "rad/s"),
+             ("w_rip", "allowed speed ripple", a.wrip, "rad/s"), ("J_l", "load inertia", a.Jl, "kg m^2"),
+             ("Sr_min", "minimum switching rate (Eq 5.1)", v, "1/s")]
+    emit(Report({"Sr_min": v}, _quantity_table(items),
+                _csv_writer("srmin", [(k, u, [x]) for k, _, x, u in items])), a, None)
 
-    q.set_defaults(func=_cc)
+
+def cadjs_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive design cadjs`: the CADJS families (Eqs 5.9-5.13 corrected), or one read at --tau-c."""
+    _check_options(a, "--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c")
+    _check_speed_range(a.wmin, a.wmax)
+    rows, data = [], []
+    for sr in a.srmin:
+        ds_ = ([D.at_clutch_torque(a.P, sr, a.wmin, a.wmax, a.vm, a.tau_c)] if a.tau_c
+               else D.cadjs(a.P, sr, a.wmin, a.wmax, a.vm, a.js))
+        for d in ds_:
+            rows.append([sr, d.J_s, d.K, d.tau_c, d.x_max, d.Sr_max, d.capacity])
+            data.append({"Sr_min": sr, "J_s": d.J_s, "K": d.K, "tau_c": d.tau_c, "x_max": d.x_max,
+                         "Sr_max": d.Sr_max, "capacity": d.capacity})
+    units = ["1/s", "kg m^2", "N m/rad", "N m", "rad", "1/s", "J"]
+    names = ["Sr_min", "J_s", "K", "tau_c", "x_max", "Sr_max", "capacity"]
+    table = format_table([f"{n} [{u}]" for n, u in zip(names, units, strict=True)], rows, ".4g")
+    table += "\n" + textwrap.fill(
+        "Sr_min/Sr_max: lowest/highest switching rate; J_s: spring-system inertia; K: spring rate; tau_c: clutch "
+        "torque; x_max: largest spring twist; capacity: spring energy 1/2 K x_max^2 (Eqs 5.9-5.13 corrected).", 100)
+    fig = partial(cadjs_figure, data) if len(data) > len(a.srmin) else None
+    cols = [(n, u, [r[i] for r in rows]) for i, (n, u) in enumerate(zip(names, units, strict=True))]
+    emit(Report({"designs": data}, table, _csv_writer("cadjs", cols, fig)), a, None)
+
+
+def springsz_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive design springsz`: SPRINGSZ (Eqs 5.14-5.21)."""
+    _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
+    r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
+    items = [("K", "spring rate", a.K, "N m/rad"), ("x_max", "largest twist", a.xmax, "rad"),
+             ("fatigue", "allowed / ultimate tensile stress", a.fatigue, "1"),
+             ("sigma_uts", "ultimate tensile stress", a.sigma_uts, "Pa"), ("E", "Young's modulus", a.E, "Pa"),
+             ("d", "wire diameter (Eq 5.21)", r["d"], "m"),
+             ("DN", "coil diameter x number of turns (Eq 5.14)", r["DN"], "m"),
+             ("V", "spring volume (Eq 5.19)", r["V"], "m^3"),
+             ("V_check", "pi^2 DN d^2 (same volume from d, DN)", r["V_check"], "m^3")]
+    emit(Report(r, _quantity_table(items), _csv_writer("springsz", [(k, u, [x]) for k, _, x, u in items])),
+         a, None)
+
+
+def gains_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive design gains`: gain selection (Eqs 5.32-5.37), closed-loop poles and the stability line (5.36)."""
+    _check_options(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
+    if a.btotal is None:
+        if a.P is None:
+            raise SceneError("give --btotal or --P (Eq 5.38)")
+        a.btotal = D.b_total(a.P, a.w0, a.taul)
+    kp, ki = D.gains(a.Jl, a.ts, a.btotal, a.taul, a.w0)
+    poles = D.closed_loop_poles(kp, ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
+    kp_crit = D.stability_kp(ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
+    data = {"B_total": a.btotal, "Kp": kp, "KI": ki, "poles": [complex(x).real for x in poles],
+            "Kp_stability_line": kp_crit}
+    items = [("J_l", "load inertia", a.Jl, "kg m^2"), ("t_s", "energy-cycle period", a.ts, "s"),
+             ("tau_l", "load torque", a.taul, "N m"), ("w0", "operating speed", a.w0, "rad/s"),
+             ("B_total", "total viscous coefficient (Eq 5.38 if not given)", a.btotal, "N m s"),
+             ("Kp", "proportional gain (Eqs 5.32-5.37)", kp, "kg m^2"),
+             ("KI", "integral gain", ki, "kg m^2/s")]
+    items += [(f"pole_{i + 1}", "closed-loop pole in z (real part)", float(x), "1")
+              for i, x in enumerate(data["poles"])]
+    items += [("Kp_stability_line", "K_p on the stability line (Eq 5.36)", kp_crit, "kg m^2")]
+    emit(Report(data, _quantity_table(items), _csv_writer("gains", [(k, u, [x]) for k, _, x, u in items])),
+         a, None)
+
+
+def run_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive run`: a scene on its path with cycle statistics, energy balance and lock events."""
+    sc = _scene(a)
+    res = sim_result(sc, *simulate_scene(sc))
+    eb = res.stats["energy_balance"]
+    cyc = res.stats.get("cycles", {})
+    rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
+            ["events", "clutch/brake mode changes", len(res.events), ""]]
+    rows += [[k, *CYCLE_QUANTITIES.get(k, (k, ""))[:1], v, CYCLE_QUANTITIES.get(k, (k, ""))[1]]
+             for k, v in cyc.items()]
+    rows += [["E_in", "input energy", eb["input"], "J"], ["E_out", "output energy", eb["output"], "J"],
+             ["stored", "change of stored energy", eb["stored"], "J"],
+             ["balance", "energy residual / turnover", eb["relative"], "1"]]
+    rows += [[f"loss_{k}", loss_label(k), v, "J"] for k, v in eb["losses"].items()]
+    rep = Report({"summary": res.summary(), "stats": res.stats}, _quantity_table(
+        [(k, m, float(v) if isinstance(v, float | np.floating) else str(v), u) for k, m, v, u in rows]),
+        partial(_write_run, res))
+    emit(rep, a, sc.to_dict())
+
+
+def _write_run(res, out: Path) -> list[Path]:
+    """The files of `drive run --out`: the time series and the run figure."""
+    return [res.write_csv(Path(out) / "timeseries.csv"), save(run_figure(res), Path(out) / "run.png")]
+
+
+def efficiency_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive efficiency`: open-loop efficiency over load torques (`analysis.efficiency`)."""
+    _check_options(a, "--loads")
+    sc = _scene(a)
+    loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
+    emit(efficiency(sc, loads, engine=a.engine), a, sc.to_dict())
+
+
+def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
+    """`drive coupled-clutches`: both paths against the Dymola reference (`analysis.coupled_clutches_table`)."""
+    _check_options(a, "--timestep")
+    _check_steps("--timestep", cc.T_END, a.timestep)
+    d = coupled_clutches_table(timestep=a.timestep)
+    mode = {v: k for k, v in cc.MODE_CODE.items()}
+    rows = []
+    for i, r in enumerate(d["reference"]["events"]):
+        m = d["mujoco"]["events"][i]
+        rows.append([r["element"], mode.get(r["from"], r["from"]), mode.get(r["to"], r["to"]), r["t_ref"],
+                     r["t"], m["t"], None if r["t"] is None else r["t"] - r["t_ref"],
+                     None if m["t"] is None or r["t"] is None else m["t"] - r["t"]])
+    t1 = format_table(["clutch", "from", "to", "t_Dymola [s]", "t_hand [s]", "t_MuJoCo [s]", "hand-Dym [s]",
+                       "MuJoCo-hand [s]"], [r[:6] + [_e(x) for x in r[6:]] for r in rows], ".10g")
+    w_ref, w_h, w_m = (np.asarray(x) for x in (d["w_ref"], d["reference"]["w"], d["mujoco"]["w"]))
+    rows2 = [[g, *(np.round(wr, 6) + 0.0), _e(np.max(np.abs(wh - wr))), _e(np.max(np.abs(wm - wh)))]
+             for g, wr, wh, wm in zip(d["grid"], w_ref, w_h, w_m, strict=True)]
+    t2 = format_table(["t [s]"] + [f"w{k} [rad/s]" for k in range(1, 5)]
+                      + ["dw hand-Dym [rad/s]", "dw MuJoCo-hand [rad/s]"], rows2, ".6g")
+    t2 += ("\nw1..w4: speeds of the inertias J1..J4 (Dymola reference, rounded to 1e-6); dw: largest"
+           " |difference|\nover w1..w4 (every path's values: --out DIR, coupled_clutches_w.csv).")
+    ev_cols = [("clutch", "", [r[0] for r in rows]), ("from", "", [r[1] for r in rows]),
+               ("to", "", [r[2] for r in rows])]
+    ev_cols += [(n, "s", [_nan(r[i]) for r in rows]) for i, n in enumerate(
+        ("t_dymola", "t_hand", "t_mujoco", "hand_minus_dymola", "mujoco_minus_hand"), start=3)]
+    w_cols = [("t", "s", d["grid"])] + [(f"{src}_w{k + 1}", "rad/s", w[:, k]) for src, w in
+                                        (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
+    ref = cc.load_reference()
+    write = partial(_write_coupled_clutches, d, ref["t"], ref["w"], ev_cols, w_cols)
+    emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2, write), a, None)
+
+
+def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,
+                            out: Path) -> list[Path]:
+    """The files of `drive coupled-clutches --out`: events and speeds as CSV, the comparison figure."""
+    fig = coupled_clutches_figure(d, ref_t, ref_w)
+    return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
+            write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),
+            save(fig, Path(out) / "coupled_clutches.png")]
 
 
 def _e(x: float | None) -> str:

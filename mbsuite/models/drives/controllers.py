@@ -1,7 +1,7 @@
 """Switching controllers of the drives (thesis App. E and App. F, reconstructed from the printed C listings).
 
 Every controller is sampled at `fs` and returns the commanded clutch/brake states; the actuation delays are applied by
-`friction.CommandQueue` (quantised to samples, as the thesis' shift registers). Rotor order: motor 0, spring 1, load 2.
+`commands.CommandQueue` (quantised to samples, as the thesis' shift registers). Rotor order: motor 0, spring 1, load 2.
 The same controller object drives the hand-derived and the MuJoCo paths (as the thesis ran the prototype's C code in
 its simulator, Sec. 4.3.5).
 """
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError
-from .friction import delay_samples, time_to_samples
+from .commands import delay_samples, time_to_samples
 
 STEP_UP_CONTROLLERS = ("pwm", "resonant", "motor_resonant")
 SUSD_CONTROLLERS = ("energy_packet",)

@@ -17,7 +17,7 @@ import numpy as np
 from ...engines.signals import Signal, Sine, Step
 from ...errors import ModelFileError
 from ...paths import models_root
-from .friction import Friction, Part, RotorSystem, Source
+from .rotor_system import Friction, Part, RotorSystem, Source
 
 T_END = 1.5
 FN_MAX = 20.0

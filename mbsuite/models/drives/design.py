@@ -3,7 +3,7 @@
 * `srmin` (5.1): minimum switching rate from the ripple specification.
 * `cadjs` (5.9-5.11, 5.13 corrected): for each spring-system inertia J_s the spring rate K, clutch torque, maximum
   extension and maximum switching rate; `at_clutch_torque` reads the family at a given clutch torque (Tables 5.2, 6.2).
-* `cadk` (5.12 corrected): J_s for a given K (quadratic with a spurious root rejected by (5.11)).
+* `js_from_k` (5.12 corrected): J_s for a given K (quadratic with a spurious root rejected by (5.11)).
 * `springsz` (5.14-5.21): wire diameter, D*N and volume of a helical torsion spring with a fatigue factor.
 * Discrete controller model (5.22-5.25), gain selection (5.32-5.37) and the stability line (5.36).
 Assumptions of the component-selection model (Sec. 5.1.1): frictionless, instant clutches, constant motor speed.
@@ -116,15 +116,6 @@ def cadjs(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, J_s=N
     """CADJS: the family over J_s (default 1e-5 ... 1e-4 as the toolbox)."""
     J_s = np.arange(1, 11) * 1e-5 if J_s is None else np.atleast_1d(J_s)
     return [design_point(P, Sr_min, w_min, w_max, V_m, float(j)) for j in J_s]
-
-
-def cadk(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, K) -> list[Design]:
-    """CADK: as CADJS but for given spring rates (J_s from the corrected Eq 5.12)."""
-    out = []
-    for k in np.atleast_1d(K):
-        js = js_from_k(P, Sr_min, w_min, V_m, float(k))
-        out.append(design_point(P, Sr_min, w_min, w_max, V_m, js))
-    return out
 
 
 def at_clutch_torque(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, tau_c: float) -> Design:

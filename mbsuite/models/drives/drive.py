@@ -1,4 +1,5 @@
-"""The two drives as `RotorSystem`s (Eqs 3.1-3.6) and their simulation in both paths, with losses and energy balance.
+"""The two drives as `RotorSystem`s (Eqs 3.1-3.6) with their controllers, and the analysis of a run: energy balance,
+cycle statistics, energy packets, the comparison of two runs.
 
 Step-up (Fig. 3.3): motor -K- spring end; brake spring end -> ground; clutch spring end -> load (Eqs 3.1-3.3).
 Step-up/step-down (Fig. 3.4): spring system -K- ground; clutch a motor -> spring; clutch b spring -> load (3.4-3.6).
@@ -18,10 +19,10 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError, SceneError
-from ...paths import mjcf_path
+from .commands import delay_samples
 from .controllers import EnergyPacketController, StepUpController
-from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring, delay_samples, simulate_reference
 from .params import motor_line
+from .rotor_system import Friction, Part, RefResult, RotorSystem, Source, Spring
 
 ROTORS = ["motor", "spring", "load"]
 T0_TOL = 1e-9  # s: window starts compare controller times with this tolerance
@@ -130,25 +131,6 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
                                   anti_windup=anti_windup)
 
 
-def run_paths(system: RotorSystem, mechanism: str, make_controller, t_end: float, engines=("reference", "mujoco"),
-              sample_dt: float = 1e-3, timestep: float = 1e-4, rtol: float = 1e-9, atol: float = 1e-11
-              ) -> dict[str, tuple[RefResult, Any]]:
-    """Simulate with a fresh controller per engine. Returns {engine: (result, controller)}."""
-    out = {}
-    q0 = w0 = np.zeros(3)
-    for eng in engines:
-        ctrl = make_controller()
-        if eng == "reference":
-            res = simulate_reference(system, q0, w0, t_end, controller=ctrl, sample_dt=sample_dt, rtol=rtol, atol=atol)
-        else:
-            from .mujoco_path import MujocoRotorSim
-
-            sim = MujocoRotorSim(system, mjcf_path(f"drive_{mechanism}"), timestep=timestep)
-            res = sim.run(q0, w0, t_end, controller=ctrl, sample_dt=sample_dt)
-        out[eng] = (res, ctrl)
-    return out
-
-
 @dataclass
 class Balance:
     """Energy balance of a run over a window [J]: input, output, losses by term, change of stored energy,
@@ -185,11 +167,6 @@ def energy_balance(system: RotorSystem, res: RefResult, i0: int = 0, i1: int = -
     stored = ke1 + pe1 - ke0 - pe0
     resid = e_in - e_out - sum(d.values()) - stored
     return Balance(e_in, e_out, d, stored, resid)
-
-
-def lock_times(res: RefResult, element: str, to: str = "stuck") -> np.ndarray:
-    """Times [s] at which `element` changed to mode `to` (default: locked up)."""
-    return np.array([e["t"] for e in res.events if e["element"] == element and e["to"] == to])
 
 
 def cycle_stats(res: RefResult, ctrl, t0: float = 0.0) -> dict[str, Any]:
@@ -341,10 +318,3 @@ def energy_packets(system: RotorSystem, res: RefResult, ctrl, t0: float = 0.0) -
         out["demand"].append(float(e.get("eps", 0.0)))
         out["dir"].append(float(e.get("dir", 1)))
     return {k: np.asarray(v, float) for k, v in out.items()}
-
-
-def peak_spring_energies(system: RotorSystem, ctrl) -> np.ndarray:
-    """1/2 K theta_peak^2 at each transfer (the spring system's peak potential energy; not the packet size - see
-    `energy_packets`)."""
-    K = system.springs[0].K
-    return np.array([0.5 * K * e["theta_peak"] ** 2 for e in ctrl.log if e["event"] == "transferred"])

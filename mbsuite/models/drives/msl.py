@@ -12,7 +12,7 @@ Components (reusable parts of the drives package, equations of `Modelica/Mechani
 * `ideal_gear_row` (`Components.IdealGear`): w_a = ratio w_b, flange b as a row over the rotors;
 * torque sources from `mbsuite.engines.signals` (Step, Sine, Pulse, Ramp) and `quadratic_speed_torque`
   (`Sources.QuadraticSpeedDependentTorque`, TorqueDirection = true: tau = tau_nominal (w/w_nominal)^2);
-* spring-damper: `friction.Spring` with `D` (`Components.SpringDamper`: tau = c phi_rel + d w_rel).
+* spring-damper: `rotor_system.Spring` with `D` (`Components.SpringDamper`: tau = c phi_rel + d w_rel).
 
 Examples: `Friction` (3 s), `OneWayClutch` (2 s), `OneWayClutchDisengaged` (2 s), `SimpleGearShift` (5 s), each
 an `Example` with its rotor system, initial state, compared signals on the reference's names and mode conventions.
@@ -32,7 +32,7 @@ import numpy as np
 from ...engines.signals import Pulse, Ramp, Signal, Sine, Step
 from ...errors import ModelFileError, ParameterError
 from ...paths import models_root
-from .friction import Friction, Part, RefResult, RotorSystem, Source, Spring
+from .rotor_system import Friction, Part, RefResult, RotorSystem, Source, Spring
 
 MU0 = 0.5  #: Modelica's default mu_pos = [0, 0.5]
 EPS0 = 1.0e-4  #: OneWayClutch: relative hysteresis epsilon (tau0_max_low = eps0 mu0 cgeo fn_max)

@@ -17,11 +17,8 @@ import numpy as np
 
 from ...engines import core, mujoco_engine, native
 from ...engines.signals import Signal
-from .mujoco_path import CHUNK, HINT, RotorRun
-
-FREE = 2
-#: chattering: an element changing mode CHATTER_N + 1 times within CHATTER_WINDOW steps stops the run
-CHATTER_N, CHATTER_WINDOW = 16, 64
+from .rotor_run import CHATTER_N, CHATTER_WINDOW, CHUNK, HINT, RotorRun
+from .rotor_system import FREE
 
 _P = ctypes.c_void_p
 _LONG = np.dtype(f"i{ctypes.sizeof(ctypes.c_long)}")

@@ -134,7 +134,7 @@ def run_figure(res: Any) -> Figure:
 def coupled_clutches_figure(table: Mapping[str, Any], ref_t: np.ndarray, ref_w: np.ndarray) -> Figure:
     """CoupledClutches: the speeds w1..w4 of the four inertias J1..J4 [rad/s] of the Dymola reference (lines) with the
     hand path and MuJoCo on the 0.1 s grid (markers), and the differences on that grid (lower panel). `table` is
-    `model.coupled_clutches_table()`; `ref_t`, `ref_w` the reference series (`coupled_clutches.load_reference()`)."""
+    `analysis.coupled_clutches_table()`; `ref_t`, `ref_w` the reference series (`coupled_clutches.load_reference()`)."""
     fig, (ax0, ax1) = figure(2, 1, size=(10.0, 7.0), sharex=True, height_ratios=(2.0, 1.0))
     grid = np.asarray(table["grid"])
     w_ref = np.asarray(table["w_ref"])

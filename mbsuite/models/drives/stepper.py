@@ -10,7 +10,8 @@ checked. `advance(t)` steps up to t and `result()` makes the final decision at t
 
 Every method mirrors the C function of the same name statement for statement (plain loops, the same floating-point
 operations in the same order), so that a test can hold the two paths equal. It exists to be read and to check the
-native stepper; runs use the native one (`MujocoRotorSim.run(..., stepper="python")` selects this one).
+native stepper; runs use the native one (`MujocoRotorSim.run(..., stepper="python")` selects this one). About 530
+lines: it mirrors `native/drives.c` function for function and is kept in one file to be read beside it.
 """
 
 from __future__ import annotations
@@ -22,9 +23,8 @@ import mujoco
 import numpy as np
 
 from ...errors import SolverError
-from .friction import BWD, FREE, FWD, STUCK, RefResult
-from .mujoco_path import HINT, RotorRun
-from .native_stepper import CHATTER_N, CHATTER_WINDOW
+from .rotor_run import CHATTER_N, CHATTER_WINDOW, HINT, RotorRun
+from .rotor_system import BWD, FREE, FWD, STUCK, RefResult
 
 ZERO_SLIP = 1e-12  # rad/s: a free element engaging at a smaller slip is tried for a lock
 _INTEGRATE = {
@@ -49,7 +49,7 @@ class RotorStepper:
     """A run of a rotor system on MuJoCo, one step at a time (module docstring)."""
 
     def __init__(self, run: RotorRun):
-        self.run = run
+        self.rotor_run = run
         self.m, self.d = run.m, run.d
         sim, sys = run.sim, run.sys
         self.n, self.ne = sys.n, len(sys.frictions)
@@ -103,7 +103,7 @@ class RotorStepper:
 
     def levels(self, t: float) -> tuple[list[float], list[float]]:
         """Sliding torque of every part and element at t under the current commands (C: levels)."""
-        run = self.run
+        run = self.rotor_run
         el = [0.0] * self.ne
         lv = []
         for p, pt in enumerate(self.parts):
@@ -123,7 +123,7 @@ class RotorStepper:
 
     def shape(self, s: int, t: float) -> float:
         """Value of source shape s at time t (1 without a shape)."""
-        sig = self.run.shapes[s]
+        sig = self.rotor_run.shapes[s]
         return 1.0 if sig is None else sig(t)
 
     def slips(self) -> None:
@@ -291,10 +291,10 @@ class RotorStepper:
             d.ctrl[self.act[e]] = self.act_sign[e] * tau
         for s, a in enumerate(self.src):
             v = self.shape(s, t)
-            so = self.run.sys.sources[s]
+            so = self.rotor_run.sys.sources[s]
             if so.c2 != 0.0:
                 dof = self.dof[so.body]
-                w = float(d.qvel[dof]) + (0.5 * self.run.dt * float(d.qacc[dof]) if mid else 0.0)
+                w = float(d.qvel[dof]) + (0.5 * self.rotor_run.dt * float(d.qacc[dof]) if mid else 0.0)
                 v = so.c0 * v + so.c2 * w * w  # the actuator's gain is 1
                 self.sheld[s] = v
             d.ctrl[a] = v
@@ -319,8 +319,8 @@ class RotorStepper:
         if math.isfinite(gp) and math.isfinite(gn) and gp != gn:
             frac = gn / (gn - gp)
             if 0.0 <= frac <= 1.0:
-                te = t - frac * self.run.dt
-        self.events.append(self.run.event(te, t, e, old, new))
+                te = t - frac * self.rotor_run.dt
+        self.events.append(self.rotor_run.event(te, t, e, old, new))
         ring = self.chatter[e]
         if len(ring) == CHATTER_N and k - ring[0] < CHATTER_WINDOW:
             raise SolverError(f"drives MuJoCo path: the stick/slip state machine does not settle: friction element "
@@ -335,12 +335,12 @@ class RotorStepper:
     def decide(self, k: int) -> None:
         """The mode decisions at t_k, the lock trials, the events and the torques held over the step; d leaves with
         the forward of the final state, locks and control (C: decide)."""
-        d, ne, dt = self.d, self.ne, self.run.dt
+        d, ne, dt = self.d, self.ne, self.rotor_run.dt
         t = k * dt
         for i in range(self.n):
             if not (math.isfinite(self.w(i)) and math.isfinite(self.q(i))):
-                raise SolverError(f"drives MuJoCo path: the speed or position of rotor '{self.run.sys.names[i]}' is "
-                                  f"not finite at t = {t:.6g} s; {HINT}")
+                raise SolverError(f"drives MuJoCo path: the speed or position of rotor "
+                                  f"'{self.rotor_run.sys.names[i]}' is not finite at t = {t:.6g} s; {HINT}")
         lv, el = self.levels(t)
         self.slips()
         old = list(self.modes)
@@ -395,7 +395,7 @@ class RotorStepper:
         self.first = False
         self.slips()
         self.gprev = self.event_function(el, True)
-        lvm, elm = self.levels(t + 0.5 * dt) if self.run.timevar else (lv, el)
+        lvm, elm = self.levels(t + 0.5 * dt) if self.rotor_run.timevar else (lv, el)
         self.lvm = lvm
         ctrl0 = d.ctrl.copy()
         self.set_ctrl(t + 0.5 * dt, elm, True)
@@ -404,7 +404,7 @@ class RotorStepper:
             mujoco.mj_checkAcc(self.m, d)
         self.wa = [self.w(i) for i in range(self.n)]
         self.qa = [self.q(i) for i in range(self.n)]
-        self.row = (self.qa + self.wa + [float(x) for x in self.modes] + [float(x) for x in self.run.u_arr]
+        self.row = (self.qa + self.wa + [float(x) for x in self.modes] + [float(x) for x in self.rotor_run.u_arr]
                     + list(self.acc) + [self.reset_energy])
 
     def lock_trial(self, t: float, el: list[float]) -> None:
@@ -430,10 +430,10 @@ class RotorStepper:
 
     def work(self, k: int) -> None:
         """Energy terms of step k: held torques x integrated displacement, velocity terms trapezoidal (C: work)."""
-        n, dt = self.n, self.run.dt
+        n, dt = self.n, self.rotor_run.dt
         tm = k * dt + 0.5 * dt
         src = 0.0
-        for s, so in enumerate(self.run.sys.sources):
+        for s, so in enumerate(self.rotor_run.sys.sources):
             i = so.body
             w0, w1 = self.wa[i], self.w(i)
             held = self.sheld[s] if so.c2 != 0.0 else so.c0 * self.shape(s, tm)
@@ -481,7 +481,7 @@ class RotorStepper:
 
     def step(self) -> None:
         """Step k -> k + 1 (module docstring)."""
-        run, k = self.run, self.k
+        run, k = self.rotor_run, self.k
         if run.controller is not None and k % run.period == 0:
             run.sample(k)
         self._forward()
@@ -498,14 +498,29 @@ class RotorStepper:
 
     def advance(self, t: float) -> RotorStepper:
         """Step up to time t (at most the run's end); returns self."""
-        k_end = min(self.run.nstep, int(round(t / self.run.dt)))
+        k_end = min(self.rotor_run.nstep, int(round(t / self.rotor_run.dt)))
         while self.k < k_end:
             self.step()
         return self
 
+    @property
+    def t(self) -> float:
+        """Current time [s]: step count x timestep."""
+        return self.k * self.rotor_run.dt
+
+    @property
+    def status(self) -> str:
+        """"running" until every step of the run is made, then "finished" (`mbsuite.stepping.StepObject`; a failing
+        step raises SolverError)."""
+        return "finished" if self.k >= self.rotor_run.nstep else "running"
+
+    def run(self, t_end: float) -> None:
+        """Step up to t_end (at most the run's end; `mbsuite.stepping.StepObject`; = `advance(t_end)`)."""
+        self.advance(t_end)
+
     def result(self) -> RefResult:
         """The final decision at the end of the run (recorded if on the output grid) and the RefResult."""
-        run = self.run
+        run = self.rotor_run
         if self.k < run.nstep:
             self.advance(run.nstep * run.dt)
         if not self.done:

@@ -1,9 +1,6 @@
-"""Coaxial rotor systems with Coulomb friction elements and an event-exact stick/slip state machine (hand-derived path).
-
-A `RotorSystem` is a set of rigid rotors (inertia J_i, viscous bearing B_i to ground), linear torsion springs (between
-two rotors or a rotor and ground), torque sources tau = c0*shape(t) + c1*w, and *friction elements* (clutches between
-two rotors, brakes/bearings/Coulomb loads between a rotor and ground). The semantics follow Modelica's
-`Rotational.Interfaces.PartialFriction` (modes -1 backward sliding, 0 stuck, 1 forward sliding, 2 free):
+"""The hand-derived path: an event-exact stick/slip simulation of a `RotorSystem` (Modelica's
+`Rotational.Interfaces.PartialFriction` semantics). One class, `ReferenceSimulator`, kept whole (about 500 lines) so
+that the state machine reads in one place.
 
 * sliding: the element transmits tau_e = mode * level(t) (level = sliding torque), w_rel = w_b - w_a;
 * a sliding element locks when w_rel reaches 0 **and** the torque needed to hold it is within the breakaway limit
@@ -13,9 +10,7 @@ two rotors, brakes/bearings/Coulomb loads between a rotor and ground). The seman
 * several stuck elements form rigid groups (nested locks: clutch + brake, both clutches, all three bodies). The
   accelerations of a configuration are the M-orthogonal projection onto the constraint subspace; the constraint torques
   are the capacity-weighted minimum-norm solution (exact when the stuck elements contain no closed loop; for parallel
-  elements it shares the torque in proportion to capacity, so they break together).
-
-Sign convention: an element between rotor a and rotor b (b = -1: ground) acts with +tau_e on a and -tau_e on b.
+  elements it shares the torque in proportion to capacity, so they break together; `projection.StuckProjection`).
 
 `simulate_reference` integrates the smooth pieces with scipy's DOP853 (dense output) and locates every lock/break
 event by root finding on the dense output (brentq, |dt| ~ 1e-14 s); time breakpoints (controller actions, normal-force
@@ -25,306 +20,18 @@ the step object `ReferenceSimulator` (`step()` = one DOP853 step of the current 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from ... import perturbation
 from ...errors import ParameterError, SolverError
-
-FWD, STUCK, BWD, FREE = 1, 0, -1, 2
-MODE_NAME = {FWD: "forward", STUCK: "stuck", BWD: "backward", FREE: "free"}
-
-
-@dataclass
-class Part:
-    """One contribution to a friction element's sliding torque: `level` N m, times the command `command` (0/1, None =
-    always on) times `schedule(t)` (clipped at 0; None = 1). `output=True` marks a useful load (its work is output).
-
-    A schedule is best an `mbsuite.engines.signals` signal (Step, Sine, Ramp, Pulse, Table, ...): the hand path calls
-    it, the MuJoCo path evaluates the same signal in C. Any other callable works too; the MuJoCo path then tabulates it
-    on its half-step grid (`mujoco_path.signal_for`)."""
-
-    label: str
-    level: float
-    command: str | None = None
-    schedule: Callable[[float], float] | None = None
-    output: bool = False
-
-
-@dataclass
-class Friction:
-    """A Coulomb friction element between rotor `a` and rotor `b` (-1 = ground). Breakaway = `peak` x sliding torque.
-
-    `g` (optional, one coefficient per rotor) replaces a/b by a general relative speed w_rel = g . w, on which the
-    element acts with the generalised torque -g tau_e (virtual work); a/b is the row g = e_b - e_a. It is what an
-    element behind an ideal gear or planetary sees (Modelica `IdealPlanetary`: a massless ring eliminated).
-    `one_way_hold` (N m, optional) makes it Modelica's `OneWayClutch` (a freewheel in parallel with a clutch): it
-    slides only forward (w_rel > 0, torque = level), locks whenever w_rel reaches 0 and holds any torque toward
-    w_rel < 0; it releases forward when the holding torque exceeds `peak` x level, or `one_way_hold`
-    (= eps0 mu0 cgeo fn_max, Modelica's tau0_max_low) while disengaged (level 0)."""
-
-    name: str
-    a: int
-    b: int
-    parts: list[Part]
-    peak: float = 1.0
-    g: tuple[float, ...] | None = None
-    one_way_hold: float | None = None
-
-
-@dataclass
-class Spring:
-    """Linear torsion spring K (N m/rad) between rotor a and rotor b (-1 = ground): tau_a = -K (q_a - q_b), with an
-    optional parallel damper D (N m s/rad; Modelica `SpringDamper`): tau_a -= D (w_a - w_b); its loss is the energy
-    term `damper_<name>`."""
-
-    name: str
-    a: int
-    b: int
-    K: float
-    D: float = 0.0
-
-
-@dataclass
-class Source:
-    """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w + c2 * w^2 (a DC motor: c0 = Kt Vs / R,
-    c1 = -Kt Ke / R; Modelica `QuadraticSpeedDependentTorque`: c2 = tau_nominal / w_nominal^2).
-    `shape` (None = 1) is best a signal of `mbsuite.engines.signals`, as `Part.schedule`."""
-
-    label: str
-    body: int
-    c0: float
-    c1: float = 0.0
-    shape: Callable[[float], float] | None = None
-    c2: float = 0.0
-
-
-@dataclass
-class RotorSystem:
-    """Coaxial rotors (inertias J, viscous B) with friction elements, springs and torque sources: the
-    system both paths simulate (Eqs 3.1-3.6 for the drives; the Modelica examples)."""
-    names: list[str]
-    J: np.ndarray
-    B: np.ndarray
-    springs: list[Spring] = field(default_factory=list)
-    frictions: list[Friction] = field(default_factory=list)
-    sources: list[Source] = field(default_factory=list)
-    breaks: list[float] = field(default_factory=list)  # times where a schedule jumps or crosses zero
-    delays: dict[str, tuple[float, float]] = field(default_factory=dict)  # command -> (engage, release) delay (s)
-
-    def __post_init__(self) -> None:
-        self.J = np.asarray(self.J, float)
-        self.B = np.asarray(self.B, float)
-        if perturbation.active():  # the stability check: every coefficient perturbed (copies; callers' objects kept)
-            pv = perturbation.value
-            self.J, self.B = perturbation.state(self.J, "rotor.J"), perturbation.state(self.B, "rotor.B")
-            self.springs = [replace(s, K=pv(s.K, key=f"{s.name}.K"), D=pv(s.D, key=f"{s.name}.D"))
-                            for s in self.springs]
-            self.frictions = [replace(f, parts=[replace(p, level=pv(p.level, key=f"{p.label}.level")) for p in f.parts])
-                              for f in self.frictions]
-            self.sources = [replace(s, c0=pv(s.c0, key=f"{s.label}.c0"), c1=pv(s.c1, key=f"{s.label}.c1"),
-                                    c2=pv(s.c2, key=f"{s.label}.c2")) for s in self.sources]
-        for nm, j in zip(self.names, self.J, strict=True):
-            if not (np.isfinite(j) and j > 0):
-                raise ParameterError(f"inertia of rotor '{nm}' must be positive, got {j!r} kg m^2")
-        for nm, b in zip(self.names, self.B, strict=True):
-            if not (np.isfinite(b) and b >= 0):
-                raise ParameterError(f"viscous bearing coefficient of rotor '{nm}' must be >= 0, got {b!r} N m s/rad")
-        for s in self.springs:
-            if not (np.isfinite(s.K) and s.K > 0):
-                raise ParameterError(f"spring rate of '{s.name}' must be positive, got {s.K!r} N m/rad")
-        for s in self.springs:
-            if not (np.isfinite(s.D) and s.D >= 0):
-                raise ParameterError(f"damping of '{s.name}' must be >= 0, got {s.D!r} N m s/rad")
-        for s in self.sources:
-            if not all(np.isfinite(x) for x in (s.c0, s.c1, s.c2)):
-                raise ParameterError(f"torque source '{s.label}': c0, c1, c2 must be finite, got {s}")
-        rows = []
-        for f in self.frictions:
-            if f.peak < 1.0:
-                raise ParameterError(f"breakaway factor of '{f.name}' must be >= 1, got {f.peak!r}")
-            if f.one_way_hold is not None and not (np.isfinite(f.one_way_hold) and f.one_way_hold > 0):
-                raise ParameterError(f"one-way hold torque of '{f.name}' must be > 0, got {f.one_way_hold!r} N m")
-            if f.g is None:
-                row = np.zeros(self.n)
-                row[f.a] -= 1.0
-                if f.b >= 0:
-                    row[f.b] += 1.0
-            else:
-                row = np.asarray(f.g, float)
-                if row.shape != (self.n,) or not np.all(np.isfinite(row)) or not np.any(row):
-                    raise ParameterError(f"relative-speed row g of '{f.name}' must be {self.n} finite numbers, not "
-                                         f"all zero, got {f.g!r}")
-            rows.append(row)
-            for p in f.parts:
-                if not (np.isfinite(p.level) and p.level >= 0):
-                    raise ParameterError(f"friction torque '{p.label}' of '{f.name}' must be >= 0, got {p.level!r} N m")
-        self.rows = np.array(rows).reshape(len(self.frictions), self.n)
-
-    @property
-    def n(self) -> int:
-        """Number of rotors."""
-        return len(self.names)
-
-    def commands(self) -> list[str]:
-        """The command names (clutch/brake switches) of the system's parts."""
-        return sorted({p.command for f in self.frictions for p in f.parts if p.command})
-
-    def part_labels(self) -> list[str]:
-        """The labels of all friction parts, in element order (the loss terms)."""
-        return [p.label for f in self.frictions for p in f.parts]
-
-    def levels(self, t: float, u: dict[str, float]) -> np.ndarray:
-        """Sliding torque of every part at time t under engagement states u (flattened over elements)."""
-        out = []
-        for f in self.frictions:
-            for p in f.parts:
-                v = p.level
-                if p.command is not None:
-                    v *= u.get(p.command, 0.0)
-                if p.schedule is not None:
-                    v *= max(0.0, p.schedule(t))
-                out.append(v)
-        return np.asarray(out, float)
-
-    def w_rel(self, w: np.ndarray) -> np.ndarray:
-        """Slip speed of every friction element [rad/s] (w_b - w_a, or the element's row times w)."""
-        return np.array([((w[f.b] if f.b >= 0 else 0.0) - w[f.a]) if f.g is None else float(self.rows[e] @ w)
-                         for e, f in enumerate(self.frictions)])
-
-    def G(self, idx: Sequence[int]) -> np.ndarray:
-        """Constraint rows (d/dt w_rel) of the friction elements `idx`."""
-        return self.rows[list(idx)].reshape(len(idx), self.n)
-
-    def apply(self, f: np.ndarray, e: int, tau: float) -> None:
-        """Add element e's torque tau_e to the rotor torques f (+tau on a, -tau on b; -g tau for a general row)."""
-        fr = self.frictions[e]
-        if fr.g is None:
-            f[fr.a] += tau
-            if fr.b >= 0:
-                f[fr.b] -= tau
-        else:
-            f -= self.rows[e] * tau
-
-    def dampers(self) -> list[Spring]:
-        """The springs with damping (their viscous loss is a term of the balance)."""
-        return [s for s in self.springs if s.D > 0]
-
-    def stored_energy(self, q: np.ndarray, w: np.ndarray) -> tuple[float, float]:
-        """Kinetic and spring energy (ke, pe) [J] at state (q, w)."""
-        ke = 0.5 * float(np.sum(self.J * w**2))
-        pe = 0.0
-        for s in self.springs:
-            d = q[s.a] - (q[s.b] if s.b >= 0 else 0.0)
-            pe += 0.5 * s.K * d * d
-        return ke, pe
-
-    def free_torque(self, t: float, q: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, float]:
-        """Torques of sources, springs and viscous bearings on each rotor, and the source power."""
-        f = -self.B * w
-        p_src = 0.0
-        for s in self.sources:
-            tau = s.c0 * (s.shape(t) if s.shape is not None else 1.0) + s.c1 * w[s.body]
-            if s.c2:
-                tau += s.c2 * w[s.body] * w[s.body]
-            f[s.body] += tau
-            p_src += tau * w[s.body]
-        for s in self.springs:
-            d = q[s.a] - (q[s.b] if s.b >= 0 else 0.0)
-            if s.D:
-                d_w = w[s.a] - (w[s.b] if s.b >= 0 else 0.0)
-                f[s.a] -= s.K * d + s.D * d_w
-                if s.b >= 0:
-                    f[s.b] += s.K * d + s.D * d_w
-                continue
-            f[s.a] -= s.K * d
-            if s.b >= 0:
-                f[s.b] += s.K * d
-        return f, p_src
-
-
-class Controller(Protocol):
-    """A discrete controller sampled every `dt` seconds; returns the commanded states {command: 0/1} (or None)."""
-
-    dt: float
-
-    def __call__(self, k: int, t: float, q: np.ndarray, w: np.ndarray) -> dict[str, int] | None: ...
-
-
-def time_to_samples(duration: float, fs: float, rounding: str = "nearest", what: str = "duration") -> int:
-    """A time in controller samples - the one conversion of every controller of both paths (the MuJoCo path's C
-    stepper converts no time: it reads the command states the same Python controllers set).
-
-    `rounding = "nearest"` for a **duration the thesis means as a whole number of samples** (storage time t_k =
-    duty x t_l, cycle t_l, dead time t_n): the sample nearest to duration x fs, ties up. The thesis' code computes
-    these counts as `(int)(tk*sample_rate)` in single precision, where 0.35 x 0.2 x 500 is exactly 35.0; in double
-    precision the product is 34.99999999999999 and a plain int() would lose a sample.
-    `rounding = "floor"` where the thesis **means truncation**: the actuation delays of its shift registers (App. C,
-    `count = (int)(delay*sample_rate)`) and the waits computed from the state (clutch loiter Eq 2.1, extraction and
-    transfer waits of App. F: the last sample not after the computed instant).
-    Both round the product to 9 decimals first, so a time that is a whole number of samples in decimal stays one
-    (0.3 ms at 10 kHz: 0.0003 x 10000 = 2.9999999999999996 in binary gives 3)."""
-    if not (math.isfinite(duration) and duration >= 0.0):
-        raise ParameterError(f"{what} must be a finite number >= 0 s, got {duration!r}")
-    if not (math.isfinite(fs) and fs > 0.0):
-        raise ParameterError(f"controller sample rate must be positive, got {fs!r}")
-    x = round(duration * fs, 9)
-    if rounding == "nearest":
-        return int(math.floor(x + 0.5))
-    if rounding == "floor":
-        return int(math.floor(x))
-    raise ParameterError(f"rounding must be 'nearest' or 'floor', got {rounding!r}")
-
-
-def delay_samples(delay: float, fs: float) -> int:
-    """Actuation delay in controller samples, as the thesis' shift registers: `count = (int)(delay*sample_rate)`
-    (App. C): truncation (`time_to_samples(delay, fs, "floor")`). The one conversion used by the command
-    queue, the controllers and `drive.build_controller`."""
-    return time_to_samples(delay, fs, "floor", "actuation delay")
-
-
-class CommandQueue:
-    """Commands with pure actuation delays quantised to controller samples (`delay_samples`, thesis App. C)."""
-
-    def __init__(self, delays: dict[str, tuple[float, float]], dt: float, initial: dict[str, int]):
-        fs = 1.0 / dt
-        self.counts = {c: (delay_samples(d_on, fs), delay_samples(d_off, fs)) for c, (d_on, d_off) in delays.items()}
-        self.dt = dt
-        self.commanded = dict(initial)
-        self.pending: list[tuple[float, str, int]] = []
-
-    def issue(self, k: int, cmds: dict[str, int] | None) -> None:
-        """Queue the controller's commands of sample k; each takes effect after its quantised delay."""
-        if not cmds:
-            return
-        for c, v in cmds.items():
-            if self.commanded.get(c, 0) != v:
-                self.commanded[c] = v
-                n_on, n_off = self.counts.get(c, (0, 0))
-                n = n_on if v else n_off
-                self.pending.append(((k + n) * self.dt, c, int(v)))
-        self.pending.sort()
-
-
-@dataclass
-class RefResult:
-    """A run of either path: time t [s], angles q [rad] and speeds w [rad/s] per rotor, command states u,
-    mode-change events, cumulative energy terms [J] and solver statistics."""
-    t: np.ndarray
-    q: np.ndarray
-    w: np.ndarray
-    modes: np.ndarray  # (n_elements, n_samples)
-    energy: dict[str, np.ndarray]
-    events: list[dict[str, Any]]
-    u: dict[str, np.ndarray]
-    stats: dict[str, Any]
+from .commands import CommandQueue, Controller
+from .projection import StuckProjection
+from .rotor_system import BWD, FREE, FWD, MODE_NAME, STUCK, Friction, RefResult, RotorSystem
 
 
 def _const(y: np.ndarray):
@@ -339,32 +46,6 @@ def _root(fun, a: float, b: float) -> float:
     if fb == 0.0:
         return b
     return brentq(fun, a, b, xtol=1e-15, rtol=1e-15)
-
-
-class _Config:
-    """Precomputed projection for one set of stuck elements."""
-
-    def __init__(self, sys: RotorSystem, stuck: list[int], caps: np.ndarray):
-        n = sys.n
-        Minv = np.diag(1.0 / sys.J)
-        self.stuck = stuck
-        if stuck:
-            G = sys.G(stuck)
-            S = G @ Minv @ G.T
-            Sp = np.linalg.pinv(S, rcond=1e-12)
-            self.Pa = Minv - Minv @ G.T @ Sp @ G @ Minv
-            self.Pw = np.eye(n) - Minv @ G.T @ Sp @ G  # plastic-impact velocity projection
-            W = np.diag(np.maximum(caps, 1e-300) ** 2)
-            R = np.eye(n) - np.diag(sys.J) @ self.Pa  # f -> constraint torque resultant r = f - M a
-            self.L = W @ G @ np.linalg.pinv(G.T @ W @ G, rcond=1e-12) @ R
-        else:
-            self.Pa = Minv
-            self.Pw = np.eye(n)
-            self.L = np.zeros((0, n))
-
-    def lam(self, f: np.ndarray) -> np.ndarray:
-        """Constraint torques of the stuck elements for the generalised forces f."""
-        return self.L @ f
 
 
 class ReferenceSimulator:
@@ -401,7 +82,7 @@ class ReferenceSimulator:
         self.dampers = sys.dampers()
         self.one_way = np.array([f.one_way_hold is not None for f in sys.frictions], bool)
         self.ne_tot = 1 + self.n + len(self.part_owner) + len(self.dampers)
-        self._cfg_cache: dict[tuple, _Config] = {}
+        self._cfg_cache: dict[tuple, StuckProjection] = {}
         self.stats: dict[str, Any] = {"nfev": 0, "steps": 0, "restarts": 0, "reset_energy": 0.0, "events": 0}
         y = np.concatenate([np.asarray(q0, float), np.asarray(w0, float), np.zeros(self.ne_tot)])
         self.t = 0.0
@@ -420,7 +101,7 @@ class ReferenceSimulator:
         self.solver: DOP853 | None = None  # the solver of the current smooth piece (None between pieces)
         self._f_known: list[tuple[float, np.ndarray]] = []  # (t, right-hand side) at the solver step's ends
         self._graze: dict[int, float] | None = None
-        self._cfg: _Config | None = None  # the piece's projection and sliding elements (modes fixed on a piece)
+        self._cfg: StuckProjection | None = None  # the piece's projection and sliding elements (modes fixed on a piece)
         self._slid: list[tuple[int, int]] = []
         self._evs: list = []
         self._g_old: list[float] = []
@@ -437,7 +118,7 @@ class ReferenceSimulator:
         np.add.at(el, self.part_owner, lv)
         return lv, el
 
-    def config(self, t: float) -> _Config:
+    def config(self, t: float) -> StuckProjection:
         """The projection of the current set of stuck elements (cached; capacities only matter for closed loops of
         stuck elements, rebuilt if they changed)."""
         stuck = [e for e in range(self.ne) if self.modes[e] == STUCK]
@@ -446,7 +127,7 @@ class ReferenceSimulator:
         key = tuple(stuck)
         c = self._cfg_cache.get(key)
         if c is None or (len(stuck) > 1 and not np.allclose(c.caps, caps)):
-            c = _Config(self.sys, stuck, caps)
+            c = StuckProjection(self.sys, stuck, caps)
             c.caps = caps  # type: ignore[attr-defined]
             self._cfg_cache[key] = c
         return c
@@ -805,6 +486,16 @@ class ReferenceSimulator:
             self._finish()
         return self
 
+    @property
+    def status(self) -> str:
+        """"running" until the run reached t_end, then "finished" (`mbsuite.stepping.StepObject`; a failing step
+        raises SolverError)."""
+        return "finished" if self.done else "running"
+
+    def run(self, t_end: float) -> None:
+        """Step until t >= t_end or the run is finished (`mbsuite.stepping.StepObject`; = `advance(t_end)`)."""
+        self.advance(t_end)
+
     def _finish(self) -> None:
         if not self.done:
             y = self.y
@@ -843,120 +534,3 @@ def simulate_reference(
     return ReferenceSimulator(sys, q0, w0, t_end, controller=controller, u0=u0, sample_dt=sample_dt, rtol=rtol,
                               atol=atol, max_step=max_step, v_tol=v_tol,
                               max_events_at_instant=max_events_at_instant).advance(t_end).result()
-
-
-def simulate_velocity_band(
-    sys: RotorSystem,
-    q0: Sequence[float],
-    w0: Sequence[float],
-    t_end: float,
-    *,
-    controller: Controller | None = None,
-    u0: dict[str, int] | None = None,
-    sample_dt: float = 1e-3,
-    velocity_tol: float = 0.01,
-    rtol: float = 1e-3,
-    atol: float = 1e-6,
-    max_step: float = 0.0019,
-) -> RefResult:
-    """The thesis' numerical treatment (Sec. 3.2, App. C/D): no events; inside |w_rel| < velocity_tol an element is
-    held (zero relative acceleration) while the torque it must carry is within its capacity; RK23 with the App. J
-    settings (tol 1e-3, max step 1.9 ms). The velocity stays wherever it was inside the band, so positions creep.
-    Held torques use the same capacity-weighted constraint solution as the event-exact path (the App. D two-body test
-    evaluated jointly rather than clutch by clutch)."""
-    from scipy.integrate import solve_ivp
-
-    if sys.dampers() or any(f.g is not None or f.one_way_hold is not None for f in sys.frictions):
-        raise ParameterError("the velocity-band scheme takes two-rotor friction elements without one-way logic and "
-                             "springs without dampers (the thesis' systems); use simulate_reference")
-    n, ne = sys.n, len(sys.frictions)
-    part_owner = [e for e, f in enumerate(sys.frictions) for _ in f.parts]
-    peaks = np.array([f.peak for f in sys.frictions])
-    labels = sys.part_labels()
-    u = {c: 0 for c in sys.commands()}
-    u.update(u0 or {})
-    queue = CommandQueue(sys.delays, controller.dt if controller else 1.0, u) if controller else None
-    cache: dict[tuple, _Config] = {}
-    ne_tot = 1 + n + len(part_owner)
-
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
-        q, w = y[:n], y[n:2 * n]
-        lv = sys.levels(t, u)
-        el = np.zeros(ne)
-        np.add.at(el, part_owner, lv)
-        wr = sys.w_rel(w)
-        mode = np.where(el <= 0, FREE, np.where(np.abs(wr) < velocity_tol, STUCK, np.sign(wr))).astype(int)
-        f0, p_src = sys.free_torque(t, q, w)
-        for _ in range(2 * ne + 2):
-            stuck = [e for e in range(ne) if mode[e] == STUCK]
-            caps = peaks[stuck] * el[stuck]
-            key = (tuple(stuck), tuple(np.round(caps, 12)) if len(stuck) > 1 else ())
-            cfg = cache.get(key) or cache.setdefault(key, _Config(sys, stuck, caps))
-            f = f0.copy()
-            for e in range(ne):
-                if mode[e] in (FWD, BWD):
-                    fr = sys.frictions[e]
-                    f[fr.a] += mode[e] * el[e]
-                    if fr.b >= 0:
-                        f[fr.b] -= mode[e] * el[e]
-            if not stuck:
-                break
-            lam = cfg.lam(f)
-            ratio = np.abs(lam) / caps
-            r = int(np.argmax(ratio))
-            if ratio[r] <= 1.0:
-                break
-            mode[stuck[r]] = FWD if lam[r] > 0 else BWD
-        dy = np.zeros(2 * n + ne_tot)
-        dy[:n] = w
-        dy[n:2 * n] = cfg.Pa @ f
-        dy[2 * n] = p_src
-        dy[2 * n + 1:2 * n + 1 + n] = sys.B * w * w
-        for i, e in enumerate(part_owner):
-            if mode[e] in (FWD, BWD):
-                dy[2 * n + 1 + n + i] = lv[i] * abs(wr[e])
-        return dy
-
-    y = np.concatenate([np.asarray(q0, float), np.asarray(w0, float), np.zeros(ne_tot)])
-    t_samples = np.arange(0.0, t_end + 0.5 * sample_dt, sample_dt)
-    Y = np.empty((t_samples.size, y.size))
-    U = {c: np.empty(t_samples.size) for c in u}
-    Y[0] = y
-    for c in u:
-        U[c][0] = u[c]
-    k_out = 1
-    t = 0.0
-    dt_c = controller.dt if controller else t_end
-    k = 0
-    nfev = 0
-    while t < t_end - 1e-12:
-        if controller is not None:
-            queue.issue(k, controller(k, t, y[:n], y[n:2 * n]))
-            while queue.pending and queue.pending[0][0] <= t + 1e-12:
-                _, c, v = queue.pending.pop(0)
-                u[c] = v
-        t_next = min((k + 1) * dt_c, t_end)
-        for b in sys.breaks:
-            if t < b < t_next:
-                t_next = b
-        ts = t_samples[(t_samples > t + 1e-12) & (t_samples <= t_next + 1e-12)]
-        sol = solve_ivp(rhs, (t, t_next), y, method="RK23", rtol=rtol, atol=atol, max_step=max_step,
-                        t_eval=ts if ts.size else None)
-        if not sol.success:
-            raise SolverError(f"velocity-band integration failed at t = {t:.6g} s: {sol.message}")
-        nfev += sol.nfev
-        for j in range(ts.size):
-            Y[k_out] = sol.y[:, j]
-            for c in u:
-                U[c][k_out] = u[c]
-            k_out += 1
-        y = sol.y[:, -1] if not ts.size or abs(sol.t[-1] - t_next) < 1e-12 else \
-            solve_ivp(rhs, (sol.t[-1], t_next), sol.y[:, -1], method="RK23", rtol=rtol, atol=atol).y[:, -1]
-        if abs(t_next - (k + 1) * dt_c) < 1e-12:
-            k += 1
-        t = t_next
-    Y = Y[:k_out]
-    e_names = ["source"] + [f"viscous_{nm}" for nm in sys.names] + labels
-    return RefResult(t=t_samples[:k_out], q=Y[:, :n].T, w=Y[:, n:2 * n].T, modes=np.zeros((ne, k_out), int),
-                     energy={nm: Y[:, 2 * n + i] for i, nm in enumerate(e_names)}, events=[],
-                     u={c: v[:k_out] for c, v in U.items()}, stats={"nfev": nfev, "reset_energy": 0.0})

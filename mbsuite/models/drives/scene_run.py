@@ -1,8 +1,11 @@
-"""Scene -> simulation for the drives model (the `run` hook) and the CoupledClutches comparison."""
+"""A drives scene as a run of a rotor system: what both paths share - the system, initial state, controller and output
+grid a scene asks for (`setup`), and the `SimResult` of a run (`sim_result`: signals, energy balance, cycle statistics,
+mode changes, the energy-residual health figure). The paths themselves: `equations.py` (hand) and `mujoco.py`."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -10,12 +13,12 @@ import numpy as np
 from ... import perturbation
 from ...errors import SceneError
 from ...health import Figure
-from ...paths import mjcf_path
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from . import coupled_clutches as cc
 from . import drive, msl
-from .friction import RefResult, simulate_reference
+from .commands import Controller
+from .rotor_system import RefResult, RotorSystem
 
 SIGNALS = {
     "w_motor": "rad/s", "w_spring": "rad/s", "w_load": "rad/s",
@@ -75,35 +78,31 @@ def _initial(q0, w0) -> tuple[np.ndarray, np.ndarray]:
     return perturbation.state(q0, "q0"), perturbation.state(w0, "w0")
 
 
-def simulate_scene(scene: Scene) -> tuple[RefResult, Any, Any]:
-    """Run a scene on its engine; returns (result, controller, rotor system)."""
+@dataclass
+class RunSetup:
+    """What a scene asks either path to simulate: the rotor system, its initial state, the controller (None for the
+    Modelica examples), the output sample interval [s] and the stem of its MJCF file (`mjcf/<stem>.xml`)."""
+
+    system: RotorSystem
+    q0: np.ndarray
+    w0: np.ndarray
+    controller: Controller | None
+    sample_dt: float
+    mjcf: str
+
+
+def setup(scene: Scene) -> RunSetup:
+    """The run a scene asks for (any engine): a Modelica example, CoupledClutches, or a drive (Eqs 3.1-3.6) with its
+    controller and speed reference."""
     eff = dict(scene.effects)
     mech = eff["mechanism"]
     sv = scene.solver
     if mech in msl.EXAMPLES:
         ex = msl.example(mech)
-        if sv.engine == "reference":
-            res = simulate_reference(ex.system, *_initial(ex.q0, ex.w0), sv.duration, sample_dt=sv.sample_dt or 5e-4,
-                                     rtol=sv.rtol, atol=sv.atol)
-        else:
-            from .mujoco_path import MujocoRotorSim
-
-            sim = MujocoRotorSim(ex.system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep,
-                                 integrator=sv.integrator)
-            res = sim.run(*_initial(ex.q0, ex.w0), sv.duration, sample_dt=sv.sample_dt or 5e-4)
-        return res, None, ex.system
+        return RunSetup(ex.system, *_initial(ex.q0, ex.w0), None, sv.sample_dt or 5e-4, f"drive_{mech}")
     if mech == "coupled_clutches":
         system = cc.build_system()
-        if sv.engine == "reference":
-            res = simulate_reference(system, *_initial(cc.Q0, cc.W0), sv.duration, sample_dt=sv.sample_dt or 5e-4,
-                                     rtol=sv.rtol, atol=sv.atol)
-        else:
-            from .mujoco_path import MujocoRotorSim
-
-            sim = MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=sv.timestep,
-                                 integrator=sv.integrator)
-            res = sim.run(*_initial(cc.Q0, cc.W0), sv.duration, sample_dt=sv.sample_dt or 5e-4)
-        return res, None, system
+        return RunSetup(system, *_initial(cc.Q0, cc.W0), None, sv.sample_dt or 5e-4, "coupled_clutches")
     p = scene.build_params().resolved(eff["param_set"])
     system = drive.build_system(mech, p, eff)
     ref = reference_signal(dict(scene.input), p["ref"] or 0.0)
@@ -117,23 +116,12 @@ def simulate_scene(scene: Scene) -> tuple[RefResult, Any, Any]:
         ctrl.ref = ref
     dt_c = 1.0 / p["fs"]
     q0, w0 = np.zeros(3), np.zeros(3)  # at rest: a relative perturbation leaves it there
-    if sv.engine == "reference":
-        res = simulate_reference(system, q0, w0, sv.duration, controller=ctrl,
-                                 sample_dt=sv.sample_dt or dt_c, rtol=sv.rtol, atol=sv.atol)
-    else:
-        from .mujoco_path import MujocoRotorSim
-
-        if abs(dt_c / sv.timestep - round(dt_c / sv.timestep)) > 1e-9:
-            raise SceneError(f"solver.timestep {sv.timestep} must divide the controller period {dt_c}")
-        sim = MujocoRotorSim(system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep, integrator=sv.integrator)
-        res = sim.run(q0, w0, sv.duration, controller=ctrl, sample_dt=sv.sample_dt or dt_c)
-    return res, ctrl, system
+    return RunSetup(system, q0, w0, ctrl, sv.sample_dt or dt_c, f"drive_{mech}")
 
 
-def run(scene: Scene) -> SimResult:
-    """The `run` hook: simulate the scene on its engine and return a `SimResult` (speeds, angles, twist,
-    energies, commands; energy balance, cycle statistics and mode changes in `stats`)."""
-    res, ctrl, system = simulate_scene(scene)
+def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> SimResult:
+    """The `SimResult` of a run of the scene (speeds, angles, twist, energies, commands; energy balance, cycle
+    statistics and mode changes in `stats`; the energy residual as a health figure, judged by `mbsuite.run`)."""
     mech = scene.effects["mechanism"]
     sig: dict[str, np.ndarray] = {}
     if mech in msl.EXAMPLES:
@@ -179,33 +167,3 @@ def run(scene: Scene) -> SimResult:
         "tighten solver.rtol/atol (reference) or reduce solver.timestep (mujoco)"))
     return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats,
                     health=health)
-
-
-def coupled_clutches_table(engines=("reference", "mujoco"), timestep: float = 1e-4) -> dict[str, Any]:
-    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s."""
-    ref = cc.load_reference()
-    rev = cc.reference_events(ref)
-    out: dict[str, Any] = {"reference_events": rev}
-    system = cc.build_system()
-    grid = np.round(np.arange(0.0, cc.T_END + 1e-9, 0.1), 10)
-    j_ref = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
-    out["grid"] = grid.tolist()
-    out["w_ref"] = ref["w"][:, j_ref].T.tolist()
-    for eng in engines:
-        if eng == "reference":
-            res = simulate_reference(system, cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)
-        else:
-            from .mujoco_path import MujocoRotorSim
-
-            res = MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=timestep).run(
-                cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)
-        ev = cc.events_as_codes(res.events)
-        rows = cc.match_events(ev, rev)
-        idx = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
-        w = res.w[:, idx].T
-        dts = [r["t"] - r["t_ref"] for r in rows if r["t"] is not None and r["t_ref"] is not None]
-        out[eng] = {"events": rows, "w": w.tolist(),
-                    "same_sequence": all(r["t"] is not None and r["t_ref"] is not None for r in rows),
-                    "max_event_dt": float(max(abs(x) for x in dts)) if dts else math.nan,
-                    "max_w_err": float(np.max(np.abs(w - np.asarray(out["w_ref"]))))}
-    return out

@@ -92,7 +92,7 @@ def test_run_hook_returns_simresult_with_statistics(tmp_path, capsys):
 
     scene = load_scene("catenary").replace(params={"n_spans": 2, "x_end": 110.0, "window_start": 50.0,
                                                    "window_end": 100.0}, input={"speed": 200.0})
-    res = scene.spec.run(scene)
+    res = scene.spec.paths[scene.solver.engine].run(scene)
     assert isinstance(res, SimResult) and res.engine == "reference"
     assert {"contact_force", "contact_force_filtered", "uplift_60m"} <= set(res.signals)
     assert res.units["contact_force"] == "N" and res.t.size == res.signals["contact_force"].size

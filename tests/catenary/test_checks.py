@@ -13,8 +13,9 @@ from mbsuite import load_scene
 from mbsuite.errors import ParameterError, SceneError
 from mbsuite.health import AccuracyError, InaccurateResultWarning
 from mbsuite.limits import limit_of, undeclared
-from mbsuite.models.catenary import analysis
-from mbsuite.models.catenary.analysis import CriticalSpeedWarning, passage_size, simulate
+from mbsuite.models.catenary import train
+from mbsuite.models.catenary.analysis import simulate
+from mbsuite.models.catenary.config import CriticalSpeedWarning, passage_size
 from mbsuite.models.catenary.fe import build_nodes
 from mbsuite.models.catenary.params import CatenaryParams
 
@@ -70,7 +71,7 @@ def test_tiny_elements_are_refused_before_anything_is_built(monkeypatch):
     def boom(*_a, **_k):
         raise AssertionError("assembled a mesh the size guard should have refused")
 
-    monkeypatch.setattr(analysis, "assemble", boom)
+    monkeypatch.setattr(train, "assemble", boom)
     scene = load_scene("catenary").replace(params={"element_length": 1e-4})
     with pytest.raises(SceneError, match="element-steps exceed params.max_element_steps") as err:
         mbsuite.run(scene)  # refused before anything is assembled (`assemble` above would raise)
@@ -84,7 +85,7 @@ def test_tiny_elements_are_refused_before_anything_is_built(monkeypatch):
 
 
 def test_passage_steps_are_held_to_solver_max_steps(monkeypatch):
-    monkeypatch.setattr(analysis, "assemble", lambda *_a, **_k: pytest.fail("built past the step guard"))
+    monkeypatch.setattr(train, "assemble", lambda *_a, **_k: pytest.fail("built past the step guard"))
     # solver.duration is informative for a passage (6.1 s in the scene); the passage's own step count is what counts
     scene = load_scene("catenary").replace(solver={"max_steps": 10_000, "duration": 1.0})
     with pytest.raises(SceneError, match=r"30,240 steps.*exceeds solver\.max_steps = 1e\+04"):

@@ -12,7 +12,7 @@ import pytest
 
 import mbsuite
 from mbsuite.errors import ParameterError, SceneError, SolverError
-from mbsuite.models.catenary import analysis
+from mbsuite.models.catenary import analysis, train
 from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.pantographs import build
 from mbsuite.models.catenary.params import CatenaryParams
@@ -170,8 +170,8 @@ def test_supercritical_speed_is_refused_before_integrating(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("the pantograph or the integration was started")
 
-    monkeypatch.setattr(analysis, "build_pantograph", boom)
-    monkeypatch.setattr(analysis, "CoupledSimulation", boom)
+    monkeypatch.setattr(train, "build_pantographs", boom)
+    monkeypatch.setattr(train, "CoupledSimulation", boom)
     sc = load_scene("catenary/eppinger_lab").replace(input={"speed": 500.0})
     with pytest.raises(ParameterError, match="speed 500.0 km/h"):
         mbsuite.run(sc)

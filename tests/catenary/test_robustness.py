@@ -12,8 +12,9 @@ import mbsuite
 from mbsuite.cli import main
 from mbsuite.errors import ParameterError
 from mbsuite.health import AccuracyError, InaccurateResultWarning
-from mbsuite.models.catenary import analysis
-from mbsuite.models.catenary.analysis import check_timestep, check_wave_resolution, simulate
+from mbsuite.models.catenary import train
+from mbsuite.models.catenary.analysis import simulate
+from mbsuite.models.catenary.config import check_timestep, check_wave_resolution
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.train import simulate_train
 from mbsuite.scenes import load_scene
@@ -46,7 +47,7 @@ def test_scene_timestep_half_a_second_names_the_key(tmp_path, capsys):
 def test_timestep_past_the_wave_resolution_is_not_trusted(tmp_path, capsys, monkeypatch):
     """0.01 s: a valid record for the 20 Hz filter, but a wire wave crosses 2.4 elements per step: refused before
     anything is built (AccuracyError naming solver.timestep and its range) unless inaccurate results are allowed."""
-    monkeypatch.setattr(analysis, "assemble", lambda *_a, **_k: pytest.fail("built past the timestep check"))
+    monkeypatch.setattr(train, "assemble", lambda *_a, **_k: pytest.fail("built past the timestep check"))
     path = tmp_path / "coarse.toml"
     path.write_text(SHORT.format(dt=0.01))
     assert main(["run", str(path)]) == 2

@@ -11,7 +11,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbsuite.errors import ParameterError
-from mbsuite.models.catenary.analysis import ContactLostWarning, CriticalSpeedWarning, simulate
+from mbsuite.models.catenary.analysis import ContactLostWarning, simulate
+from mbsuite.models.catenary.config import CriticalSpeedWarning
 from mbsuite.models.catenary.fe import CW_T, CW_W, NDOF_NODE, assemble, hermite
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams

@@ -10,10 +10,11 @@ import pytest
 
 import mbsuite
 from mbsuite.errors import ParameterError, SceneError
-from mbsuite.models.catenary.analysis import CriticalSpeedWarning, simulate
+from mbsuite.models.catenary.analysis import simulate
+from mbsuite.models.catenary.config import CriticalSpeedWarning, check_train, validate_train_section
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams
-from mbsuite.models.catenary.train import check_train, simulate_train, validate_section
+from mbsuite.models.catenary.train import simulate_train
 
 STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "loss_pct")
 P5 = CatenaryParams(element_length=0.5, n_spans=5, x_end=150.0, window_start=60.0, window_end=120.0)
@@ -111,11 +112,11 @@ def test_bad_spacings_name_the_value():
     with pytest.raises(ParameterError, match="2 pantographs need 1 spacings"):
         simulate_train(P5, 250.0, 2e-4, ["reference2mass", "reference2mass"], [])
     with pytest.raises(SceneError, match=r"spacings\[0\] = 0.1"):
-        validate_section({"pantographs": ["reference2mass", "reference2mass"], "spacings": [0.1]})
+        validate_train_section({"pantographs": ["reference2mass", "reference2mass"], "spacings": [0.1]})
     with pytest.raises(SceneError, match="pantographs must be"):
-        validate_section({"pantographs": ["reference2mass", "pendolino"], "spacings": [200.0]})
+        validate_train_section({"pantographs": ["reference2mass", "pendolino"], "spacings": [200.0]})
     with pytest.raises(SceneError, match="unknown key"):
-        validate_section({"pantographs": ["reference2mass"], "spacing": []})
+        validate_train_section({"pantographs": ["reference2mass"], "spacing": []})
 
 
 def test_two_pantograph_scene_runs_through_mbsuite_run():
@@ -126,3 +127,29 @@ def test_two_pantograph_scene_runs_through_mbsuite_run():
     r = mbsuite.run(sc)
     assert {"p1_Fm", "p2_Fm", "p1_quality_pass", "p2_sigma"} <= set(r.stats)
     assert r.signals["contact_force_p2"].size == r.signals["contact_force_p1"].size == r.t.size
+
+
+def test_passages_are_step_objects():
+    """The Python passage and the core-driven passage of a train meet `mbsuite.stepping.StepObject`: `run(t_end)`
+    steps until t >= t_end, then on to the end; the compiled passage of one 2-mass pantograph is the Python one's
+    twin (the contact force to rounding, as in tests/catenary/test_native.py)."""
+    from mbsuite.models.catenary.fe import assemble
+    from mbsuite.models.catenary.sim import CoupledSimulation
+    from mbsuite.models.catenary.train import TrainPassage
+    from mbsuite.stepping import StepObject
+
+    p = CatenaryParams(n_spans=2, element_length=0.5, x_start=30.0, x_end=50.0, window_start=35.0, window_end=45.0)
+    sim = CoupledSimulation(assemble(p), _panto(p), 250 / 3.6, 2e-4, "slack")
+    ps = sim.start(30.0, 50.0)
+    assert isinstance(ps, StepObject)
+    ps.run(0.1)
+    assert ps.status == "running" and 0.1 <= ps.t < 0.1 + 2e-4
+    ps.run(1.0)
+    assert ps.status == "finished" and ps.n == ps.nsteps
+    for compiled in (True, False):
+        sim = CoupledSimulation(assemble(p), _panto(p), 250 / 3.6, 2e-4, "slack")
+        tp = TrainPassage(sim, [sim.panto], sim.start(30.0, 50.0), [0.0], compiled)
+        assert isinstance(tp, StepObject) and tp.status == "running"
+        tp.run(1.0)
+        assert tp.status == "finished" and tp.n == tp.nsteps == ps.nsteps
+        assert abs(tp.F[-1, 0] - ps.force) < 1e-8

@@ -19,7 +19,7 @@ from .pantographs import PANTOGRAPH_MODELS
 def _catenary_critical_speed(ck: Checker) -> None:
     import math
 
-    from .analysis import CriticalSpeedWarning, speed_regime
+    from .config import CriticalSpeedWarning, speed_regime
     from .params import CatenaryParams
 
     p = CatenaryParams()
@@ -65,7 +65,7 @@ def _contact_law(ck: Checker, run, label: str) -> None:
 
 
 def _trailing_near_warning_speed(ck: Checker) -> None:
-    from .analysis import CriticalSpeedWarning
+    from .config import CriticalSpeedWarning
     from .train import simulate_train
 
     with warnings.catch_warnings(record=True) as w:

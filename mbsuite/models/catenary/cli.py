@@ -5,13 +5,16 @@ from __future__ import annotations
 
 import argparse
 
+from ...errors import SceneError
 from ...results import Progress
-from ...scenes import load_scene
+from ...scenes import Scene, load_scene
+
+COMMAND = "catenary"
 
 
-def register(sub, add_common, emit) -> None:
-    """Add the `mbsuite catenary` command to the CLI's subparsers `sub`."""
-    p = sub.add_parser("catenary", help="pantograph passage under the FE catenary: EN 50318 statistics, plots, CSV")
+def register(sub, add_common, emit) -> str:
+    """Add the `mbsuite catenary` command to the CLI's subparsers `sub`; returns its name."""
+    p = sub.add_parser(COMMAND, help="pantograph passage under the FE catenary: EN 50318 statistics, plots, CSV")
     p.add_argument("scene", nargs="?", default="catenary",
                    help="scene TOML path, 'catenary' (default scene) or catenary/<scene>")
     p.add_argument("--speed", type=float, default=None, help="train speed (km/h); default: the scene's input.speed")
@@ -31,16 +34,27 @@ def register(sub, add_common, emit) -> None:
     p.add_argument("--spacings", type=float, nargs="+", default=None,
                    help="distances (m) between consecutive pantographs of a [train] scene (overrides the scene)")
     add_common(p)
-    p.set_defaults(func=lambda args: _handler(args, emit))
+    p.set_defaults(func=cmd_catenary, emit=emit)
+    return COMMAND
 
 
-def _handler(args: argparse.Namespace, emit) -> None:
-    from .analysis import report, run_scene
+class _Percent:
+    """A progress callback `(step, total)` that advances a 100-step `Progress` bar by whole percent."""
 
+    def __init__(self, bar: Progress):
+        self.bar, self.last = bar, 0
+
+    def __call__(self, step: int, total: int) -> None:
+        k = int(100 * step / total)
+        if k > self.last:
+            self.bar.update(k - self.last)
+            self.last = k
+
+
+def _scene(args: argparse.Namespace) -> Scene:
+    """The command's catenary scene with the command line's overrides."""
     scene = load_scene(args.scene)
     if scene.model != "catenary":
-        from ...errors import SceneError
-
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "
                          "catenary scene")
     if args.engine is not None:
@@ -51,6 +65,17 @@ def _handler(args: argparse.Namespace, emit) -> None:
         scene = scene.replace(params={"element_length": args.element_length})
     if args.speed is not None:
         scene = scene.replace(input={"speed": args.speed})
+    if args.spacings is not None and "train" not in scene.sections:
+        raise SceneError("--spacings needs a scene with a [train] section (e.g. catenary/en50318_two_pantographs)")
+    return scene
+
+
+def cmd_catenary(args: argparse.Namespace) -> None:
+    """One passage (or a train's, with `[train]`) of the scene, and its report."""
+    from .analysis import run_scene, run_train_scene
+    from .reports import report, train_report
+
+    scene = _scene(args)
     criteria = None
     if args.quality or args.system is not None:
         from .quality import criteria_from
@@ -59,38 +84,16 @@ def _handler(args: argparse.Namespace, emit) -> None:
         if args.system is not None:
             sec["system"] = args.system
         criteria = criteria_from(sec)
-    if args.spacings is not None and "train" not in scene.sections:
-        from ...errors import SceneError
-
-        raise SceneError("--spacings needs a scene with a [train] section (e.g. catenary/en50318_two_pantographs)")
     if "train" in scene.sections:
-        from .train import run_train_scene, train_report
-
         with Progress(100, desc="catenary train") as bar:
-            last = [0]
-
-            def tprog(step, total, bar=bar, last=last):
-                k = int(100 * step / total)
-                if k > last[0]:
-                    bar.update(k - last[0])
-                    last[0] = k
-
-            run = run_train_scene(scene, progress=tprog, spacings=args.spacings)
-        emit(train_report(run, quality=criteria), args, scene.to_dict())
+            run = run_train_scene(scene, progress=_Percent(bar), spacings=args.spacings)
+        args.emit(train_report(run, quality=criteria), args, scene.to_dict())
         return
-    runs = []
     variants = [scene]
     if args.with_linear and scene.effects["droppers"] != "linear":
         variants.append(scene.replace(effects={"droppers": "linear"}))
+    runs = []
     for sc in variants:
         with Progress(100, desc=f"catenary {sc.effects['droppers']}") as bar:
-            last = [0]
-
-            def prog(step, total, bar=bar, last=last):
-                k = int(100 * step / total)
-                if k > last[0]:
-                    bar.update(k - last[0])
-                    last[0] = k
-
-            runs.append(run_scene(sc, progress=prog))
-    emit(report(runs[0], scene.to_dict(), runs[1:], quality=criteria), args, scene.to_dict())
+            runs.append(run_scene(sc, progress=_Percent(bar)))
+    args.emit(report(runs[0], scene.to_dict(), runs[1:], quality=criteria), args, scene.to_dict())

@@ -40,7 +40,8 @@ def evaluate(job: tuple[dict, float, dict[str, float]]) -> dict[str, Any]:
     import time
 
     from ...scenes import scene_from_dict
-    from .analysis import CriticalSpeedWarning, run_scene, speed_regime
+    from .analysis import run_scene, run_train_scene
+    from .config import CriticalSpeedWarning, speed_regime
     from .quality import assess, criteria_from
 
     c0 = time.process_time()
@@ -49,8 +50,6 @@ def evaluate(job: tuple[dict, float, dict[str, float]]) -> dict[str, Any]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CriticalSpeedWarning)
         if "train" in scene.sections:
-            from .train import run_train_scene
-
             run = run_train_scene(scene, speed_kmh=speed, **values)
             stats, dt = run.stats[-1], run.dt
         else:

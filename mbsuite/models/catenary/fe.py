@@ -131,13 +131,6 @@ class CatenaryFE:
         h = x[e + 1] - x[e]
         return e, (xp - x[e]) / h, h
 
-    def static_cw_height(self, xp: float) -> float:
-        """Static CW height at xp relative to the level of the droppers (m, <= 0 between droppers)."""
-        e, xi, h = self.element_at(xp)
-        d = self.w0_full[[NDOF_NODE * e + CW_W, NDOF_NODE * e + CW_T, NDOF_NODE * (e + 1) + CW_W,
-                          NDOF_NODE * (e + 1) + CW_T]]
-        return float(hermite(xi, h) @ d)
-
 
 def assemble(p: CatenaryParams) -> CatenaryFE:
     """Mesh, assemble and solve the static state of the catenary described by `p`."""

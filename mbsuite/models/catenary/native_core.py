@@ -4,7 +4,7 @@
 C, once), K in CSR, the droppers' influence columns, and the state of a passage (u, q, p, the slack set, per contact
 its element, shape functions and cached influence columns). `run(n0, n1)` steps a passage whose pantographs are all
 2-mass (affine) pantographs entirely in C; the stages `predict`, `local`, `advance` are exposed for pantographs that
-are coupled from Python (secant iteration). The readable twin is `sim.Passage`; a test holds both equal to rounding.
+are coupled from Python (secant iteration). The readable twin is `passage.Passage`; a test holds both equal to rounding.
 
 Why a hand-written banded Cholesky rather than LAPACK: S is factorised once per passage and the per-step solve is the
 core of the step, fused with the mat-vec and the recursions in one C loop; LAPACK's dpbtrs (column-oriented dtbsv)
@@ -15,6 +15,7 @@ and no binding to scipy's private LAPACK capsules is needed.
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Callable
 
 import numpy as np
 
@@ -144,18 +145,6 @@ class NativeCore:
         """Number of slack droppers in the core's current slack set."""
         return int(self.job.nslack)
 
-    def slack_set(self) -> tuple[list[int], np.ndarray]:
-        """The current slack set: dropper indices and their cancelling tensions (a copy)."""
-        m = self.nslack
-        return [int(i) for i in self.slk[:m]], self.sS[:m].copy()
-
-    def set_slack(self, S: list[int], sS: np.ndarray) -> None:
-        """Replace the core's slack set by dropper indices `S` with cancelling tensions `sS`."""
-        m = len(S)
-        self.slk[:m] = S
-        self.sS[:m] = sS
-        self.job.nslack = m
-
     def place(self, k: int, x: float) -> None:
         """Place contact k at position x (m): its element and Hermite shape functions N(x)."""
         self.lib.mbs_cat_place(ctypes.byref(self.job), k, float(x))
@@ -205,8 +194,22 @@ class NativeCore:
         return int(self.lib.mbs_cat_check(ctypes.byref(self.job)))
 
     def run(self, n0: int, n1: int, check_every: int) -> int:
-        """Steps n0+1 .. n1, all present pantographs 2-mass (state in `pm`); 0 or an error code (`_error_text`)."""
+        """Steps n0+1 .. n1, all present pantographs 2-mass (state in `pm`); 0 or an error code (`failure`)."""
         return int(self.lib.mbs_cat_run(ctypes.byref(self.job), int(n0), int(n1), int(check_every)))
+
+    def run_chunks(self, n0: int, n1: int, check_every: int, chunk: int, static_force: float,
+                   progress: Callable[[int], None] | None = None) -> None:
+        """`run` from step n0 to n1 in chunks of `chunk` steps, `progress(n)` after each; a failed step is a
+        SolverError in the words of the Python path (`failure`)."""
+        n = n0
+        while n < n1:
+            m = min(n + chunk, n1)
+            code = self.run(n, m, check_every)
+            if code:
+                raise SolverError(self.failure(code, static_force))
+            n = m
+            if progress is not None:
+                progress(n)
 
     @property
     def n_local(self) -> int:
@@ -215,3 +218,21 @@ class NativeCore:
 
     def _error_text(self, code: int, t: float) -> str:
         return f"native catenary step failed (code {code}) at t = {t:.6f} s"
+
+    def failure(self, code: int, static_force: float) -> str:
+        """The message of a failed step (`run`, `check`), in the words of `passage.Passage._check`."""
+        j = self.job
+        k = max(int(j.err_con), 0)
+        xp, yh = float(self.xc[k]), float(self.head[k])
+        if code == 4:
+            t = float(j.err_value)
+            return (f"contact/dropper active set did not settle in {int(j.max_iter)} iterations at t = {t:.6f} s "
+                    f"(time step {float(j.dt)} s); reduce solver.timestep")
+        if code == 1:
+            return f"non-finite state at x = {xp:.2f} m"
+        if code == 3:
+            return (f"the pantograph lost the wire and moved {yh:+.3g} m away from it (x = {xp:.2f} m; static "
+                    f"contact force {static_force:.4g} N): it cannot hold the wire")
+        return (f"catenary/pantograph displacement {abs(float(j.err_value)):.3g} m exceeds {float(j.max_disp):g} m "
+                f"at x = {xp:.2f} m: outside the small-displacement model (speed too close to the wave speed, or a "
+                "diverging pantograph)")

@@ -17,29 +17,37 @@ f1. Optional: `engine` (the name of the pantograph's engine path, for reports; d
 `engine_warnings() -> {name: count}` (warnings of its engine, reported with the run), `energy()` (J, for the energy
 diagnostics).
 
-This protocol is the only contract. The scene's `pantograph` effect names the pantograph: `reference2mass` is built
-here from the catenary's own parameters (m1 ... F0); every other name is a pantograph model of the registry
-(`PANTOGRAPH_MODELS`), found by `mbsuite.registry.get_model(name).under_wire` and built by that model's factory
-`under_wire(params, effects, engine, timestep)` with the `[pantograph]` section of the scene (its own `effects` and
-`params`, validated against that model's spec) and the scene's `solver.engine` as its engine path. The catenary
-imports no pantograph model.
+This protocol (`Pantograph`) and the factory that makes one (`UnderWire`: `ModelSpec.under_wire` of a registry model)
+are the only contract. The scene's `pantograph` effect names a `PantographKind`: its engine paths, the `[pantograph]`
+section it takes and its `UnderWire` factory. `reference2mass` is the catenary's own (`TwoMassPantograph`, its
+parameters m1 ... F0 the catenary's); every other name is a pantograph model of the registry (`PANTOGRAPH_MODELS`),
+found by `mbsuite.registry.get_model(name).under_wire` with the `[pantograph]` section of the scene (its own `effects`
+and `params`, validated against that model's spec). The catenary imports no pantograph model.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, Protocol
+from dataclasses import dataclass
+from functools import partial
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
 from ...errors import SceneError
+from ...registry import ModelSpec, get_model
 
-#: the `pantograph` effect's values that name a registry model (value -> model name); reference2mass is built here
+#: the catenary's own pantograph, the EN 50318 2-mass reference (parameters m1 ... F0 among the catenary's)
+TWO_MASS = "reference2mass"
+#: the `pantograph` effect's values that name a registry model (value -> model name)
 PANTOGRAPH_MODELS = {"eppinger": "pantograph"}
+#: every value of the `pantograph` effect
+PANTOGRAPHS = (TWO_MASS, *PANTOGRAPH_MODELS)
 #: keys of the scene's `[pantograph]` section
 SECTION_KEYS = ("effects", "params")
 
 
+@runtime_checkable
 class Pantograph(Protocol):
     """What the catenary needs of a pantograph under the wire: heights from the undisturbed CW level (m),
     forces in N; over one step the contact force varies linearly f0 -> f1 (the trapezoidal rule's force history)."""
@@ -60,6 +68,15 @@ class Pantograph(Protocol):
 
     def signals(self) -> dict[str, float]:
         """The committed state's output signals (SI units)."""
+
+
+class UnderWire(Protocol):
+    """The factory of a pantograph under the wire (`ModelSpec.under_wire` of a registry model): `params` and
+    `effects` are the model's own (from the scene's `[pantograph]` section), `engine` one of its paths, `timestep` the
+    catenary's step (s)."""
+
+    def __call__(self, params: Mapping[str, Any], effects: Mapping[str, Any], engine: str,
+                 timestep: float) -> Pantograph: ...
 
 
 class TwoMassPantograph:
@@ -161,39 +178,73 @@ class TwoMassPantograph:
         return float(0.5 * self.v @ self.Mm @ self.v + 0.5 * self.x @ self.Km @ self.x - self.F0 * self.x[1])
 
 
-# --- pantographs of the registry -----------------------------------------------------------------------------------
-def _model_spec(kind: str):
-    from ...registry import get_model
+# --- the kinds of pantograph -------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PantographKind:
+    """A value of the scene's `pantograph` effect: the engine paths its pantograph has, its factory, and the registry
+    model whose declaration validates the `[pantograph]` section (None: the catenary's own, which takes none)."""
 
-    spec = get_model(PANTOGRAPH_MODELS[kind])
+    name: str
+    engines: tuple[str, ...]
+    make: UnderWire
+    spec: ModelSpec | None = None
+
+    def section(self, value: Any) -> dict[str, dict[str, Any]]:
+        """The `[pantograph]` section validated for this pantograph (SceneError naming the bad key or value)."""
+        if self.spec is None:
+            value = value or {}
+            if value.get("effects") or value.get("params"):
+                raise SceneError(f"the {self.name} pantograph takes its parameters from [params] (m1, k1, c1, m2, "
+                                 "k2, c2, F0) and has no effects: remove the [pantograph] section")
+            return {"effects": {}, "params": {}}
+        return _check_section(value, self.name, self.spec)
+
+
+def _two_mass(p, params: Mapping[str, Any], effects: Mapping[str, Any], engine: str,
+              timestep: float) -> TwoMassPantograph:
+    """`UnderWire` of the 2-mass pantograph: its parameters are the catenary's `p` (m1 ... F0)."""
+    return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
+
+
+def kind(name: str, p) -> PantographKind:
+    """The kind of pantograph the `pantograph` effect's value `name` names, under a catenary of parameters `p`."""
+    if name == TWO_MASS:
+        return PantographKind(TWO_MASS, ("reference",), partial(_two_mass, p))
+    if name not in PANTOGRAPH_MODELS:
+        raise SceneError(f"unknown pantograph {name!r}; valid: {list(PANTOGRAPHS)}")
+    spec = _model_spec(name)
+    return PantographKind(name, spec.engines, spec.under_wire, spec)
+
+
+def _model_spec(name: str) -> ModelSpec:
+    spec = get_model(PANTOGRAPH_MODELS[name])
     if spec.under_wire is None:
-        raise SceneError(f"model {spec.name!r} (pantograph {kind!r}) does not declare how it runs under the wire "
+        raise SceneError(f"model {spec.name!r} (pantograph {name!r}) does not declare how it runs under the wire "
                          "(ModelSpec.under_wire)")
     return spec
 
 
-def _check_section(value: Any, kind: str) -> dict[str, dict[str, Any]]:
-    """The `[pantograph]` section validated against the spec of the model that `kind` names."""
+def _check_section(value: Any, name: str, spec: ModelSpec) -> dict[str, dict[str, Any]]:
+    """The `[pantograph]` section validated against the spec of the registry model `spec` (pantograph `name`)."""
     if not isinstance(value, Mapping):
         raise SceneError(f"[pantograph] must be a table with keys {list(SECTION_KEYS)}, got {value!r}")
     bad = sorted(set(value) - set(SECTION_KEYS))
     if bad:
         raise SceneError(f"unknown key(s) {bad} in [pantograph]; valid keys: {list(SECTION_KEYS)}")
-    spec = _model_spec(kind)
     effects, params = value.get("effects") or {}, value.get("params") or {}
-    for name, v in (("effects", effects), ("params", params)):
+    for what, v in (("effects", effects), ("params", params)):
         if not isinstance(v, Mapping):
-            raise SceneError(f"[pantograph] {name} must be a table, got {v!r}")
+            raise SceneError(f"[pantograph] {what} must be a table, got {v!r}")
     bad = sorted(set(effects) - set(spec.effects))
     if bad:
-        raise SceneError(f"unknown effect(s) {bad} of the {kind!r} pantograph (model '{spec.name}') in [pantograph]; "
+        raise SceneError(f"unknown effect(s) {bad} of the {name!r} pantograph (model '{spec.name}') in [pantograph]; "
                          f"valid effects: {sorted(spec.effects)}")
-    for name, v in effects.items():
-        spec.effects[name].check(name, v)
+    for effect, v in effects.items():
+        spec.effects[effect].check(effect, v)
     valid = spec.param_names()
     bad = sorted(set(params) - set(valid))
     if bad:
-        raise SceneError(f"unknown parameter(s) {bad} of the {kind!r} pantograph (model '{spec.name}') in "
+        raise SceneError(f"unknown parameter(s) {bad} of the {name!r} pantograph (model '{spec.name}') in "
                          f"[pantograph]; valid parameters: {valid}")
     for k, v in params.items():
         if isinstance(v, bool) or not isinstance(v, int | float):
@@ -208,40 +259,47 @@ def validate_section(value: Any) -> dict[str, dict[str, Any]]:
     not see the scene's `pantograph` effect: it must be valid for one of the registry pantographs, and `build` checks
     it again against the one the scene names."""
     first = None
-    for kind in PANTOGRAPH_MODELS:
+    for name in PANTOGRAPH_MODELS:
         try:
-            return _check_section(value, kind)
+            return _check_section(value, name, _model_spec(name))
         except SceneError as exc:
             first = first or exc
     raise first if first is not None else SceneError("no registry pantograph takes a [pantograph] section")
 
 
-def build(kind: str, p, engine: str = "reference", dt: float = 1e-4, section: Mapping[str, Any] | None = None,
+def build(name: str, p, engine: str = "reference", dt: float = 1e-4, section: Mapping[str, Any] | None = None,
           contact: str | None = None) -> Pantograph:
-    """The pantograph named by the scene's `pantograph` effect, on the engine path `engine`, for a catenary with
+    """The pantograph named by the scene's `pantograph` effect, on its engine path `engine`, for a catenary with
     parameters `p` and time step `dt`. `section`: the scene's `[pantograph]` section (registry pantographs only);
     `contact`: the catenary's contact law, which a `contact` effect in the section must not contradict (the head-wire
     contact is the catenary's)."""
-    section = dict(section or {})
-    if kind == "reference2mass":
-        if engine != "reference":
-            raise SceneError(f"the reference2mass pantograph has only the reference path, not {engine!r}: use "
-                             "solver.engine = 'reference' (the catenary itself is always the FE reference code)")
-        if section.get("effects") or section.get("params"):
-            raise SceneError("the reference2mass pantograph takes its parameters from [params] (m1, k1, c1, m2, k2, "
-                             "c2, F0) and has no effects: remove the [pantograph] section")
-        return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
-    if kind not in PANTOGRAPH_MODELS:
-        raise SceneError(f"unknown pantograph {kind!r}; valid: {['reference2mass', *PANTOGRAPH_MODELS]}")
-    spec = _model_spec(kind)
-    if engine not in spec.engines:
-        raise SceneError(f"the {kind!r} pantograph (model '{spec.name}') has no engine path {engine!r}; valid: "
-                         f"{list(spec.engines)}")
-    sec = _check_section(section, kind)
+    k = kind(name, p)
+    if engine not in k.engines:
+        paths = " and ".join(k.engines)
+        raise SceneError(f"the {name} pantograph has only the {paths} path{'s' if len(k.engines) > 1 else ''}, not "
+                         f"{engine!r}: use solver.engine = {k.engines[0]!r} (the catenary itself is always the FE "
+                         "code)")
+    sec = k.section(dict(section or {}))
     effects = dict(sec["effects"])
-    if contact is not None and "contact" in spec.effects:
+    if contact is not None and k.spec is not None and "contact" in k.spec.effects:
         if effects.get("contact", contact) != contact:
             raise SceneError(f"[pantograph] effects.contact = {effects['contact']!r} contradicts the catenary's "
                              f"contact = {contact!r}: the head-wire contact is the catenary's effect")
         effects["contact"] = contact
-    return spec.under_wire(sec["params"], effects, engine, dt)
+    return k.make(sec["params"], effects, engine, dt)
+
+
+def build_train(pantographs: list, p, engine: str, dt: float, section: Mapping[str, Any] | None = None,
+                contact: str | None = None) -> list[Pantograph]:
+    """The pantographs of a passage, leading first: names (`build`) or objects of the protocol (taken as they are).
+    A named pantograph runs on `engine`; on a train that also carries one with that path, a pantograph without it
+    (the 2-mass one) runs on its only path."""
+    carried = any(engine in kind(n, p).engines for n in pantographs if isinstance(n, str))
+    out = []
+    for item in pantographs:
+        if not isinstance(item, str):
+            out.append(item)
+            continue
+        engines = kind(item, p).engines
+        out.append(build(item, p, engine if engine in engines or not carried else engines[0], dt, section, contact))
+    return out

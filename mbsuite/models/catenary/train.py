@@ -1,54 +1,54 @@
-"""Several pantographs on one train under the FE catenary: each with its own record and statistics.
+"""The one passage loop: a pantograph, or a train of several, under the FE catenary (`run_passage`, configured by a
+`config.PassageConfig`), each pantograph with its own record and statistics; a single pantograph is a train of one.
 
-The scene (the model README, "Two pantographs"): the leading pantograph's contact point is at x_0(t) = x_start + V t,
+A train (the model README, "Two pantographs"): the leading pantograph's contact point is at x_0(t) = x_start + V t,
 pantograph k's at x_k(t) = x_0(t) - s_k with s_k the sum of the spacings ahead of it. Before its entry time
 s_k / V a trailing pantograph exerts no force and is not integrated; at its entry step it is put at its static
 equilibrium against the wire where it stands (at x_start = 0 the wire is pinned: exactly the single pantograph's start
 state), and from then on it runs in the wave of the ones ahead. The passage lasts until the last pantograph reaches
 x_end; each pantograph's record runs from its own x_start to x_end and its statistics are those of a single passage
-(`stats.en50318_statistics` on that record) except the uplift: the largest steady-arm displacement in the window while
-the pantograph is within `uplift_reach` (30 m) of the steady arm, so that each pantograph is charged with its own.
+(`stats.en50318_statistics` on that record) except, on a train of several, the uplift: the largest steady-arm
+displacement in the window while the pantograph is within `UPLIFT_REACH` (30 m) of the steady arm, so that each
+pantograph is charged with its own.
 
-Stepping: the catenary in the compiled core (`native_core`), all contact points in one local problem per step (the
-contact forces and the slack droppers solved together, exactly). 2-mass pantographs only: the whole passage runs in
-C between entries; any nonlinear pantograph (Eppinger): the core's stages with a secant iteration on every nonlinear
-pantograph's force (the single-pantograph scheme, Jacobi-style over the pantographs).
+Stepping (`TrainPassage`, a step object): the catenary in the compiled core (`native_core`), all contact points in one
+local problem per step (the contact forces and the slack droppers solved together, exactly). 2-mass pantographs only:
+the whole passage runs in C between entries; any nonlinear pantograph (Eppinger), or dropper/energy diagnostics: the
+core's stages with a secant iteration on every nonlinear pantograph's force (the single-pantograph scheme,
+Jacobi-style over the pantographs). A single pantograph that the C loop cannot step (a nonlinear one, or `native =
+False`) takes the readable Python `passage.Passage` instead, the twin the core is tested against.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ...errors import ParameterError, SolverError
+from ...errors import SolverError
+from .config import HEAD_WIDTH, PassageConfig
 from .fe import CatenaryFE, assemble
 from .native_core import NativeCore
-from .pantographs import Pantograph, TwoMassPantograph
-from .pantographs import build as build_pantograph
+from .pantographs import Pantograph
+from .pantographs import build_train as build_pantographs
 from .params import CatenaryParams
-from .sim import CHECK_EVERY, CoupledResult, CoupledSimulation, _native_error, steps_to_cover
+from .passage import CHECK_EVERY, CoupledResult, Passage, steps_to_cover
+from .sim import CoupledSimulation
 from .stats import en50318_statistics, supports_in_window
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure as MplFigure
-
-#: length of a pantograph head along the track (m): two contact points closer than this would share one head
-HEAD_WIDTH = 0.5
-#: most pantographs on one train (the compiled core's fixed per-step buffer)
-MAX_PANTOGRAPHS = 64
-#: a steady arm's uplift is charged to a pantograph while it is within this distance of it (m)
+#: a steady arm's uplift is charged to a pantograph of a train while it is within this distance of it (m)
 UPLIFT_REACH = 30.0
+#: steps the compiled loop runs between two returns to Python (progress calls)
+CHUNK = CHECK_EVERY * 25
 
 
 @dataclass
 class TrainRun:
-    """A passage of several pantographs: per pantograph its record (CoupledResult on its own x), statistics and
-    filtered force; the catenary's support displacements over the whole passage."""
+    """A passage of one or several pantographs: per pantograph its record (CoupledResult on its own x), statistics
+    and filtered force; the catenary's support displacements over the whole passage."""
 
     params: CatenaryParams
     speed_kmh: float
@@ -69,33 +69,232 @@ class TrainRun:
     dropper_slack: np.ndarray | None = None  # (steps + 1, droppers) slack status (record_droppers)
     t: np.ndarray | None = None  # global time of the passage (s)
     x: np.ndarray | None = None  # (steps + 1, pantographs) positions on the global time
+    regime: dict = field(default_factory=dict)  # `config.speed_regime` of the speed
+    engine_warnings: list[dict[str, int]] = field(default_factory=list)  # per pantograph: its engine's warnings
 
 
-def check_train(p: CatenaryParams, spacings: Sequence[float], head_width: float = HEAD_WIDTH) -> list[float]:
-    """Offsets s_k (m) of the pantographs behind the leading one from the spacings; errors name the bad value: a
-    spacing below a head width, or a train whose leading pantograph would leave the line before the last one ends
-    its run."""
-    if len(spacings) + 1 > MAX_PANTOGRAPHS:
-        raise ParameterError(f"{len(spacings) + 1} pantographs; the core takes at most {MAX_PANTOGRAPHS}")
-    offsets = [0.0]
-    for i, s in enumerate(spacings):
-        if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s):
-            raise ParameterError(f"spacing[{i}] = {s!r} must be a finite number of metres")
-        if s < head_width:
-            raise ParameterError(f"spacing[{i}] = {s!r} m puts two pantographs closer than a head width "
-                                 f"({head_width} m); valid: >= {head_width} m")
-        offsets.append(offsets[-1] + float(s))
-    lead_end = p.x_end + offsets[-1]
-    if lead_end > p.length + 1e-9:
-        raise ParameterError(
-            f"spacings {list(spacings)} m: the leading pantograph would be at x = {lead_end:g} m, outside the "
-            f"catenary [0, {p.length:g}] m, when the last one reaches x_end = {p.x_end:g} m; valid: total spacing "
-            f"<= {p.length - p.x_end:g} m (or lengthen the line: n_spans)")
-    return offsets
+class TrainPassage:
+    """A passage of the pantographs `pans` (leading first, `offsets` m behind the leading one) stepped in the compiled
+    core (module docstring), a `mbsuite.stepping.StepObject`: `step()` runs one chunk of C steps up to the next entry
+    (`compiled`, every pantograph a 2-mass one) or one coupled step through the core's stages; the records
+    (`T`, `X`, `F`, `H`, `W`, `FR`, `U`, `NS`, one row per step from the start) fill as it goes. The leading
+    pantograph starts from `lead`, the static state of the single passage."""
+
+    def __init__(self, sim: CoupledSimulation, pans: list[Pantograph], lead: Passage, offsets: list[float],
+                 compiled: bool, record_energy: int = 0, record_droppers: bool = False):
+        p, dt, V = sim.fe.params, sim.dt, sim.V
+        self.sim, self.pans, self.lead, self.compiled = sim, pans, lead, compiled
+        self.dt, self.V = dt, V
+        nc = len(pans)
+        self.nsingle = lead.nsteps
+        self.entries = [steps_to_cover(s, V, dt) for s in offsets]
+        self.nsteps = self.entries[-1] + self.nsingle
+        self.xs = np.array([p.x_start - s for s in offsets])
+        xend = np.array([p.x_end + (offsets[-1] - s) for s in offsets])
+        core = self.core = NativeCore(sim, nc, self.xs, xend)
+        core.u[:], core.q[:], core.p[:] = lead.u, lead.q, lead.p
+        nrec = self.nsteps + 1
+        nd = sim.fe.T0.size
+        self.DE = np.zeros((nrec, nd)) if record_droppers else None
+        self.DS = np.zeros((nrec, nd), bool) if record_droppers else None
+        self.T = np.zeros(nrec)
+        self.X, self.F, self.H, self.W, self.FR = (np.zeros((nrec, nc)) for _ in range(5))
+        self.U = np.zeros((nrec, sim.fe.supports.size))
+        self.NS = np.zeros(nrec, dtype=np.int32)
+        self.psig: list[dict[str, np.ndarray]] = [{} for _ in range(nc)]
+        self.static_forces = [0.0] * nc
+        self.record_energy = record_energy
+        self.energy_rows: list[dict[str, float]] = []
+        self.energy_t: list[float] = []
+        self.n, self.t = 0, 0.0
+        for k in range(nc):
+            if self.entries[k] == 0:
+                self._enter(k, 0)
+        if compiled:
+            core.set_records(t=self.T, x=self.X, f=self.F, head=self.H, wire=self.W, frame=self.FR, up=self.U,
+                             ns=self.NS)
+            core.record(0, 0.0)
+            self._stops = sorted({e for e in self.entries if e > 0} | {self.nsteps})
+        else:
+            self._record(0, 0.0)
+            self._secant = _Secant(pans, core, dt)
+        self.status = "running" if self.nsteps > 0 else "finished"
+        if self.status == "finished":
+            self._finish()
+
+    def _enter(self, k: int, n: int) -> None:
+        """Pantograph k enters at step n: placed where it stands, at its static equilibrium against the wire."""
+        sim, core, pan = self.sim, self.core, self.pans[k]
+        core.place(k, float(self.xs[k] + self.V * n * self.dt))
+        if k == 0:
+            f, head = self.lead.force, self.lead.head
+        else:
+            f = pan.static(core.wire(k), sim.fe.params.k_contact)
+            if sim.unilateral and f < 0:
+                f = pan.static(core.wire(k), 0.0)
+            head = pan.head()
+        core.present[k], core.active[k] = 1, int(f > 0 or not sim.unilateral)
+        core.set_force(k, f)
+        core.head[k] = head
+        self.static_forces[k] = float(f)
+        if self.compiled:
+            pan.pack(core.pm[16 * k:16 * k + 16], self.dt)
+
+    def step(self) -> None:
+        """One chunk of C steps up to the next entry (compiled) or one coupled step (stages); SolverError on a
+        failure (`status` is then "failed")."""
+        if self.status != "running":
+            raise RuntimeError(f"the passage is {self.status}; start a new one")
+        try:
+            self._chunk() if self.compiled else self._stage_step()
+        except Exception:
+            self.status = "failed"
+            raise
+        self.t = self.n * self.dt
+        if self.n >= self.nsteps:
+            self.status = "finished"
+            self._finish()
+
+    def run(self, t_end: float) -> None:
+        """`step()` until t >= t_end or the passage is no longer running."""
+        while self.status == "running" and self.t < t_end:
+            self.step()
+
+    def _chunk(self) -> None:
+        stop = next(s for s in self._stops if s > self.n)
+        n1 = min(self.n + CHUNK, stop)
+        self.core.run_chunks(self.n, n1, CHECK_EVERY, CHUNK, self.static_forces[0])
+        self.n = n1
+        if n1 == stop and stop < self.nsteps:
+            for k in range(len(self.pans)):
+                if self.entries[k] == stop:
+                    self._enter(k, stop)
+                    self.core.record(stop, stop * self.dt)
+
+    def _stage_step(self) -> None:
+        core, sim, n = self.core, self.sim, self.n + 1
+        t_new = n * self.dt
+        core.predict(t_new)
+        self._secant.couple(t_new - self.dt)
+        core.advance()
+        if n % CHECK_EVERY == 0 or n == self.nsteps:
+            code = core.check()
+            if code:
+                raise SolverError(core.failure(code, self.static_forces[0]))
+        for k in range(len(self.pans)):
+            if self.entries[k] == n and n < self.nsteps:
+                self._enter(k, n)
+        self._record(n, t_new)
+        if self.DE is not None:
+            self.DE[n] = sim.fe.T0 + sim.kd * (core.u[sim.mw] - core.u[sim.cw])
+            self.DS[n, core.slk[:core.nslack]] = True
+        if self.record_energy and n % self.record_energy == 0:
+            self.energy_rows.append(_energy(core, sim, self.pans))
+            self.energy_t.append(t_new)
+        self.n = n
+
+    def _record(self, n: int, t: float) -> None:
+        _record_row(self.core, n, t, self.T, self.X, self.F, self.H, self.W, self.U, self.NS, self.pans, self.psig,
+                    self.nsteps + 1)
+        if n == 0 and self.record_energy:
+            self.energy_rows.append(_energy(self.core, self.sim, self.pans))
+            self.energy_t.append(0.0)
+
+    def _finish(self) -> None:
+        if self.compiled:
+            for k, pan in enumerate(self.pans):
+                pan.unpack(self.core.pm[16 * k:16 * k + 16])
+                self.psig[k] = {"head_displacement": self.H[:, k].copy(), "frame_displacement": self.FR[:, k].copy()}
+
+    def results(self) -> list[CoupledResult]:
+        """Each pantograph's record from its entry, on the time since its entry and its own position."""
+        sx = self.sim.fe.x[self.sim.fe.supports]
+        out = []
+        for k in range(len(self.pans)):
+            e = self.entries[k]
+            rows = slice(e, e + self.nsingle + 1)
+            out.append(CoupledResult(t=self.T[rows] - self.T[e], x=self.X[rows, k], force=self.F[rows, k],
+                                     head=self.H[rows, k], wire=self.W[rows, k], uplift=self.U[rows],
+                                     n_slack=self.NS[rows], panto={kk: v[rows] for kk, v in self.psig[k].items()},
+                                     support_x=sx, stats={"steps": self.nsingle}))
+        return out
 
 
-def _entry_step(offset: float, V: float, dt: float) -> int:
-    return steps_to_cover(offset, V, dt)
+def run_passage(cfg: PassageConfig, progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
+                native: bool | None = None, record_energy: int = 0, record_droppers: bool = False,
+                stepwise: bool = False) -> TrainRun:
+    """Check, build, step and analyse one passage (`cfg`; the EN 50318 procedure for each pantograph). Everything is
+    checked (`PassageConfig.check`) before anything is built. `native`: None = the compiled core wherever it applies,
+    False = never (a single pantograph takes the Python path, a train the core's stages), True = the compiled C loop
+    or an error. `record_energy` > 0 records the energy terms every that many steps, `record_droppers` the droppers'
+    elastic tensions T0 + k delta and slack status at every step (both on the core's stages); `stepwise` takes the
+    core's stages even for 2-mass pantographs (a test holds both equal). `progress(n, nsteps)` reports the steps."""
+    adm = cfg.check()
+    p, dt = cfg.params, cfg.dt
+    t0, c0 = time.perf_counter(), time.process_time()
+    fe = fe if fe is not None else assemble(p)
+    pans = build_pantographs(list(cfg.pantographs), p, cfg.engine, dt, cfg.pantograph_section, cfg.contact)
+    sim = CoupledSimulation(fe, pans[0], adm.V, dt, dropper_law=cfg.dropper_law, contact=cfg.contact)
+    t1 = time.perf_counter()
+    diagnostics = bool(record_energy or record_droppers)
+    packable = all(hasattr(pn, "pack") and hasattr(pn, "unpack") for pn in pans)
+    if native and (not packable or diagnostics or stepwise):
+        raise SolverError("the native core steps affine 2-mass pantographs and records every step without "
+                          "dropper/energy diagnostics; use native=False for this run")
+    compiled = packable and native is not False and not diagnostics and not stepwise
+    tp = None
+    if len(pans) == 1 and not compiled and not diagnostics and not stepwise:
+        res = sim.run(p.x_start, p.x_end, progress=progress, native=False)
+        results, static_forces, local_solves = [res], [float(res.force[0])], res.stats["local_solves"]
+        T, X = res.t, res.x[:, None]
+    else:
+        tp = TrainPassage(sim, pans, sim.start(p.x_start, p.x_end), adm.offsets, compiled, record_energy,
+                          record_droppers)
+        while tp.status == "running":
+            tp.step()
+            if progress is not None and (compiled or tp.n % CHECK_EVERY == 0 or tp.n == tp.nsteps):
+                progress(tp.n, tp.nsteps)
+        results, static_forces, local_solves = tp.results(), tp.static_forces, tp.core.n_local
+        T, X = tp.T, tp.X
+    t2 = time.perf_counter()
+    stats, filtered = [], []
+    for res in results:
+        s, ff = _statistics(res, dt, p, alone=len(results) == 1)
+        stats.append(s)
+        filtered.append(ff)
+    t3, c3 = time.perf_counter(), time.process_time()
+    steps = int(T.size - 1)
+    timing = {"build_s": t1 - t0, "integrate_s": t2 - t1, "statistics_s": t3 - t2, "total_s": t3 - t0,
+              "cpu_s": c3 - c0, "loop_wall_s": t2 - t1, "steps": steps, "dofs": fe.n,
+              "us_per_step": 1e6 * (t2 - t1) / max(steps, 1), "native": compiled, "native_loop": compiled,
+              "local_solves": local_solves}
+    energy = None
+    if tp is not None and record_energy:
+        energy = {key: np.array([r[key] for r in tp.energy_rows]) for key in tp.energy_rows[0]}
+    return TrainRun(params=p, speed_kmh=float(cfg.speed_kmh), dt=float(dt), dropper_law=cfg.dropper_law,
+                    names=[n if isinstance(n, str) else getattr(n, "name", "custom") for n in cfg.pantographs],
+                    offsets=adm.offsets, engines=[str(getattr(pn, "engine", "reference")) for pn in pans],
+                    results=results, stats=stats, filtered=filtered, static_forces=static_forces, timing=timing,
+                    energy=energy, energy_t=None if energy is None else np.array(tp.energy_t),
+                    warnings=adm.warnings, dropper_elastic=None if tp is None else tp.DE,
+                    dropper_slack=None if tp is None else tp.DS, t=T, x=X, regime=adm.regime,
+                    engine_warnings=[pn.engine_warnings() if hasattr(pn, "engine_warnings") else {} for pn in pans])
+
+
+def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -> tuple[dict, np.ndarray]:
+    """The EN 50318 statistics of one pantograph's record; on a train of several, the uplift charged to it is only
+    that while it is within UPLIFT_REACH of the steady arm."""
+    if alone:
+        return en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p)
+    sx, x = res.support_x, res.x
+    near = np.abs(x[:, None] - sx[None, :]) <= UPLIFT_REACH
+    up = np.where(near, res.uplift, -np.inf)
+    s, ff = en50318_statistics(res.t, x, res.force, np.where(np.isfinite(up), up, 0.0), sx, dt, p)
+    win = supports_in_window(sx, p)
+    per = {f"{xsup:g}": float(1000 * np.max(up[:, j])) for j, xsup in enumerate(sx) if win[j]}
+    s["uplift_at_supports_mm"] = per
+    s["uplift_mm"] = max(per.values()) if per else 0.0
+    return s, ff
 
 
 def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: Sequence[str | Pantograph],
@@ -105,165 +304,13 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
                    record_energy: int = 0, stepwise: bool = False, head_width: float = HEAD_WIDTH,
                    record_droppers: bool = False, max_steps: float | None = None,
                    allow_inaccurate: bool = False) -> TrainRun:
-    """Run a train of pantographs (leading first) at `speed_kmh` with `spacings` (m, between consecutive contact
-    points). Names are built on `engine` (reference2mass always on its only path). `record_energy` > 0 records the
-    energy terms every that many steps, `record_droppers` the droppers' elastic tensions T0 + k delta and slack status
-    at every step (`TrainRun.dropper_elastic`, `dropper_slack`; both on the stage path). `stepwise` forces the
-    Python-driven stage loop even for 2-mass pantographs (the path the nonlinear pantographs take; a test holds both
-    equal)."""
-    from .analysis import check_size, check_timestep, check_wave_resolution, speed_regime
-
-    if len(pantographs) != len(spacings) + 1:
-        raise ParameterError(f"{len(pantographs)} pantographs need {len(pantographs) - 1} spacings, got "
-                             f"{len(spacings)}")
-    if not (isinstance(speed_kmh, int | float) and math.isfinite(speed_kmh) and speed_kmh > 0):
-        raise ParameterError(f"speed must be a positive number of km/h, got {speed_kmh!r}")
-    check_timestep(p, dt)
-    offsets = check_train(p, spacings, head_width)
-    V = speed_kmh / 3.6
-    regime = speed_regime(p, V)
-    import dataclasses
-
-    check_size(dataclasses.replace(p, x_end=p.x_end + offsets[-1]), V, dt, max_steps)  # the whole train's steps
-    step_warn = check_wave_resolution(p, dt, allow_inaccurate)
-    t0, c0 = time.perf_counter(), time.process_time()
-    fe = fe if fe is not None else assemble(p)
-    pans, names, engines = [], [], []
-    for k in pantographs:
-        if isinstance(k, str):
-            eng = "reference" if k == "reference2mass" else engine
-            pans.append(build_pantograph(k, p, engine=eng, dt=dt, section=pantograph_section, contact=contact))
-            names.append(k)
-            engines.append(eng)
-        else:
-            pans.append(k)
-            names.append(getattr(k, "name", "custom"))
-            engines.append(str(getattr(k, "engine", "reference")))
-    nc = len(pans)
-    sim = CoupledSimulation(fe, pans[0], V, dt, dropper_law=dropper_law, contact=contact)
-    lead = sim.start(p.x_start, p.x_end)
-    nsingle = lead.nsteps
-    entries = [_entry_step(s, V, dt) for s in offsets]
-    ntotal = entries[-1] + nsingle
-    xs = np.array([p.x_start - s for s in offsets])
-    xend = np.array([p.x_end + (offsets[-1] - s) for s in offsets])
-    core = NativeCore(sim, nc, xs, xend)
-    core.u[:], core.q[:], core.p[:] = lead.u, lead.q, lead.p
-    all_affine = (all(isinstance(pn, TwoMassPantograph) for pn in pans) and not stepwise and not record_energy
-                  and not record_droppers)
-    nd = fe.T0.size
-    DE = np.zeros((ntotal + 1, nd)) if record_droppers else None
-    DS = np.zeros((ntotal + 1, nd), bool) if record_droppers else None
-    nrec = ntotal + 1
-    T = np.zeros(nrec)
-    X, F, H, W, FR = (np.zeros((nrec, nc)) for _ in range(5))
-    U = np.zeros((nrec, fe.supports.size))
-    NS = np.zeros(nrec, dtype=np.int32)
-    psig: list[dict[str, np.ndarray]] = [{} for _ in range(nc)]
-    static_forces = [0.0] * nc
-
-    def enter(k: int, n: int) -> None:
-        x = float(xs[k] + V * n * dt)
-        core.place(k, x)
-        if k == 0:
-            f, head = lead.force, lead.head
-        else:
-            f = pans[k].static(core.wire(k), p.k_contact)
-            if sim.unilateral and f < 0:
-                f = pans[k].static(core.wire(k), 0.0)
-            head = pans[k].head()
-        core.present[k], core.active[k] = 1, int(f > 0 or not sim.unilateral)
-        core.set_force(k, f)
-        core.head[k] = head
-        static_forces[k] = float(f)
-        if all_affine:
-            pans[k].pack(core.pm[16 * k:16 * k + 16], dt)
-
-    en_rows: list[dict[str, float]] = []
-    en_t: list[float] = []
-    for k in range(nc):
-        if entries[k] == 0:
-            enter(k, 0)
-    w_start = time.perf_counter()
-    if all_affine:
-        core.set_records(t=T, x=X, f=F, head=H, wire=W, frame=FR, up=U, ns=NS)
-        core.record(0, 0.0)
-        stops = sorted({e for e in entries if e > 0} | {ntotal})
-        n = 0
-        for stop in stops:
-            while n < stop:
-                n1 = min(n + CHECK_EVERY * 25, stop)
-                code = core.run(n, n1, CHECK_EVERY)
-                if code:
-                    raise SolverError(_native_error(core, code, static_forces[0]))
-                n = n1
-                if progress is not None:
-                    progress(n, ntotal)
-            for k in range(nc):
-                if entries[k] == stop and stop < ntotal:
-                    enter(k, stop)
-                    core.record(stop, stop * dt)
-        for k in range(nc):
-            pans[k].unpack(core.pm[16 * k:16 * k + 16])
-            psig[k] = {"head_displacement": H[:, k].copy(), "frame_displacement": FR[:, k].copy()}
-    else:
-        _record_row(core, 0, 0.0, T, X, F, H, W, U, NS, pans, psig, nrec)
-        if record_energy:
-            en_rows.append(_energy(core, sim, pans))
-            en_t.append(0.0)
-        secant = _Secant(pans, core, dt)
-        for n in range(1, ntotal + 1):
-            t_new = n * dt
-            core.predict(t_new)
-            secant.couple(t_new - dt)
-            core.advance()
-            if n % CHECK_EVERY == 0 or n == ntotal:
-                code = core.check()
-                if code:
-                    raise SolverError(_native_error(core, code, static_forces[0]))
-            for k in range(nc):
-                if entries[k] == n and n < ntotal:
-                    enter(k, n)
-            _record_row(core, n, t_new, T, X, F, H, W, U, NS, pans, psig, nrec)
-            if DE is not None:
-                DE[n] = fe.T0 + sim.kd * (core.u[sim.mw] - core.u[sim.cw])
-                DS[n, core.slk[:core.nslack]] = True
-            if record_energy and n % record_energy == 0:
-                en_rows.append(_energy(core, sim, pans))
-                en_t.append(t_new)
-            if progress is not None and (n % CHECK_EVERY == 0 or n == ntotal):
-                progress(n, ntotal)
-    wall = time.perf_counter() - w_start
-    results, stats, filtered = [], [], []
-    sx = fe.x[fe.supports]
-    for k in range(nc):
-        rows = slice(entries[k], entries[k] + nsingle + 1)
-        x = X[rows, k]
-        res = CoupledResult(t=T[rows] - T[entries[k]], x=x, force=F[rows, k], head=H[rows, k], wire=W[rows, k],
-                            uplift=U[rows], n_slack=NS[rows], panto={kk: v[rows] for kk, v in psig[k].items()},
-                            support_x=sx, stats={"steps": nsingle})
-        near = np.abs(x[:, None] - sx[None, :]) <= UPLIFT_REACH
-        up = np.where(near, res.uplift, -np.inf)
-        s, ff = en50318_statistics(res.t, x, res.force, np.where(np.isfinite(up), up, 0.0), sx, dt, p)
-        # the uplift charged to this pantograph: only while it is within UPLIFT_REACH of the steady arm
-        win = supports_in_window(sx, p)
-        per = {f"{xsup:g}": float(1000 * np.max(up[:, j])) for j, xsup in enumerate(sx) if win[j]}
-        s["uplift_at_supports_mm"] = per
-        s["uplift_mm"] = max(per.values()) if per else 0.0
-        results.append(res)
-        stats.append(s)
-        filtered.append(ff)
-    t3, c3 = time.perf_counter(), time.process_time()
-    energy = None
-    if record_energy:
-        energy = {key: np.array([r[key] for r in en_rows]) for key in en_rows[0]}
-    timing = {"total_s": t3 - t0, "cpu_s": c3 - c0, "loop_wall_s": wall, "steps": ntotal, "dofs": fe.n,
-              "native_loop": bool(all_affine), "local_solves": core.n_local}
-    return TrainRun(params=p, speed_kmh=float(speed_kmh), dt=float(dt), dropper_law=dropper_law, names=names,
-                    offsets=offsets, engines=engines, results=results, stats=stats, filtered=filtered,
-                    static_forces=static_forces, timing=timing, energy=energy,
-                    energy_t=None if energy is None else np.array(en_t), warnings=list(regime["warnings"]) + step_warn,
-                    dropper_elastic=DE, dropper_slack=DS, t=T, x=X)
+    """A train of pantographs (leading first) at `speed_kmh` with `spacings` (m, between consecutive contact
+    points): the `PassageConfig` of these arguments through `run_passage` (its options: `record_energy`,
+    `record_droppers`, `stepwise`). Names are built on `engine` where they have it (`pantographs.build_train`)."""
+    cfg = PassageConfig(p, speed_kmh, dt, tuple(pantographs), tuple(spacings), dropper_law, contact, engine,
+                        pantograph_section, max_steps, allow_inaccurate, head_width)
+    return run_passage(cfg, progress=progress, fe=fe, record_energy=record_energy, record_droppers=record_droppers,
+                       stepwise=stepwise)
 
 
 def _record_row(core: NativeCore, n: int, t: float, T, X, F, H, W, U, NS, pans, psig, nrec: int) -> None:
@@ -356,7 +403,7 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
     power the imposed horizontal motion feeds in through the sloping wire, summed over the contacts."""
     fe = sim.fe
     u = core.u
-    v = sim._mass().solve(0.5 * (core.q + core.p))
+    v = sim.mass().solve(0.5 * (core.q + core.p))
     delta = u[sim.mw] - u[sim.cw]
     kd, T0 = sim.kd, fe.T0
     if sim.slack:
@@ -381,183 +428,3 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
         slope = float(dN @ (np.where(valid, u[dofs], 0.0) + core.w0d[4 * k:4 * k + 4]))
         P += -f * sim.V * slope
     return {"catenary": E_c, "pantograph": E_p, "contact": E_k, "drive_power": P}
-
-
-# --- scene section ------------------------------------------------------------------------------------------------
-TRAIN_KEYS = ("pantographs", "spacings")
-
-
-def validate_section(value: Any) -> dict[str, Any]:
-    """Validator of a scene's `[train]` section: `pantographs` (names of the `pantograph` effect's values, leading
-    first) and `spacings` (m between consecutive contact points, one fewer). Spacing limits are checked against the
-    line when the passage starts (`check_train`)."""
-    from ...errors import SceneError
-    from .pantographs import PANTOGRAPH_MODELS
-
-    if not isinstance(value, dict):
-        raise SceneError(f"[train] must be a table with keys {list(TRAIN_KEYS)}, got {value!r}")
-    bad = sorted(set(value) - set(TRAIN_KEYS))
-    if bad:
-        raise SceneError(f"unknown key(s) {bad} in [train]; valid keys: {list(TRAIN_KEYS)}")
-    names = value.get("pantographs")
-    valid = ["reference2mass", *PANTOGRAPH_MODELS]
-    if not isinstance(names, list) or not names or any(n not in valid for n in names):
-        raise SceneError(f"[train] pantographs must be a non-empty list of {valid}, got {names!r}")
-    sp = value.get("spacings", [])
-    if not isinstance(sp, list) or len(sp) != len(names) - 1:
-        raise SceneError(f"[train] spacings must be a list of {len(names) - 1} distances (m) for {len(names)} "
-                         f"pantographs, got {sp!r}")
-    for i, s in enumerate(sp):
-        if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s) or s < HEAD_WIDTH:
-            raise SceneError(f"[train] spacings[{i}] = {s!r} m: valid spacings are >= a head width ({HEAD_WIDTH} m)")
-    return {"pantographs": list(names), "spacings": [float(s) for s in sp]}
-
-
-def run_train_scene(scene, speed_kmh: float | None = None, progress=None, spacings: Sequence[float] | None = None,
-                    **overrides: Any) -> TrainRun:
-    """A train passage of a scene with a `[train]` section (its parameters with `overrides`, speed, time step,
-    effects; `spacings` overrides the section's)."""
-    import dataclasses
-
-    from .analysis import scene_speed
-
-    p = scene.build_params()
-    if overrides:
-        p = dataclasses.replace(p, **overrides)
-    tr = scene.sections["train"]
-    return simulate_train(p, scene_speed(scene, speed_kmh), scene.solver.timestep, tr["pantographs"],
-                          list(tr["spacings"] if spacings is None else spacings),
-                          dropper_law=scene.effects["droppers"], contact=scene.effects["contact"],
-                          engine=scene.solver.engine, pantograph_section=scene.sections.get("pantograph"),
-                          progress=progress, max_steps=scene.solver.max_steps,
-                          allow_inaccurate=scene.solver.allow_inaccurate)
-
-
-# --- outputs ------------------------------------------------------------------------------------------------------
-STAT_KEYS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
-
-
-def _label(run: TrainRun, k: int) -> str:
-    role = "leading" if k == 0 else ("trailing" if len(run.names) == 2 else f"#{k + 1}")
-    path = "" if run.engines[k] == "reference" or run.names[k] == "reference2mass" else f", {run.engines[k]}"
-    return f"{role} {run.names[k]}{path} (s = {run.offsets[k]:g} m)"
-
-
-def _assessments(run: TrainRun, criteria) -> list[dict]:
-    from .quality import assess
-
-    return [assess(s, run.speed_kmh, criteria, float(s["n_samples_window"]) * run.dt) for s in run.stats]
-
-
-def train_report(run: TrainRun, quality=None):
-    """Table (one column per pantograph), JSON data and writer (per-pantograph CSV, force/uplift plot, quality plot)
-    of a train passage; `quality` (QualityCriteria) adds the quality report of every pantograph."""
-    from pathlib import Path
-
-    from ...plotting import save
-    from ...results import Report, format_table, write_csv
-    from .quality import plot as quality_plot
-    from .quality import table_rows
-    from .stats import STAT_NAMES
-
-    labels = [_label(run, k) for k in range(len(run.names))]
-    rows = [[STAT_NAMES[key]] + [f"{s[key]:.2f}" for s in run.stats] for key in STAT_KEYS]
-    lines = [f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h (element {run.params.element_length:g} m, "
-             f"dt {run.dt:g} s, {run.timing['steps']} steps, {run.timing['cpu_s']:.2f} s CPU); window "
-             f"[{run.params.window_start:g}, {run.params.window_end:g}] m on each pantograph's own position",
-             format_table(["statistic", *labels], rows)]
-    for k, s in enumerate(run.stats):
-        c = s["loss_counts"]
-        lines.append(f"{labels[k]}: static contact force {run.static_forces[k]:.2f} N; contact losses in window "
-                     f"{len(s['loss_events'])} (<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, "
-                     f">20 ms: {c['power_loss_gt_20ms']})")
-    for w in run.warnings:
-        lines.append(f"WARNING: {w}")
-    data = {"speed_kmh": run.speed_kmh, "element_length": run.params.element_length, "timestep": run.dt,
-            "timing": run.timing,
-            "pantographs": [{"name": run.names[k], "engine": run.engines[k], "offset_m": run.offsets[k],
-                             "static_contact_force": run.static_forces[k],
-                             "statistics": {key: run.stats[k][key] for key in STAT_KEYS},
-                             "uplift_at_supports_mm": run.stats[k]["uplift_at_supports_mm"],
-                             "loss_events": run.stats[k]["loss_events"]} for k in range(len(run.names))],
-            "warnings": run.warnings}
-    qs = []
-    if quality is not None:
-        qs = _assessments(run, quality)
-        for k, q in enumerate(qs):
-            data["pantographs"][k]["quality"] = q
-            lines.append(f"current-collection quality, {labels[k]}, {quality.system} criteria: "
-                         f"{'PASS' if q['pass'] else 'FAIL'}")
-            lines.append(format_table(["criterion", "value", "limit", "verdict"], table_rows(q)))
-        data["quality_pass"] = all(q["pass"] for q in qs)
-
-    def write(out: Path) -> list[Path]:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        files = []
-        for k, res in enumerate(run.results):
-            tag = f"p{k + 1}_{run.names[k]}_{run.speed_kmh:g}kmh"
-            files.append(write_csv(out / f"contact_force_{tag}.csv", [
-                ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force),
-                ("force_filtered_20Hz", "N", run.filtered[k]), ("head_height", "m", res.head),
-                ("wire_height", "m", res.wire)]))
-        files.append(save(train_figure(run, labels), out / f"train_force_{run.speed_kmh:g}kmh.png"))
-        if qs:
-            files.append(quality_plot(list(zip(labels, qs, strict=True)),
-                                      out / f"quality_train_{run.speed_kmh:g}kmh.png"))
-        return files
-
-    return Report(data=data, table="\n".join(lines), write=write)
-
-
-def train_figure(run: TrainRun, labels: list[str]) -> MplFigure:
-    """Each pantograph's 20 Hz low-pass contact force and the contact-wire height at its contact point against its
-    own position (the statistics window shaded); `labels` names the pantographs."""
-    from ...plotting import figure
-
-    p = run.params
-    fig, axes = figure(2, 1, size=(11, 7), sharex=True)
-    for k, res in enumerate(run.results):
-        axes[0].plot(res.x, run.filtered[k], lw=1.0, label=f"{labels[k]}")
-        axes[1].plot(res.x, 1000 * res.wire, lw=1.0, label=f"{labels[k]}")
-    for ax in axes:
-        ax.axvspan(p.window_start, p.window_end, color="0.9", zorder=-1)
-        ax.set_xlim(p.x_start, p.x_end)
-        ax.grid(True, lw=0.3)
-        ax.legend(fontsize=7, loc="upper left")
-    axes[0].set_ylabel("contact force F, 20 Hz low-pass [N]")
-    axes[1].set_ylabel("contact-wire height at\nthe contact point [mm]")
-    axes[1].set_xlabel("each pantograph's own position x [m]")
-    axes[0].set_title(f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h; wire height from its static "
-                      "state (grey: statistics window)", fontsize=10)
-    return fig
-
-
-def train_to_simresult(run: TrainRun, scene):
-    """A train passage as a SimResult: the leading pantograph's channels under the usual names (on its own record),
-    `contact_force_p<k>` / `position_p<k>` for every pantograph k = 1, 2, ... (each on its own record; all records
-    have the same length, one passage from x_start to x_end, on the time since the pantograph's entry), and per
-    pantograph the eight statistics and quality verdicts in `stats` (`p<k>_Fm`, ..., `p<k>_quality_pass`)."""
-    from ...results import assemble
-    from .analysis import health_of_regime
-    from .quality import criteria_from
-
-    lead = run.results[0]
-    signals = {"contact_force": lead.force, "contact_force_filtered": run.filtered[0], "position": lead.x,
-               "head_height": lead.head, "wire_height": lead.wire, "slack_droppers": lead.n_slack.astype(float)}
-    qs = _assessments(run, criteria_from(scene.sections.get("quality")))
-    stats: dict[str, Any] = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"],
-                             "total_s": run.timing["total_s"]}
-    for k, s in enumerate(run.stats):
-        stats.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})
-        stats[f"p{k + 1}_static_contact_force"] = run.static_forces[k]
-        stats[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
-    events = [{**e, "pantograph": k + 1} for k, s in enumerate(run.stats) for e in s["loss_events"]]
-    res = assemble(scene, lead.t, signals, engine=run.engines[-1], events=events, stats=stats,
-                   health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
-    for k, r in enumerate(run.results):
-        res.signals[f"contact_force_p{k + 1}"] = r.force
-        res.units[f"contact_force_p{k + 1}"] = "N"
-        res.signals[f"position_p{k + 1}"] = r.x
-        res.units[f"position_p{k + 1}"] = "m"
-    return res

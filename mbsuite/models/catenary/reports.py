@@ -1,0 +1,251 @@
+"""What a passage gives: the SimResult of a scene's run on a path (`passage_result`, the run functions of
+`reference.py` and `mujoco.py`; `to_simresult`, `train_to_simresult`), and the CLI's table, JSON data and writers
+(`report`, `train_report`: CSV records, the figures of `plots.py`, the quality plot). Nothing here simulates: every
+number comes from the runs handed in."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+from typing import Any
+
+from ...results import Report, SimResult, format_table, write_csv
+from ...results import assemble as assemble_result
+from .analysis import CatenaryRun, scene_config, single
+from .config import health_of_regime
+from .plots import force_uplift_figure, train_figure
+from .quality import QualityCriteria, assess, criteria_from
+from .quality import plot as quality_plot
+from .quality import table_rows as quality_table_rows
+from .stats import ACCEPTED_RANGES, STAT_NAMES
+from .train import TrainRun, run_passage
+
+
+def passage_result(scene, engine: str) -> SimResult:
+    """A scene's passage with its pantographs on the engine path `engine` as a SimResult: a `[train]` scene's
+    (`train_to_simresult`), else one pantograph's (`to_simresult`)."""
+    run = run_passage(scene_config(scene, engine))
+    if "train" in scene.sections:
+        return train_to_simresult(run, scene)
+    return to_simresult(single(run), scene)
+
+
+def to_simresult(run: CatenaryRun, scene) -> SimResult:
+    """The run as a SimResult (`results.assemble`: the scene's output signals with the declared units). The declared
+    signal `uplift` stands for one column per support, `uplift_<x>m` (x = the support's position), in its unit.
+    `stats`: timings, the eight EN 50318 statistics, the static contact force, the pantograph engine's warnings and
+    the quality verdicts (`quality_pass`, `quality_<criterion>_pass`, `quality_nq_pct`; limits from the scene's
+    `[quality]` section, else the AC defaults);
+    `events`: the contact losses in the window."""
+    r = run.result
+    signals = {"contact_force": r.force, "contact_force_filtered": run.filtered, "position": r.x,
+               "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
+    q = quality_of(run, criteria_from(scene.sections.get("quality")))
+    stats = {**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
+             "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings),
+             "quality_pass": q["pass"], **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
+             "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
+    res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats,
+                          health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
+    if "uplift" in scene.outputs:
+        unit = scene.spec.outputs["uplift"]
+        for j, xs in enumerate(r.support_x):
+            res.signals[f"uplift_{xs:g}m"] = r.uplift[:, j]
+            res.units[f"uplift_{xs:g}m"] = unit
+    return res
+
+
+def _scalar_stats(run: CatenaryRun) -> dict:
+    return {k: run.stats[k] for k in STAT_NAMES}
+
+
+def window_time(stats: dict, dt: float) -> float:
+    """Time (s) the pantograph spent in the statistics window (its window samples times dt)."""
+    return float(stats["n_samples_window"]) * dt
+
+
+def quality_of(run: CatenaryRun, criteria: QualityCriteria) -> dict:
+    """The current-collection quality assessment of a run (`quality.assess`, the one function for every pantograph
+    under the wire)."""
+    return assess(run.stats, run.speed_kmh, criteria, window_time(run.stats, run.dt))
+
+
+def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[CatenaryRun] | None = None,
+           quality: QualityCriteria | None = None) -> Report:
+    """Human table + JSON data + writer (CSV of filtered/unfiltered force, PNG plots) for one run (and optional
+    companion runs shown beside it, e.g. the linear-dropper scene). `quality`: add the current-collection quality
+    report of every run (table, JSON `quality`, plot `quality_<pantograph>_<speed>kmh.png`)."""
+    runs = [run] + list(extra_runs or [])
+    key = int(round(run.speed_kmh))
+    rng = ACCEPTED_RANGES.get(key) if (abs(run.speed_kmh - key) < 1e-9 and run.ranges is not None) else None
+    headers = ["statistic"] + [f"{r.dropper_law} droppers" for r in runs] + (
+        ["EN 50318 range", f"ok ({run.dropper_law})"] if rng else [])
+    rows = []
+    for name, label in STAT_NAMES.items():
+        row = [label] + [f"{r.stats[name]:.2f}" for r in runs]
+        if rng:
+            lo, hi = rng[name]
+            row += [f"{lo:g} .. {hi:g}", "yes" if run.ranges[name]["inside"] else "NO"]
+        rows.append(row)
+    what = "EN 50318 reference scene" if run.is_reference else "catenary passage (EN 50318 statistics)"
+    path = "" if run.engine == "reference" else f" ({run.engine} path)"
+    lines = [f"{what}, {run.pantograph} pantograph{path}, {run.speed_kmh:g} km/h "
+             f"(element {run.params.element_length:g} m, dt {run.dt:g} s)", format_table(headers, rows)]
+    for r in runs:
+        c = r.stats["loss_counts"]
+        lines.append(f"[{r.dropper_law}] contact losses in window: {len(r.stats['loss_events'])} "
+                     f"(<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, "
+                     f">20 ms: {c['power_loss_gt_20ms']}); "
+                     f"static contact force {r.static_force:.2f} N; run time {r.timing['total_s']:.2f} s wall, "
+                     f"{r.timing['cpu_s']:.2f} s CPU "
+                     f"({r.timing['steps']} steps, {r.timing['dofs']} DOFs, {r.timing['us_per_step']:.0f} us/step)")
+        lines[-1] = textwrap.fill(lines[-1], 100, subsequent_indent="  ")
+    lines.append(f"speed ratio V/c = {run.regime['speed_ratio']:.3f} (c = {run.regime['cw_wave_speed_kmh']:.1f} km/h), "
+                 f"regime: {run.regime['regime']}")
+    lines[-1] = textwrap.fill(lines[-1], 100, subsequent_indent="  ")
+    for w in run.warnings:
+        lines.append(textwrap.fill(f"WARNING: {w}", 100, subsequent_indent="  "))
+    data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "engine": run.engine,
+            "element_length": run.params.element_length,
+            "timestep": run.dt, "regime": {k: v for k, v in run.regime.items() if k != "warnings"},
+            "warnings": run.warnings,
+            "runs": {r.dropper_law: {"statistics": _scalar_stats(r), "ranges": r.ranges,
+                                     "uplift_at_supports_mm": r.stats["uplift_at_supports_mm"],
+                                     "loss_counts": r.stats["loss_counts"], "loss_events": r.stats["loss_events"],
+                                     "contact_lost_entirely": r.stats["contact_lost_entirely"],
+                                     "static_contact_force": r.static_force, "timing": r.timing} for r in runs}}
+    if rng:
+        data["all_inside_ranges"] = all(v["inside"] for v in run.ranges.values())
+    assessments = []
+    if quality is not None:
+        for r in runs:
+            q = quality_of(r, quality)
+            assessments.append((f"{r.pantograph} ({r.dropper_law} droppers)", q))
+            data["runs"][r.dropper_law]["quality"] = q
+            lines.append(f"current-collection quality [{r.dropper_law} droppers], {quality.system} criteria, "
+                         f"{r.speed_kmh:g} km/h: {'PASS' if q['pass'] else 'FAIL'}")
+            lines.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
+        data["quality_pass"] = all(q["pass"] for _, q in assessments)
+
+    def write(out: Path) -> list[Path]:
+        files = write_run_files(runs, out)
+        if assessments:
+            files.append(quality_plot(assessments, Path(out) / f"quality_{run.pantograph}_{run.speed_kmh:g}kmh.png"))
+        return files
+
+    return Report(data=data, table="\n".join(lines), write=write)
+
+
+def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
+    """Write each run's contact-force record (`contact_force_<pantograph>_<droppers>_<speed>kmh.csv`, SI units in
+    the header) and the force/uplift figure of all of them (`force_uplift_<pantograph>_<speed>kmh.png`); return the
+    paths."""
+    from ...plotting import save
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = []
+    for r in runs:
+        tag = f"{r.pantograph}_{r.dropper_law}_{r.speed_kmh:g}kmh"
+        res = r.result
+        files.append(write_csv(out / f"contact_force_{tag}.csv", [
+            ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force), ("force_filtered_20Hz", "N", r.filtered),
+            ("head_height", "m", res.head), ("wire_height", "m", res.wire)]))
+    files.append(save(force_uplift_figure(runs),
+                      out / f"force_uplift_{runs[0].pantograph}_{runs[0].speed_kmh:g}kmh.png"))
+    return files
+
+
+# --- trains ---------------------------------------------------------------------------------------------------------
+STAT_KEYS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
+
+
+def _label(run: TrainRun, k: int) -> str:
+    role = "leading" if k == 0 else ("trailing" if len(run.names) == 2 else f"#{k + 1}")
+    path = "" if run.engines[k] == "reference" or run.names[k] == "reference2mass" else f", {run.engines[k]}"
+    return f"{role} {run.names[k]}{path} (s = {run.offsets[k]:g} m)"
+
+
+def _assessments(run: TrainRun, criteria: QualityCriteria) -> list[dict]:
+    return [assess(s, run.speed_kmh, criteria, float(s["n_samples_window"]) * run.dt) for s in run.stats]
+
+
+def train_report(run: TrainRun, quality: QualityCriteria | None = None) -> Report:
+    """Table (one column per pantograph), JSON data and writer (per-pantograph CSV, force/uplift plot, quality plot)
+    of a train passage; `quality` (QualityCriteria) adds the quality report of every pantograph."""
+    from ...plotting import save
+
+    labels = [_label(run, k) for k in range(len(run.names))]
+    rows = [[STAT_NAMES[key]] + [f"{s[key]:.2f}" for s in run.stats] for key in STAT_KEYS]
+    lines = [f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h (element {run.params.element_length:g} m, "
+             f"dt {run.dt:g} s, {run.timing['steps']} steps, {run.timing['cpu_s']:.2f} s CPU); window "
+             f"[{run.params.window_start:g}, {run.params.window_end:g}] m on each pantograph's own position",
+             format_table(["statistic", *labels], rows)]
+    for k, s in enumerate(run.stats):
+        c = s["loss_counts"]
+        lines.append(f"{labels[k]}: static contact force {run.static_forces[k]:.2f} N; contact losses in window "
+                     f"{len(s['loss_events'])} (<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, "
+                     f">20 ms: {c['power_loss_gt_20ms']})")
+    for w in run.warnings:
+        lines.append(f"WARNING: {w}")
+    data = {"speed_kmh": run.speed_kmh, "element_length": run.params.element_length, "timestep": run.dt,
+            "timing": run.timing,
+            "pantographs": [{"name": run.names[k], "engine": run.engines[k], "offset_m": run.offsets[k],
+                             "static_contact_force": run.static_forces[k],
+                             "statistics": {key: run.stats[k][key] for key in STAT_KEYS},
+                             "uplift_at_supports_mm": run.stats[k]["uplift_at_supports_mm"],
+                             "loss_events": run.stats[k]["loss_events"]} for k in range(len(run.names))],
+            "warnings": run.warnings}
+    qs = []
+    if quality is not None:
+        qs = _assessments(run, quality)
+        for k, q in enumerate(qs):
+            data["pantographs"][k]["quality"] = q
+            lines.append(f"current-collection quality, {labels[k]}, {quality.system} criteria: "
+                         f"{'PASS' if q['pass'] else 'FAIL'}")
+            lines.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
+        data["quality_pass"] = all(q["pass"] for q in qs)
+
+    def write(out: Path) -> list[Path]:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        files = []
+        for k, res in enumerate(run.results):
+            tag = f"p{k + 1}_{run.names[k]}_{run.speed_kmh:g}kmh"
+            files.append(write_csv(out / f"contact_force_{tag}.csv", [
+                ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force),
+                ("force_filtered_20Hz", "N", run.filtered[k]), ("head_height", "m", res.head),
+                ("wire_height", "m", res.wire)]))
+        files.append(save(train_figure(run, labels), out / f"train_force_{run.speed_kmh:g}kmh.png"))
+        if qs:
+            files.append(quality_plot(list(zip(labels, qs, strict=True)),
+                                      out / f"quality_train_{run.speed_kmh:g}kmh.png"))
+        return files
+
+    return Report(data=data, table="\n".join(lines), write=write)
+
+
+def train_to_simresult(run: TrainRun, scene) -> SimResult:
+    """A train passage as a SimResult: the leading pantograph's channels under the usual names (on its own record),
+    `contact_force_p<k>` / `position_p<k>` for every pantograph k = 1, 2, ... (each on its own record; all records
+    have the same length, one passage from x_start to x_end, on the time since the pantograph's entry), and per
+    pantograph the eight statistics and quality verdicts in `stats` (`p<k>_Fm`, ..., `p<k>_quality_pass`)."""
+    lead = run.results[0]
+    signals = {"contact_force": lead.force, "contact_force_filtered": run.filtered[0], "position": lead.x,
+               "head_height": lead.head, "wire_height": lead.wire, "slack_droppers": lead.n_slack.astype(float)}
+    qs = _assessments(run, criteria_from(scene.sections.get("quality")))
+    stats: dict[str, Any] = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"],
+                             "total_s": run.timing["total_s"]}
+    for k, s in enumerate(run.stats):
+        stats.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})
+        stats[f"p{k + 1}_static_contact_force"] = run.static_forces[k]
+        stats[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
+    events = [{**e, "pantograph": k + 1} for k, s in enumerate(run.stats) for e in s["loss_events"]]
+    res = assemble_result(scene, lead.t, signals, engine=run.engines[-1], events=events, stats=stats,
+                   health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
+    for k, r in enumerate(run.results):
+        res.signals[f"contact_force_p{k + 1}"] = r.force
+        res.units[f"contact_force_p{k + 1}"] = "N"
+        res.signals[f"position_p{k + 1}"] = r.x
+        res.units[f"position_p{k + 1}"] = "m"
+    return res

@@ -6,6 +6,7 @@ import argparse
 import math
 import textwrap
 import warnings
+from functools import partial
 from pathlib import Path
 
 from ...errors import ParameterError, SceneError
@@ -22,17 +23,20 @@ def mbsuite_run(scene):
     return run(scene)
 
 
-def _finite(name: str):
-    def conv(s: str) -> float:
-        try:
-            v = float(s)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
-        if not math.isfinite(v):
-            raise argparse.ArgumentTypeError(f"{name} must be finite, got {s!r}")
-        return v
+def _finite_value(name: str, s: str) -> float:
+    """The option `name`'s value `s` as a finite float (argparse type; ArgumentTypeError naming the option)."""
+    try:
+        v = float(s)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{name} must be finite, got {s!r}")
+    return v
 
-    return conv
+
+def _finite(name: str) -> partial:
+    """The argparse type of a finite number for option `name`."""
+    return partial(_finite_value, name)
 
 
 def _geometry_args(p: argparse.ArgumentParser, ey_default: float) -> None:
@@ -46,62 +50,59 @@ def _params(args: argparse.Namespace) -> CouplerParams:
     return CouplerParams(gamma=args.gamma, e_y=args.ey, R=args.R)
 
 
-def _cmd_jacobian(emit):
-    def run(args: argparse.Namespace) -> None:
-        p = _params(args)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", analysis.SingularityWarning)
-            rep = analysis.jacobian_report(p, args.phi_a, args.alpha_bx, args.alpha_bz, args.engine)
-        msgs = [str(w.message) for w in caught if issubclass(w.category, analysis.SingularityWarning)]
-        if msgs:
-            rep.data["warnings"] = msgs
-            rep.table = "".join(textwrap.fill("WARNING: " + m, 100, subsequent_indent="  ") + "\n"
-                                for m in msgs) + rep.table
-        emit(rep, args, None)
-
-    return run
+def cmd_jacobian(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler jacobian`: the single coupler's Jacobian report, singularity warnings stated in it."""
+    p = _params(args)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", analysis.SingularityWarning)
+        rep = analysis.jacobian_report(p, args.phi_a, args.alpha_bx, args.alpha_bz, args.engine)
+    msgs = [str(w.message) for w in caught if issubclass(w.category, analysis.SingularityWarning)]
+    if msgs:
+        rep.data["warnings"] = msgs
+        rep.table = "".join(textwrap.fill("WARNING: " + m, 100, subsequent_indent="  ") + "\n"
+                            for m in msgs) + rep.table
+    emit(rep, args, None)
 
 
 #: default size guard of `coupler fpp`: samples per revolution (about 0.2 ms each; 1e5 take ~20 s); --max-n raises it
 FPP_MAX_N = 100_000
 
 
-def _count(name: str):
-    def conv(s: str) -> int:
-        try:
-            v = float(s)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
-        if not math.isfinite(v) or v != int(v):
-            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {s!r}")
-        return int(v)
-
-    return conv
+def _count_value(name: str, s: str) -> int:
+    """The option `name`'s value `s` as a whole number (argparse type; ArgumentTypeError naming the option)."""
+    try:
+        v = float(s)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
+    if not math.isfinite(v) or v != int(v):
+        raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {s!r}")
+    return int(v)
 
 
-def _cmd_fpp(emit):
-    def run(args: argparse.Namespace) -> None:
-        if not 3 <= args.n <= args.max_n:
-            raise ParameterError(f"--n = {args.n} is invalid; valid: integer in [3, {args.max_n}] (the size guard "
-                                 f"--max-n, default {FPP_MAX_N}; each sample is one FPP solve, ~0.2 ms)")
-        emit(analysis.fpp_report(_params(args), args.alpha_bx, args.alpha_bz, args.n, args.engine), args, None)
-
-    return run
+def _count(name: str) -> partial:
+    """The argparse type of a whole number for option `name`."""
+    return partial(_count_value, name)
 
 
-def _cmd_criteria(emit):
-    def run(args: argparse.Namespace) -> None:
-        if args.quick:
-            rep = analysis.criteria_report(gammas=(0.297,), eys=(0.1,), alphas=(0.0, 0.035, 0.07), zcs=(0.0, 0.05),
-                                           lbs=(2.0,), n=61)
-        else:
-            rep = analysis.criteria_report()
-        emit(rep, args, None)
-
-    return run
+def cmd_fpp(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler fpp`: the single coupler's pose over one revolution (size-guarded sample count)."""
+    if not 3 <= args.n <= args.max_n:
+        raise ParameterError(f"--n = {args.n} is invalid; valid: integer in [3, {args.max_n}] (the size guard "
+                             f"--max-n, default {FPP_MAX_N}; each sample is one FPP solve, ~0.2 ms)")
+    emit(analysis.fpp_report(_params(args), args.alpha_bx, args.alpha_bz, args.n, args.engine), args, None)
 
 
-#: units of the statistics of a dynamics run (`mujoco.stats`, `mujoco.run_reference`)
+def cmd_criteria(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler criteria`: c1-c5 over the design grid (a small grid with --quick)."""
+    if args.quick:
+        rep = analysis.criteria_report(gammas=(0.297,), eys=(0.1,), alphas=(0.0, 0.035, 0.07), zcs=(0.0, 0.05),
+                                       lbs=(2.0,), n=61)
+    else:
+        rep = analysis.criteria_report()
+    emit(rep, args, None)
+
+
+#: units of the statistics of a dynamics run (`mujoco.stats`, `reference.run_reference`)
 STAT_UNITS = {"window_start": "s", "revolutions": "-", "phi_c_err_max": "rad", "phi_c_err_rms": "rad",
               "phi_c_kin_fluctuation_pp": "rad", "closure_residual_max": "m", "closure_residual_max_all": "m",
               "torque_in_mean": "N m", "torque_in_ripple_pp": "N m", "torque_in_ripple_rel": "-",
@@ -142,32 +143,32 @@ def dynamics_table(scene_input: dict, res) -> str:
     return table
 
 
-def _cmd_dynamics(emit):
-    def run(args: argparse.Namespace) -> None:
-        scene = load_scene(args.scene)
-        if scene.model != "coupler":
-            raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; coupler dynamics needs a coupler scene "
-                             "('coupler' or coupler/<scene>, e.g. coupler/double_friction)")
-        if args.engine:
-            scene = scene.replace(solver={"engine": args.engine})
-        res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)
-        inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
-        table = dynamics_table(inputs, res)
+def write_dynamics(res, out: Path) -> list[Path]:
+    """The files of `coupler dynamics --out`: the run's time series (CSV) and its figure."""
+    from ...plotting import save
+    from .plots import dynamics_figure
 
-        def write(out: Path) -> list[Path]:
-            from ...plotting import save
-            from .plots import dynamics_figure
-
-            return [res.write_csv(out / "timeseries.csv"), save(dynamics_figure(res), out / "timeseries.png")]
-
-        emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
-                    write), args, scene.to_dict())
-
-    return run
+    return [res.write_csv(out / "timeseries.csv"), save(dynamics_figure(res), out / "timeseries.png")]
 
 
-def register(sub, add_common, emit) -> None:
-    """Add the `mbsuite coupler jacobian | fpp | criteria | dynamics` commands to the parser `sub`."""
+def cmd_dynamics(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler dynamics`: a double-coupler run of a coupler scene with its statistics and health."""
+    scene = load_scene(args.scene)
+    if scene.model != "coupler":
+        raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; coupler dynamics needs a coupler scene "
+                         "('coupler' or coupler/<scene>, e.g. coupler/double_friction)")
+    if args.engine:
+        scene = scene.replace(solver={"engine": args.engine})
+    res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)
+    inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
+    table = dynamics_table(inputs, res)
+    emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
+                partial(write_dynamics, res)), args, scene.to_dict())
+
+
+def register(sub, add_common, emit) -> str:
+    """Add the `mbsuite coupler jacobian | fpp | criteria | dynamics` commands to the parser `sub`; return the group's
+    command name."""
     g = sub.add_parser("coupler", help="4-link coupler kinematics (Jacobian, FPP, criteria) and dynamics")
     gs = g.add_subparsers(dest="coupler_command", required=True)
 
@@ -178,7 +179,7 @@ def register(sub, add_common, emit) -> None:
     p.add_argument("--alpha-bz", type=_finite("--alpha-bz"), default=0.0, help="inclination about z [rad]")
     p.add_argument("--engine", choices=["reference", "pinocchio"], default="reference")
     add_common(p)
-    p.set_defaults(func=_cmd_jacobian(emit))
+    p.set_defaults(func=partial(cmd_jacobian, emit=emit))
 
     p = gs.add_parser("fpp", help="single-coupler pose over one revolution of phi_a (continuation)")
     _geometry_args(p, 0.1)
@@ -190,15 +191,16 @@ def register(sub, add_common, emit) -> None:
     p.add_argument("--engine", choices=["reference", "pinocchio"], default="reference",
                    help="pinocchio: also solve with the URDF model and report the difference")
     add_common(p)
-    p.set_defaults(func=_cmd_fpp(emit))
+    p.set_defaults(func=partial(cmd_fpp, emit=emit))
 
     p = gs.add_parser("criteria", help="c1-c4 (single) and c5 (double) tables; plots (Figs 6-10 style) with --out")
     p.add_argument("--quick", action="store_true", help="a small grid (for a smoke test)")
     add_common(p)
-    p.set_defaults(func=_cmd_criteria(emit))
+    p.set_defaults(func=partial(cmd_criteria, emit=emit))
 
     p = gs.add_parser("dynamics", help="MuJoCo double-coupler run with agreement statistics")
     p.add_argument("scene", nargs="?", default="coupler", help="scene (default: coupler's default scene)")
     p.add_argument("--engine", choices=["mujoco", "reference"], help="override the scene's engine")
     add_common(p)
-    p.set_defaults(func=_cmd_dynamics(emit))
+    p.set_defaults(func=partial(cmd_dynamics, emit=emit))
+    return "coupler"

@@ -11,9 +11,9 @@ import json
 from pathlib import Path
 
 import mbsuite
-from mbsuite.models.catenary.analysis import quality_of, run_scene
+from mbsuite.models.catenary.analysis import run_scene, run_train_scene
 from mbsuite.models.catenary.quality import CRITERIA, criteria_from
-from mbsuite.models.catenary.train import _assessments, run_train_scene
+from mbsuite.models.catenary.reports import quality_of, train_assessments
 from mbsuite.results import format_table
 
 SCENES = ("en50318", "en50318_linear", "en50318_eppinger", "eppinger_lab", "en50318_two_pantographs")
@@ -32,7 +32,7 @@ def main() -> None:
         for v in a.speeds:
             if "train" in scene.sections:
                 run = run_train_scene(scene, speed_kmh=v)
-                qs = [(f"p{k + 1} {n}", q) for k, (n, q) in enumerate(zip(run.names, _assessments(run, crit),
+                qs = [(f"p{k + 1} {n}", q) for k, (n, q) in enumerate(zip(run.names, train_assessments(run, crit),
                                                                              strict=True))]
             else:
                 run = run_scene(scene, speed_kmh=v)

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.quality import QualityCriteria, assess
-from mbsuite.models.catenary.train import STAT_KEYS, simulate_train
+from mbsuite.models.catenary.reports import STAT_KEYS
+from mbsuite.models.catenary.train import simulate_train
 from mbsuite.results import format_table
 
 

@@ -166,7 +166,8 @@ def _label(run: TrainRun, k: int) -> str:
     return f"{role} {run.names[k]}{path} (s = {run.offsets[k]:g} m)"
 
 
-def _assessments(run: TrainRun, criteria: QualityCriteria) -> list[dict]:
+def train_assessments(run: TrainRun, criteria: QualityCriteria) -> list[dict]:
+    """The current-collection quality assessment of every pantograph of a train passage (`quality.assess`)."""
     return [assess(s, run.speed_kmh, criteria, float(s["n_samples_window"]) * run.dt) for s in run.stats]
 
 
@@ -198,7 +199,7 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None) -> Repor
             "warnings": run.warnings}
     qs = []
     if quality is not None:
-        qs = _assessments(run, quality)
+        qs = train_assessments(run, quality)
         for k, q in enumerate(qs):
             data["pantographs"][k]["quality"] = q
             lines.append(f"current-collection quality, {labels[k]}, {quality.system} criteria: "
@@ -233,7 +234,7 @@ def train_to_simresult(run: TrainRun, scene) -> SimResult:
     lead = run.results[0]
     signals = {"contact_force": lead.force, "contact_force_filtered": run.filtered[0], "position": lead.x,
                "head_height": lead.head, "wire_height": lead.wire, "slack_droppers": lead.n_slack.astype(float)}
-    qs = _assessments(run, criteria_from(scene.sections.get("quality")))
+    qs = train_assessments(run, criteria_from(scene.sections.get("quality")))
     stats: dict[str, Any] = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"],
                              "total_s": run.timing["total_s"]}
     for k, s in enumerate(run.stats):

@@ -1,5 +1,5 @@
 """Regression tests of the robustness corpus' coupler findings: a non-coupler scene for `coupler dynamics`, and the
-file checks the engines' loaders run on a coupler model file (`modelfiles.check_model_file`)."""
+file checks the engines' loaders run on a coupler model file (`filechecks.check_model_file`)."""
 
 from __future__ import annotations
 

@@ -52,7 +52,8 @@ def _urdf_inertial(name: str, mass: float, ixx: float, iyy: float, izz: float) -
 
 
 def _urdf_chain(prefix: str, origin, child: str) -> str:
-    """Six joints x, y, z (prismatic, base axes), alpha_z, alpha_x, phi (revolute): R = R_z R_x R_y (reference.py)."""
+    """Six joints x, y, z (prismatic, base axes), alpha_z, alpha_x, phi (revolute): R = R_z R_x R_y
+    (`geometry.shaft_rotation`)."""
     names = [f"x_{prefix}", f"y_{prefix}", f"z_{prefix}", f"alpha_{prefix}z", f"alpha_{prefix}x", f"phi_{prefix}"]
     types = ["prismatic"] * 3 + ["revolute"] * 3
     axes = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, 1), (1, 0, 0), (0, 1, 0)]

@@ -18,7 +18,6 @@ from ...errors import ParameterError
 from .commands import delay_samples, time_to_samples
 
 STEP_UP_CONTROLLERS = ("pwm", "resonant", "motor_resonant")
-SUSD_CONTROLLERS = ("energy_packet",)
 
 
 # ---- velocity matching ----------------------------------------------------------------------------------------------

@@ -97,11 +97,6 @@ class PantographParams:
         """Absolute supply pressure Ps = Pg + Pa (Pa)."""
         return self.Pg + self.Pa
 
-    @property
-    def F_static(self) -> float:
-        """Static cylinder force Pg*Ap (Eqs 3.23, 3.27) (N)."""
-        return self.Pg * self.Ap
-
     def replace(self, **changes: float) -> PantographParams:
         """A copy with some fields changed (checked again)."""
         return dataclasses.replace(self, **changes)

@@ -1,0 +1,65 @@
+"""Command line: `mbsuite list | run | view | sweep | workprecision | perturb | hardcases` plus each model's command
+group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
+
+Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the
+header), PNG plots and `summary.json` (versions + scene). A model package adds its own commands by defining
+`register(sub, add_common, emit) -> str` in its `cli` module (returning its group's command name).
+
+The package: `parser.py` (the parser, the model groups), `commands.py` (the generic commands), `sweep.py` (`mbsuite
+sweep`), `options.py` (options several commands share), `output.py` (tables, JSON, files, one-line errors).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Sequence
+
+from ..errors import MbsuiteError
+from .output import check_out, fail, quiet_stdout
+from .parser import UsageError, build_parser
+
+__all__ = ["build_parser", "main"]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line. Exit status: 0 success, 2 any error (one line naming the input; under --json also a JSON
+    object `{"error": {...}}` on stdout), 130 interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
+    ap = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        args = ap.parse_args(argv)
+    except UsageError as exc:
+        return fail(str(exc), "--json" in argv, "UsageError")
+    except SystemExit as exc:  # --help / --version
+        return int(exc.code or 0)
+    as_json = bool(getattr(args, "json", False))
+    try:
+        check_out(getattr(args, "out", None))
+        args.func(args)
+    except MbsuiteError as exc:
+        return fail(str(exc), as_json, type(exc).__name__)
+    except KeyboardInterrupt:
+        store = getattr(args, "store", None)
+        saved = f"finished points are kept in {store} (rerun the command to resume)" if store else "nothing was saved"
+        print(f"mbsuite: interrupted; {saved}", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        quiet_stdout()
+        return 0
+    except MemoryError:
+        return fail("out of memory: the job is too large for this machine; make it smaller (fewer points, shorter "
+                    "run, larger step)", as_json, "MemoryError")
+    except OSError as exc:
+        name = f" {exc.filename}" if exc.filename else ""
+        return fail(f"cannot access{name}: {exc.strerror or exc}", as_json, "OSError")
+    except Exception as exc:  # a defect in mbsuite: still one line, the traceback on request
+        if os.environ.get("MBSUITE_DEBUG"):
+            raise
+        return fail(f"internal error ({type(exc).__name__}: {exc}); this is a bug in mbsuite, please report it with "
+                    "the command line (MBSUITE_DEBUG=1 prints the traceback)", as_json, "InternalError")
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        quiet_stdout()
+    return 0

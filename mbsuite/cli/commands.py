@@ -1,0 +1,182 @@
+"""The generic commands: `list`, `run`, `view`, `workprecision`, `hardcases`, `perturb`. Each reads its options,
+calls the suite's API and hands the result to `emit`; none of them does physics."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+
+from .. import registry
+from ..errors import MbsuiteError
+from ..results import Report, format_table
+from ..scenes import load_scene
+from .options import MAX_REPEATS, load
+from .output import emit, wrap
+
+ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view")
+
+
+def analyses(spec: registry.ModelSpec, group: str | None) -> list[str]:
+    """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
+    hooks = {"run": spec.paths or None, "view": spec.mujoco_model}
+    out = [a for a in ANALYSES if (hooks[a] if a in hooks else getattr(spec, a)) is not None]
+    if spec.paths:
+        out += ["sweep", "perturb"]
+    if spec.cases:
+        out += ["workprecision", "hardcases"]
+    if group:
+        out.append(f"mbsuite {group} ...")
+    return out
+
+
+def cmd_list(args: argparse.Namespace) -> None:
+    """`mbsuite list`: each model, its scenes, its paths (key, label, what it is) and what it offers."""
+    groups: dict[str, str] = getattr(args, "cli_groups", None) or {}
+    rows = []
+    data = {}
+    blocks = []
+    for name, spec in sorted(registry.models().items()):
+        scenes = sorted(spec.scene_files())
+        offered = analyses(spec, groups.get(name))
+        paths = {k: {"label": p.label, "what": p.what} for k, p in spec.paths.items()}
+        rows.append([name, spec.default_scene, len(scenes), "/".join(spec.engines)])
+        data[name] = {"summary": spec.summary, "default_scene": spec.default_scene, "scenes": scenes,
+                      "engines": list(spec.engines), "analyses": offered,
+                      "effects": {k: list(e.choices) for k, e in spec.effects.items()}, "paths": paths}
+        path_lines = [wrap(f"path {k}" + (f" ({p['label']})" if p["label"] != k else "") + f": {p['what']}")
+                      for k, p in paths.items()]
+        blocks.append("\n".join([wrap(f"{name}: {spec.summary}", indent=""), *path_lines,
+                                 wrap("analyses: " + ", ".join(offered)), wrap("scenes: " + ", ".join(scenes))]))
+    table = format_table(["model", "default scene", "scenes", "engines"], rows) + "\n\n" + "\n\n".join(blocks)
+    emit(Report(data, table), args, None)
+
+
+def cmd_run(args: argparse.Namespace) -> None:
+    """`mbsuite run SCENE`: the scene's time simulation on its path (health judged by `mbsuite.run`)."""
+    from .. import run
+
+    scene = load(args)
+    emit(run(scene).report(), args, scene.to_dict())
+
+
+def cmd_view(args: argparse.Namespace) -> None:
+    """Open MuJoCo's interactive viewer on the scene's MuJoCo model (its effects active, its initial state)."""
+    scene = load(args)
+    if scene.spec.mujoco_model is None:
+        raise MbsuiteError(f"model '{scene.model}' has no MuJoCo model to view")
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or sys.platform == "darwin"):
+        raise MbsuiteError("mbsuite view needs a display (no DISPLAY or WAYLAND_DISPLAY is set); on a headless "
+                           "machine render offscreen instead (MUJOCO_GL=egl, mujoco.Renderer)")
+    import mujoco.viewer
+
+    model, data = scene.spec.mujoco_model(scene)
+    mujoco.viewer.launch(model, data)
+
+
+def print_progress(msg: str) -> None:
+    """A progress line on stderr (`--verbose`)."""
+    print(msg, file=sys.stderr, flush=True)
+
+
+def cmd_workprecision(args: argparse.Namespace) -> None:
+    """`mbsuite workprecision SCENE`: error against wall time for every engine and method."""
+    from ..analysis.workprecision import workprecision
+
+    scene = load_scene(args.scene)
+    if not 1 <= args.repeats <= MAX_REPEATS:
+        raise MbsuiteError(f"--repeats {args.repeats} is invalid; valid: integer in [1, {MAX_REPEATS}] (runs per "
+                           "setting; the wall time is their median)")
+    progress = print_progress if args.verbose else None
+    emit(workprecision(scene, repeats=args.repeats, quick=args.quick, progress=progress), args, scene.to_dict())
+
+
+def cmd_hardcases(args: argparse.Namespace) -> None:
+    """`mbsuite hardcases`: the hard-case registry, and with `--run` each case's assertions (exit 2 on a failure)."""
+    from .. import hardcases
+
+    cases = hardcases.cases(args.model, include_slow=not args.no_slow)
+    if args.name:
+        cases = [hardcases.get(n) for n in args.name]
+    data: dict = {"cases": []}
+    rows = []
+    outcomes = {}
+    if args.run:
+        for c in cases:
+            outcomes[c.name] = hardcases.run_case(c)
+    for c in cases:
+        d = {"name": c.name, "model": c.model, "hard": c.hard, "scene": c.scene, "asserts": c.asserts,
+             "slow": c.slow, "known": c.known or None, "expected_failure": c.expected_failure or None}
+        status = ""
+        if c.name in outcomes:
+            o = outcomes[c.name]
+            status = "PASS" if o.passed else ("KNOWN FAIL" if c.expected_failure else "FAIL")
+            d.update(passed=o.passed, error=o.error,
+                     checks=[{"what": k.what, "ok": k.ok, "value": k.value, "bound": k.bound} for k in o.checks])
+        data["cases"].append(d)
+        rows.append([c.name, c.model, "slow" if c.slow else "", status, c.hard])
+    counts: dict[str, int] = {}
+    for c in cases:
+        counts[c.model] = counts.get(c.model, 0) + 1
+    data["counts"] = {"total": len(cases), "by_model": counts}
+    table = format_table(["case", "model", "", "result" if args.run else "", "what makes it hard"], rows)
+    table += "\n" + f"{len(cases)} hard cases: " + ", ".join(f"{m} {n}" for m, n in sorted(counts.items()))
+    if args.run:
+        n_ok = sum(o.passed for o in outcomes.values())
+        n_known = sum(1 for n, o in outcomes.items() if not o.passed and hardcases.get(n).expected_failure)
+        data["counts"].update(passed=n_ok, known_failures=n_known)
+        table += (f"; {n_ok}/{len(outcomes)} pass, {n_known} known failure(s)\n\n"
+                  + "\n".join(o.text() for o in outcomes.values()))
+    else:
+        table += "\n" + "\n".join(f"- {c.name}: scene {c.scene}; asserts {c.asserts}" +
+                                   (f"; KNOWN: {c.known}" if c.known else "")
+                                   + (f"; FAILS TODAY: {c.expected_failure}" if c.expected_failure else "")
+                                   for c in cases)
+    emit(Report(data, table), args, None)
+    bad = [n for n, o in outcomes.items() if not o.passed and not hardcases.get(n).expected_failure]
+    if bad:
+        raise MbsuiteError("hard case(s) failed: " + ", ".join(bad))
+
+
+def cmd_perturb(args: argparse.Namespace) -> None:
+    """`mbsuite perturb`: stability under relative perturbations of every scene or hard case given."""
+    from .. import hardcases, perturbation
+
+    try:
+        epsilons = [float(e) for e in args.eps.split(",")]
+    except ValueError as exc:
+        raise MbsuiteError(f"--eps {args.eps!r} is not a comma list of numbers, e.g. 1e-12,1e-9") from exc
+    for e in epsilons:
+        if not (math.isfinite(e) and 0.0 < e < 1e-3):
+            raise MbsuiteError(f"--eps {e!r} is invalid; valid: (0, 1e-3) (a relative perturbation)")
+    if not 1 <= args.draws <= MAX_REPEATS:
+        raise MbsuiteError(f"--draws {args.draws} is invalid; valid: integer in [1, {MAX_REPEATS}]")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise MbsuiteError(f"--duration {args.duration!r} is invalid; valid: (0, inf) s")
+    scenes = []
+    if not args.hardcases_only:
+        names = args.target or sorted(registry.models())
+        for t in names:
+            if "/" in t or t.endswith(".toml"):
+                scenes.append(load_scene(t))
+            else:
+                scenes += [load_scene(f"{t}/{s}") for s in registry.get_model(t).scene_files()]
+    cases = []
+    if args.hardcases or args.hardcases_only:
+        models = {t.split("/")[0] for t in args.target} if args.target else None
+        cases = [c for c in hardcases.cases(include_slow=not args.no_slow)
+                 if (models is None or c.model in models) and not c.expected_failure]
+    reports = []
+    targets = [(perturbation.check_scene, perturbation.shortened(sc, args.duration)) for sc in scenes]
+    for check, target in targets + [(perturbation.check_case, c) for c in cases]:
+        base = None  # the unperturbed run, made once for every eps
+        for e in epsilons:
+            reports.append(check(target, eps=e, draws=args.draws, seed=args.seed, base=base))
+            base = reports[-1].base
+            if args.verbose:
+                print(" ".join(map(str, reports[-1].row())), file=sys.stderr, flush=True)
+    emit(perturbation.report(reports), args, None)
+    bad = sorted({r.target for r in reports if not r.ok})
+    if bad:
+        raise MbsuiteError("unstable under perturbation: " + ", ".join(bad))

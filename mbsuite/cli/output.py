@@ -1,0 +1,73 @@
+"""What the command line writes: a report as a table or JSON (and its files under `--out`), one-line errors, the
+checks and clean-ups around them."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import textwrap
+from pathlib import Path
+
+from ..errors import MbsuiteError
+from ..results import Report, to_jsonable
+
+
+def add_common(p: argparse.ArgumentParser) -> None:
+    """`--json` and `--out DIR`, which every command that reports takes."""
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    p.add_argument("--out", metavar="DIR", help="write CSV/PNG/summary.json into DIR")
+
+
+def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> None:
+    """Print `report` (its table, or its data as JSON under `--json`) and write its files under `--out`."""
+    files = report.save(args.out, scene_dict) if getattr(args, "out", None) else []
+    if args.json:
+        payload = dict(report.data)
+        if files:
+            payload["files"] = [str(f) for f in files]
+        print(json.dumps(to_jsonable(payload), indent=2))
+    else:
+        print(report.table)
+        for f in files:
+            print(f"wrote {f}")
+
+
+def wrap(text: str, width: int = 100, indent: str = "  ") -> str:
+    """`text` filled to `width` columns, later lines indented two more."""
+    return textwrap.fill(text, width=width, initial_indent=indent, subsequent_indent=indent + "  ")
+
+
+def fail(message: str, as_json: bool, kind: str) -> int:
+    """One line on stderr (and, under --json, a JSON object on stdout); exit status 2."""
+    message = " ".join(message.split())  # messages quoting a solver's text may hold line breaks
+    if as_json:
+        print(json.dumps({"error": {"type": kind, "message": message}}))
+    print(f"mbsuite: error: {message}", file=sys.stderr)
+    return 2
+
+
+def check_out(out: str | None) -> None:
+    """`--out DIR` must be a directory we can write, checked before any work is done."""
+    if not out:
+        return
+    path = Path(out)
+    if path.exists() and not path.is_dir():
+        raise MbsuiteError(f"--out {out}: exists and is not a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".mbsuite-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise MbsuiteError(f"--out {out}: cannot write there ({exc.strerror or exc})") from exc
+
+
+def quiet_stdout() -> None:
+    """After a closed pipe: send the rest of stdout to /dev/null so the interpreter's final flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass

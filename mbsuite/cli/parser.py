@@ -1,0 +1,121 @@
+"""The `mbsuite` argument parser: the generic commands, then each model's own command group (`register(sub,
+add_common, emit)` in the model's `cli` module, which returns the group's command name)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+
+from .. import registry
+from . import commands
+from .options import SCENE_HELP, add_scene_options, add_sweep_options
+from .output import add_common, emit
+from .sweep import cmd_sweep
+
+
+class UsageError(Exception):
+    """A command line argparse refuses (unknown command or option, a value of the wrong type)."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: `mbsuite: error: <what>` naming the argument, and where to read the usage."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise UsageError(f"{message} (usage: {self.prog} --help)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The `mbsuite` argument parser: the generic commands plus each model's own command group. The groups, model ->
+    command name, are the parser's default `cli_groups` (what `mbsuite list` shows)."""
+    from .. import __version__
+
+    ap = Parser(
+        prog="mbsuite", description="Cross-checked multibody models of railway mechanisms on Pinocchio and MuJoCo: "
+        "run scenes, sweeps, frequency responses, work-precision studies and hard cases; `mbsuite list` shows the "
+        "models and what each offers.")
+    ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
+    add_generic_commands(sub)
+    ap.set_defaults(cli_groups=add_model_groups(sub))
+    return ap
+
+
+def add_generic_commands(sub: argparse._SubParsersAction) -> None:
+    """`list`, `run`, `view`, `sweep`, `workprecision`, `perturb`, `hardcases`: commands every model's scenes take."""
+    p = sub.add_parser("list", help="models, their paths and their shipped scenes")
+    add_common(p)
+    p.set_defaults(func=commands.cmd_list)
+
+    p = sub.add_parser("run", help="time simulation of a scene")
+    p.add_argument("scene", help=SCENE_HELP)
+    add_common(p)
+    add_scene_options(p)
+    p.add_argument("--engine", metavar="PATH",
+                   help="override the scene's path: a key or label of the model's path table (mbsuite list)")
+    p.set_defaults(func=commands.cmd_run)
+
+    p = sub.add_parser("view", help="open MuJoCo's viewer on a scene's model, its effects active")
+    p.add_argument("scene", help=SCENE_HELP)
+    p.set_defaults(func=commands.cmd_view)
+
+    p = sub.add_parser("sweep", help="parameter study: run a scene over a grid of inputs/parameters/settings")
+    p.add_argument("scene", help=SCENE_HELP)
+    p.add_argument("--vary", action="append", metavar="SECTION.KEY=VALUES",
+                   help="a grid axis: comma list or start:stop:step, e.g. input.frequency=1:30:0.5 (repeatable: "
+                        "the grid is the product)")
+    p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
+    p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
+    add_sweep_options(p)
+    add_scene_options(p)
+    add_common(p)
+    p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("workprecision", help="what accuracy costs: error vs wall time for every engine and method")
+    p.add_argument("scene", help=SCENE_HELP)
+    p.add_argument("--repeats", type=int, default=5, help="runs per setting; wall time = median (default 5)")
+    p.add_argument("--quick", action="store_true", help="a few settings and short runs (smoke test)")
+    p.add_argument("--verbose", action="store_true", help="print each setting as it finishes (stderr)")
+    add_common(p)
+    p.set_defaults(func=commands.cmd_workprecision)
+
+    p = sub.add_parser("perturb", help="stability under perturbation: every parameter, input and initial state "
+                                       "changed by a relative eps; invariants, sensitivities, jumps")
+    p.add_argument("target", nargs="*", help="scenes (model/scene or TOML path) or models (all their scenes); "
+                                             "default: every shipped scene")
+    p.add_argument("--eps", default="1e-12,1e-9", help="comma list of relative perturbations (default 1e-12,1e-9)")
+    p.add_argument("--draws", type=int, default=2, help="perturbed copies per eps (seeded; default 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first draw (default 0)")
+    p.add_argument("--duration", type=float, help="shorten longer runs to this many seconds (s)")
+    p.add_argument("--hardcases", action="store_true", help="also run the hard cases (of the targets' models)")
+    p.add_argument("--hardcases-only", action="store_true", help="only the hard cases")
+    p.add_argument("--no-slow", action="store_true", help="leave out the slow hard cases")
+    p.add_argument("--verbose", action="store_true", help="print each row as it finishes (stderr)")
+    add_common(p)
+    p.set_defaults(func=commands.cmd_perturb)
+
+    p = sub.add_parser("hardcases", help="the hard-case registry: what is hard, the scene, what is asserted")
+    p.add_argument("--run", action="store_true", help="run the cases and report each assertion (exit 2 on failure)")
+    p.add_argument("--model", help="only this model's cases")
+    p.add_argument("--name", action="append", help="only this case (repeatable)")
+    p.add_argument("--no-slow", action="store_true", help="leave out the slow cases")
+    add_common(p)
+    p.set_defaults(func=commands.cmd_hardcases)
+
+
+def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:
+    """Let each model with a `cli` module add its command group; returns model -> the group's command name."""
+    groups: dict[str, str] = {}
+    for name in sorted(registry.models()):
+        try:
+            mod = importlib.import_module(f"mbsuite.models.{name}.cli")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"mbsuite.models.{name}.cli":
+                raise
+            continue
+        before = set(sub.choices)
+        group = mod.register(sub, add_common, emit)
+        if group is None:  # a register() that does not name its group yet: the command it added
+            group = max(set(sub.choices) - before, default=None)
+        if group:
+            groups[name] = group
+    return groups

@@ -1,0 +1,139 @@
+"""`mbsuite sweep SCENE --vary SECTION.KEY=VALUES ...`: a parameter study over the product grid of the axes, each point
+a run of the scene (`scene_point`), tabulated per signal (min, max, mean) and written as CSV and a plot."""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import itertools
+from pathlib import Path
+from typing import Any
+
+from ..analysis.sweep import check_grid, parse_values, run_sweep, scene_point
+from ..errors import MbsuiteError
+from ..results import Report, format_table, write_csv
+from ..scenes import Scene
+from .options import check_workers, load, sweep_options
+from .output import emit
+
+SECTIONS = ("input", "params", "solver", "effects")
+
+
+def grid_axes(vary: list[str] | None, max_points: int) -> list[tuple[str, str, list]]:
+    """(section, key, values) of each `--vary SECTION.KEY=VALUES`, the grid's size checked before it is built."""
+    axes = []
+    for spec in vary or []:
+        key, sep, vals = spec.partition("=")
+        section, dot, name = key.partition(".")
+        if not sep or not dot or section not in SECTIONS:
+            raise MbsuiteError(f"--vary {spec!r}: expected SECTION.KEY=VALUES with SECTION in input, params, solver, "
+                               "effects (e.g. input.frequency=1:30:0.5 or params.k_s=1e5,2e5)")
+        axes.append((section, name, parse_values(vals, max_points=max_points)))
+    if not axes:
+        raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")
+    check_grid([len(a[2]) for a in axes], max_points=max_points, what="--vary grid")
+    return axes
+
+
+def cmd_sweep(args: argparse.Namespace) -> None:
+    """Run the scene at every point of the grid, tabulate the chosen signals, emit the report."""
+    scene = load(args)
+    check_workers(args.workers)
+    options = sweep_options(args)
+    axes = grid_axes(args.vary, options.max_points)
+    combos = list(itertools.product(*[a[2] for a in axes]))
+    points, engines = [], set()
+    for combo in combos:
+        sections: dict = {}
+        for (section, name, _), v in zip(axes, combo, strict=True):
+            sections.setdefault(section, {})[name] = v
+        engines.add(scene.replace(**sections).solver.engine)  # validate every point before anything runs
+        points.append((scene.to_dict(), sections))
+    # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
+    auto = "threads" if engines == {"mujoco"} else "local"
+    results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
+                        executor=None if args.executor else auto, options=options)
+    emit(sweep_report(scene, axes, combos, results, args.signals), args, scene.to_dict())
+
+
+def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
+                 signals_arg: str | None) -> Report:
+    """The table (one row per point and signal), the data (axes, units, points) and the CSV/PNG writer."""
+    signals = [x for x in (signals_arg.split(",") if signals_arg else []) if x] or \
+        sorted(results[0]["signals"]) if results else []
+    head = [f"{s}.{n}" for s, n, _ in axes]
+    units = {h: axis_unit(scene, s, n) for h, (s, n, _) in zip(head, axes, strict=True)}
+    sig_units = {sig: scene.spec.outputs.get(sig, "") for sig in signals}
+    rows, cols = [], {h: [] for h in head}
+    for combo, r in zip(combos, results, strict=True):
+        for h, v in zip(head, combo, strict=True):
+            cols[h].append(v)
+        for sig in signals:
+            st = r["signals"].get(sig)
+            if st is None:
+                raise MbsuiteError(f"signal {sig!r} not in the results; available: {sorted(r['signals'])}")
+            rows.append([*combo, sig, sig_units[sig], st["min"], st["max"], st["mean"]])
+            for k in ("min", "max", "mean"):
+                cols.setdefault(f"{sig}_{k}", []).append(st[k])
+    heads = [f"{h} [{units[h]}]" if units[h] else h for h in head]
+    table = format_table([*heads, "signal", "unit", "min", "max", "mean"], rows, ".5g")
+    data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "units": {**units, **sig_units},
+            "points": [{"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}
+    write = functools.partial(write_sweep, head=head, units=units, combos=combos, results=results, signals=signals,
+                              sig_units=sig_units, cols=cols)
+    return Report(data, table, write)
+
+
+def write_sweep(out: Path, *, head: list[str], units: dict, combos: list, results: list, signals: list[str],
+                sig_units: dict, cols: dict[str, list[Any]]) -> list[Path]:
+    """`sweep.csv` (SI units in the header) and `sweep.png` under `out`."""
+    from ..plotting import save
+
+    csv_cols = [(k, units[k] if k in units else sig_units[k.rsplit("_", 1)[0]], v) for k, v in cols.items()]
+    return [write_csv(Path(out) / "sweep.csv", csv_cols),
+            save(plot_sweep(head, units, combos, results, signals, sig_units), Path(out) / "sweep.png")]
+
+
+def axis_unit(scene, section: str, name: str) -> str:
+    """The SI unit of a swept key, from its declaration (parameter field, input key or solver setting)."""
+    from ..limits import limit_of
+    from ..solver import SOLVER_LIMITS
+
+    lim = None
+    if section == "params":
+        try:
+            lim = limit_of(scene.spec.params_cls, name)
+        except (KeyError, TypeError):
+            lim = None
+    elif section == "input":
+        lim = (scene.spec.inputs.get(scene.input.get("type"), {}) or {}).get(name)
+    elif section == "solver":
+        lim = SOLVER_LIMITS.get(name)
+    return getattr(lim, "unit", "") or ""
+
+
+def plot_sweep(head: list[str], units: dict, combos: list, results: list, signals: list[str], sig_units: dict):
+    """Each signal's mean (line) and min-max (band) against the first swept key; one line per combination of the
+    other keys (at most 8)."""
+    from ..plotting import figure
+
+    shown = signals[:6]
+    fig, axs = figure(len(shown), 1, size=(8.0, 1.8 + 2.0 * len(shown)), sharex=True, squeeze=False)
+    groups: dict = {}
+    for i, c in enumerate(combos):
+        groups.setdefault(tuple(c[1:]), []).append(i)
+    numeric = all(isinstance(c[0], int | float) and not isinstance(c[0], bool) for c in combos)
+    for ax, sig in zip(axs[:, 0], shown, strict=True):
+        for rest, idx in list(groups.items())[:8]:
+            x = [combos[i][0] if numeric else str(combos[i][0]) for i in idx]
+            st = [results[i]["signals"][sig] for i in idx]
+            label = ", ".join(f"{h} = {v}" for h, v in zip(head[1:], rest, strict=True)) or None
+            line, = ax.plot(x, [s["mean"] for s in st], marker="o", ms=3, label=label)
+            ax.fill_between(x, [s["min"] for s in st], [s["max"] for s in st], color=line.get_color(), alpha=0.15)
+        ax.set_ylabel(f"{sig} [{sig_units[sig]}]" if sig_units[sig] else sig)
+        ax.grid(True, alpha=0.3)
+        if len(groups) > 1:
+            ax.legend(fontsize=6)
+    axs[-1, 0].set_xlabel(f"{head[0]} [{units[head[0]]}]" if units[head[0]] else head[0])
+    fig.suptitle("sweep: mean (line) and min-max over the run (band)", fontsize=9)
+    return fig

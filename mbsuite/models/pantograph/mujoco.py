@@ -1,4 +1,6 @@
 """MuJoCo path of the pantograph: the MJCF of exactly the scene's effects, stepped by mbsuite's native core.
+`run_mujoco(scene)` is the path's run, `view_model(scene)` the model `mbsuite view` shows, `mujoco_modes` MuJoCo's own
+linearisation; `MujocoPantograph` holds the compiled model, its statics and its time stepping.
 
 The model is `modelfiles.mjcf_text(p, cfg=...)` (the shipped `mjcf/pantograph.xml` is that text for Table 3-I and the
 lab effects). What each effect puts into it (nothing else is built):

@@ -58,3 +58,18 @@ def test_freqresp_small(tmp_path, capsys):
 def test_errors_exit_2_with_message(argv, msg, capsys):
     assert main(argv) == 2
     assert msg in capsys.readouterr().err
+
+
+def test_pantograph_group_equals_the_top_level_aliases(capsys):
+    assert main(["pantograph", "equilibrium", "--json"]) == 0  # the scene defaults to the pantograph's
+    group = json.loads(capsys.readouterr().out)
+    assert main(["equilibrium", "pantograph", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == group
+    assert main(["pantograph", "modes", "pantograph/lab", "--height", "1.6", "--json"]) == 0
+    group = json.loads(capsys.readouterr().out)
+    assert main(["modes", "pantograph/lab", "--height", "1.6", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == group
+    assert main(["pantograph", "modes", "coupler"]) == 2  # another model's scene
+    assert "does not support 'modes'" in capsys.readouterr().err
+    assert main(["pantograph", "freqresp", "--f-min", "10", "--f-max", "5"]) == 2
+    assert "--f-max" in capsys.readouterr().err

@@ -73,3 +73,33 @@ def test_sweep_command_grid_store_and_errors(tmp_path, capsys):
     assert "SECTION.KEY" in capsys.readouterr().err
     assert main(["sweep", "iftomm/fourbar", "--vary", "params.nosuch=1"]) == 2
     assert "unknown parameter" in capsys.readouterr().err
+
+
+def test_list_shows_each_models_paths_and_groups(capsys):
+    from mbsuite import model_specs
+    from mbsuite.cli import build_parser
+
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    for name, spec in model_specs().items():
+        paths = data[name]["paths"]
+        assert list(paths) == list(spec.engines) == data[name]["engines"]
+        assert all(paths[k] == {"label": p.label, "what": p.what} for k, p in spec.paths.items())
+    assert main(["list"]) == 0
+    text = capsys.readouterr().out
+    assert all(f"path {k}" in text and p.what[:20] in text for k, p in model_specs()["iftomm"].paths.items())
+    groups = build_parser().parse_args(["list"]).cli_groups  # what each model's register() named
+    assert groups["pantograph"] == "pantograph" and groups["coupler"] == "coupler"
+    assert all(f"mbsuite {g} ..." in data[m]["analyses"] for m, g in groups.items())
+
+
+def test_engine_override_takes_a_path_key_or_label_and_names_the_flag(capsys):
+    from argparse import Namespace
+
+    from mbsuite.cli.options import load
+
+    for engine in ("reference", "pinocchio"):  # the path's key or its label
+        assert load(Namespace(scene="iftomm/fourbar", engine=engine)).solver.engine == "reference"
+    assert main(["run", "iftomm/fourbar", "--engine", "bullet"]) == 2
+    err = capsys.readouterr().err
+    assert "--engine 'bullet'" in err and "'mujoco'" in err and "'pinocchio'" in err

@@ -48,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
 
     methods = "linear,mujoco,reference" if args.reference else "linear,mujoco"
     fr, t_fr = _step("Pantograph frequency response 1-30 Hz (Eppinger's lab test)",
-                     ["freqresp", "pantograph", "--methods", methods, "--out", str(out / "pantograph_freqresp")])
+                     ["pantograph", "freqresp", "--methods", methods, "--out", str(out / "pantograph_freqresp")])
     cat = {}
     t_cat = 0.0
     for v in (250, 300):

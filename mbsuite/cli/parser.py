@@ -112,10 +112,8 @@ def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:
             if exc.name != f"mbsuite.models.{name}.cli":
                 raise
             continue
-        before = set(sub.choices)
         group = mod.register(sub, add_common, emit)
-        if group is None:  # a register() that does not name its group yet: the command it added
-            group = max(set(sub.choices) - before, default=None)
-        if group:
-            groups[name] = group
+        if group not in sub.choices:
+            raise TypeError(f"mbsuite.models.{name}.cli.register returned {group!r}, not the command it added")
+        groups[name] = group
     return groups

@@ -22,7 +22,7 @@ import numpy as np
 from mbsuite import load_scene
 from mbsuite.analysis.sweep import get_state, rollout_sweep, run_sweep, scene_point
 from mbsuite.engines.core import n_workers
-from mbsuite.models.pantograph.analysis import mujoco_sweep
+from mbsuite.models.pantograph.freqresp import mujoco_sweep
 from mbsuite.models.pantograph.mujoco import MujocoPantograph, hold_offset
 from mbsuite.results import format_table
 

@@ -56,7 +56,7 @@ def test_threads_equal_serial_and_keep_order():
 def test_pantograph_frequency_sweep_threads_and_rollout_identical_to_one_thread():
     """The MuJoCo frequency sweep in C threads equals one thread; mujoco.rollout runs the same plugin model with 1 or 2
     threads to identical states."""
-    from mbsuite.models.pantograph.analysis import mujoco_sweep
+    from mbsuite.models.pantograph.freqresp import mujoco_sweep
     from mbsuite.models.pantograph.mujoco import MujocoPantograph
 
     sc = load_scene("pantograph").replace(solver={"duration": 0.6, "t_settle": 0.1})

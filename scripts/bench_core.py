@@ -100,9 +100,9 @@ def bench_scene(ref: str, repeats: int, duration: float | None) -> list:
 
 
 def plugin_cost(repeats: int) -> list:
+    from mbsuite.models.pantograph.equations import PantographConfig
     from mbsuite.models.pantograph.mujoco import compiled_model
     from mbsuite.models.pantograph.params import PantographParams
-    from mbsuite.models.pantograph.reference import PantographConfig
 
     rows = []
     for cfg in (PantographConfig(), PantographConfig(cylinder="nonlinear")):

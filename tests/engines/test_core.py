@@ -15,10 +15,10 @@ import mbsuite
 from mbsuite import SolverError
 from mbsuite.engines import native
 from mbsuite.engines.core import Channel, Stepper, map_threads, rows_for
+from mbsuite.models.pantograph.equations import PantographConfig
 from mbsuite.models.pantograph.modelfiles import mjcf_text
 from mbsuite.models.pantograph.mujoco import compiled_model
 from mbsuite.models.pantograph.params import PantographParams
-from mbsuite.models.pantograph.reference import PantographConfig
 
 PENDULUM = """<mujoco><option timestep="0.002"/><worldbody><body><joint name="j" type="hinge" axis="0 1 0"/>
 <geom type="capsule" fromto="0 0 0 0 0 -1" size="0.05" mass="1"/></body></worldbody>

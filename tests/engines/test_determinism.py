@@ -164,11 +164,11 @@ def _blas_workloads() -> dict[str, np.ndarray]:
     assembly and static solve). Each goes through BLAS: with OpenBLAS forced onto another CPU's kernels
     (OPENBLAS_CORETYPE=Sandybridge) they move by 7e-15 ... 2e-11 of each channel's largest value (measured)."""
     import mbsuite
-    from mbsuite.models.coupler import reference
+    from mbsuite.models.coupler import single
     from mbsuite.models.coupler.params import CouplerParams
 
     out = {f"coupler.{k}": v for k, v in mbsuite.run("coupler/double_lateral").signals.items()}
-    out["coupler_fpp.u"] = reference.single_revolution(CouplerParams(), 0.0, 0.0, 73).u
+    out["coupler_fpp.u"] = single.single_revolution(CouplerParams(), 0.0, 0.0, 73).u
     scene = mbsuite.load_scene("catenary/en50318").replace(
         params={"n_spans": 4, "x_end": 180.0, "window_start": 60.0, "window_end": 180.0})
     r = mbsuite.run(scene)

@@ -121,7 +121,7 @@ def test_ctrl_c_exits_130_and_says_what_was_saved(monkeypatch, capsys):
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "_cmd_list", interrupted)
+    monkeypatch.setattr(cli.commands, "cmd_list", interrupted)
     rc, _, err = _run_cli(["list"], capsys)
     assert rc == 130 and "interrupted" in err and "nothing was saved" in err and "Traceback" not in err
 
@@ -132,7 +132,7 @@ def test_internal_error_is_one_line_not_a_traceback(monkeypatch, capsys):
     def broken(args):
         raise ZeroDivisionError("boom")
 
-    monkeypatch.setattr(cli, "_cmd_list", broken)
+    monkeypatch.setattr(cli.commands, "cmd_list", broken)
     monkeypatch.delenv("MBSUITE_DEBUG", raising=False)
     rc, _, err = _run_cli(["list"], capsys)
     assert rc == 2 and "internal error" in err and "ZeroDivisionError" in err and "Traceback" not in err

@@ -51,8 +51,7 @@ The store (`store=PATH`): a JSON-lines file, schema version `SCHEMA_VERSION`, th
   a line that is not UTF-8 are each a `StoreError` (an `MbsuiteError`) naming the file (and line).
 
 `SweepOptions` carries `executor`/`scheduler`/`store`/`max_points` from whoever chose them (the CLI's flags) down to
-`run_sweep(options=...)`, checked once when made. An analysis hook whose signature has no `options` parameter is reached
-by `ambient_options(options)` around the call instead.
+`run_sweep(options=...)`, checked once when made; an analysis that runs sweeps takes `options` and hands it on.
 
 The package: `options.py` (SweepOptions, limits), `grid.py` (values, grid sizes), `encoding.py` (stored values, keys),
 `store.py` (SweepStore), `executors.py` (where points run), `driver.py` (run_sweep), `rollout.py` (mujoco.rollout
@@ -64,13 +63,13 @@ from __future__ import annotations
 from .driver import run_sweep
 from .encoding import StoreError, StoreWarning, decode_value, encode_value, point_key
 from .grid import check_grid, parse_values
-from .options import EXECUTORS, MAX_POINTS, SweepOptions, ambient_options, current_executor
+from .options import EXECUTORS, MAX_POINTS, SweepOptions
 from .points import scene_point
 from .rollout import get_state, rollout_sweep, state_size
 from .store import FORMAT, SCHEMA_VERSION, SweepStore
 
 __all__ = [
     "EXECUTORS", "FORMAT", "MAX_POINTS", "SCHEMA_VERSION", "StoreError", "StoreWarning", "SweepOptions", "SweepStore",
-    "ambient_options", "check_grid", "current_executor", "decode_value", "encode_value", "get_state", "parse_values",
+    "check_grid", "decode_value", "encode_value", "get_state", "parse_values",
     "point_key", "rollout_sweep", "run_sweep", "scene_point", "state_size",
 ]

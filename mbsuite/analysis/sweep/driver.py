@@ -13,7 +13,7 @@ from ...results import Progress
 from .encoding import StoreError, encode_value, fn_id, record_key
 from .executors import Runner
 from .grid import take
-from .options import SweepOptions, ambient, check_executor, check_max_points
+from .options import SweepOptions, check_executor, check_max_points
 from .store import SweepStore
 
 _POLL = 0.1  # s between looks at the store while waiting for points other writers compute
@@ -31,9 +31,9 @@ def run_sweep(fn: Callable[[Any], Any], points: Iterable[Any], *, workers: int =
     sweep is a `SceneError` before anything runs. With a store, equal points are computed once.
 
     `options` (`SweepOptions`, e.g. the CLI's `--executor/--scheduler/--store/--max-points`) fills in what the call
-    does not pass; `executor` is then the caller's preference (`SweepOptions.executor_for`). Without `options`, those
-    of `ambient_options` (default `SweepOptions()`)."""
-    opts = options if options is not None else ambient()
+    does not pass; `executor` is then the caller's preference (`SweepOptions.executor_for`); by default
+    `SweepOptions()`."""
+    opts = options if options is not None else SweepOptions()
     executor = opts.executor_for(executor)
     scheduler = scheduler if scheduler is not None else opts.scheduler
     store = store if store is not None else opts.store

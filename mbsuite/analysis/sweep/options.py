@@ -4,8 +4,6 @@ handed to `run_sweep(options=...)` by whoever runs the sweep (the CLI builds one
 
 from __future__ import annotations
 
-import contextlib
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -58,29 +56,3 @@ class SweepOptions:
         and wins over a local preference)."""
         executor = preferred or self.executor or "local"
         return "dask" if executor == "threads" and self.executor == "dask" else executor
-
-
-_ambient = SweepOptions()
-
-
-@contextlib.contextmanager
-def ambient_options(options: SweepOptions) -> Iterator[None]:
-    """`options` for the `run_sweep` calls in the block that are given none: the way to reach an analysis hook whose
-    signature (the model's) has no `options` parameter. Pass `options=` where the signature allows it."""
-    global _ambient
-    saved = _ambient
-    _ambient = options
-    try:
-        yield
-    finally:
-        _ambient = saved
-
-
-def ambient() -> SweepOptions:
-    """The options `run_sweep` uses when it is given none (set by `ambient_options`; by default `SweepOptions()`)."""
-    return _ambient
-
-
-def current_executor() -> str:
-    """The executor a `run_sweep` call without `executor` and `options` would use."""
-    return ambient().executor_for(None)

@@ -4,7 +4,6 @@ options. `mbsuite equilibrium | modes | freqresp SCENE` with the same options ar
 from __future__ import annotations
 
 import argparse
-import inspect
 
 from ...cli.options import SCENE_HELP, add_scene_options, add_sweep_options, check_workers, load, sweep_options
 from ...errors import MbsuiteError
@@ -96,17 +95,8 @@ def freq_args(args: argparse.Namespace) -> dict:
 
 def cmd_freqresp(args: argparse.Namespace) -> None:
     """The frequency response; its sweeps run where `--executor/--scheduler/--store/--max-points` say."""
-    from ...analysis.sweep import ambient_options
-
     scene = _scene(args, "freqresp")
-    kwargs = freq_args(args)
-    options = sweep_options(args)
-    hook = scene.spec.freqresp
-    if "options" in inspect.signature(hook).parameters:
-        report = hook(scene, **kwargs, options=options)
-    else:  # a hook without an `options` parameter reads them from the block
-        with ambient_options(options):
-            report = hook(scene, **kwargs)
+    report = scene.spec.freqresp(scene, **freq_args(args), options=sweep_options(args))
     args.emit(report, args, scene.to_dict())
 
 

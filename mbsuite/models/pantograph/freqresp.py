@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 
 from ...analysis.harmonic import fundamental
-from ...analysis.sweep import current_executor, run_sweep
+from ...analysis.sweep import SweepOptions, run_sweep
 from ...errors import SceneError
 from ...health import judge
 from ...results import Report, SimResult, format_table, write_csv
@@ -68,14 +68,15 @@ def _point(job: tuple[dict, float, str]) -> dict:
 
 
 def mujoco_sweep(scene: Scene, freqs: np.ndarray, *, method: str = "mujoco", workers: int = 0,
-                 progress: bool | None = None) -> list[dict]:
+                 progress: bool | None = None, options: SweepOptions | None = None) -> list[dict]:
     """The MuJoCo path at every frequency of `freqs` (`method` "mujoco", or "mujoco_no_coulomb" for the same sweep
     without Coulomb friction): one compiled model and one equilibrium, one native-core run per frequency, the runs
     spread over `workers` C threads (0 = all cores; the results do not depend on it). Under the Dask executor every
-    point runs through `run_mujoco` on the cluster instead."""
+    point runs through `run_mujoco` on the cluster instead (`options`: where and how sweeps run, `SweepOptions`)."""
     jobs = [(scene.to_dict(), float(f), method) for f in freqs]
-    if current_executor() == "dask":
-        return run_sweep(_point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}")
+    options = options or SweepOptions()
+    if options.executor_for(None) == "dask":
+        return run_sweep(_point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}", options=options)
     if method == "mujoco_no_coulomb":
         scene = scene.replace(effects={"coulomb": False})
     p = scene.build_params()
@@ -101,7 +102,8 @@ def mujoco_sweep(scene: Scene, freqs: np.ndarray, *, method: str = "mujoco", wor
         out["cost"] = {"steps": tr.steps, "integrator": s.integrator, "timestep": s.timestep, "warnings": tr.warnings}
         return out
 
-    return run_sweep(point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}", executor="threads")
+    return run_sweep(point, jobs, workers=workers, progress=progress, desc=f"freqresp {method}", executor="threads",
+                     options=options)
 
 
 def peaks(freqs: np.ndarray, amp: np.ndarray) -> list[float]:
@@ -118,10 +120,10 @@ def peaks(freqs: np.ndarray, amp: np.ndarray) -> list[float]:
 
 def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 0.5,
              methods: str | tuple[str, ...] = ("linear", "mujoco", "reference"), workers: int = 0,
-             progress: bool | None = None) -> Report:
+             progress: bool | None = None, options: SweepOptions | None = None) -> Report:
     """The `freqresp` hook: frequency response from (i) the linearisation, (ii) the reference time simulation,
     (iii) MuJoCo (with and without Coulomb friction), and MuJoCo time histories at the thesis' frequencies for the
-    writer's figure."""
+    writer's figure. `options` (`SweepOptions`): where and how the sweeps run (executor, store, size guard)."""
     if isinstance(methods, str):
         methods = tuple(m.strip() for m in methods.split(",") if m.strip())
     bad = sorted(set(methods) - {"linear", "mujoco", "reference"})
@@ -145,10 +147,11 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
     results = []
     if "reference" in sim_methods:
         jobs = [(scene.to_dict(), float(f), "reference") for f in freqs]
-        results += run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp reference")
+        results += run_sweep(_point, jobs, workers=workers, progress=progress, desc="freqresp reference",
+                             options=options)
     for m in ("mujoco", "mujoco_no_coulomb"):
         if m in sim_methods:
-            results += mujoco_sweep(scene, freqs, method=m, workers=workers, progress=progress)
+            results += mujoco_sweep(scene, freqs, method=m, workers=workers, progress=progress, options=options)
     for m in sim_methods:
         rows = [r for r in results if r["method"] == m]
         curves[m] = {s: np.array([r[s][0] * np.exp(1j * math.radians(r[s][1])) for r in rows]) for s in FR_SIGNALS}

@@ -2,7 +2,7 @@
  * real MuJoCo locks, their lock trials, event times, the energy bookkeeping and the recorded row, per step in C.
  *
  * The semantics are those of Modelica's Rotational PartialFriction (modes -1 backward, 0 stuck, 1 forward, 2 free)
- * on a MuJoCo model whose rotors are hinge joints (mbsuite/models/drives/mujoco_path.py describes the MJCF
+ * on a MuJoCo model whose rotors are hinge joints (mbsuite/models/drives/mujoco.py describes the MJCF
  * conventions). mbsuite/models/drives/stepper.py (RotorStepper) is the readable Python twin of this file, statement
  * for statement; a test holds the two equal.
  *

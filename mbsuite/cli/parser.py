@@ -21,6 +21,7 @@ class Parser(argparse.ArgumentParser):
     """argparse with one-line errors: `mbsuite: error: <what>` naming the argument, and where to read the usage."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
+        """A usage error as an exception (exit 2 with the message), not argparse's exit."""
         raise UsageError(f"{message} (usage: {self.prog} --help)")
 
 

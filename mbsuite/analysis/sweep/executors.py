@@ -66,13 +66,16 @@ class Runner:
 
     @property
     def free(self) -> int:
+        """How many more points this runner takes now."""
         return self.capacity - len(self.inflight) - len(self.serial)
 
     @property
     def busy(self) -> bool:
+        """True while points are queued or running."""
         return bool(self.inflight or self.serial)
 
     def submit(self, gid: Any, point: Any) -> None:
+        """Queue `point` (group `gid`) on this runner."""
         if self.kind == "serial":
             self.serial.append((gid, point))
         elif self.kind == "dask":
@@ -98,6 +101,7 @@ class Runner:
         return [(self.inflight.pop(f), f.result()) for f in done]
 
     def close(self, failed: bool) -> None:
+        """Shut the runner down (cancelling what is in flight if the sweep `failed`)."""
         if failed:
             for f in self.inflight:
                 f.cancel()

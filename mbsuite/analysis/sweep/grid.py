@@ -13,6 +13,7 @@ from .options import MAX_POINTS, check_max_points
 
 
 def too_many(what: str, count: float | str, limit: int) -> SceneError:
+    """The SceneError of a job of `count` items above its `limit`, naming `what` and how to raise the limit."""
     if isinstance(count, str):
         n = count
     else:

@@ -345,6 +345,7 @@ class Recorder:
         self.record(passage)
 
     def record(self, ps: Passage) -> None:
+        """Store the passage's current state as the next row."""
         r = self.rows
         self.T[r], self.X[r], self.F[r], self.H[r] = ps.t, ps.x, ps.force, ps.head
         self.W[r] = ps.wire_height()
@@ -361,6 +362,7 @@ class Recorder:
         self.rows += 1
 
     def result(self, stats: dict) -> CoupledResult:
+        """The recorded rows as a `CoupledResult` with `stats`."""
         sl = slice(0, self.rows)
         return CoupledResult(t=self.T[sl], x=self.X[sl], force=self.F[sl], head=self.H[sl], wire=self.W[sl],
                              uplift=self.U[sl], n_slack=self.NS[sl], panto={k: v[sl] for k, v in self.psig.items()},

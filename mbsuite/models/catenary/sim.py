@@ -142,6 +142,7 @@ class CoupledSimulation:
 
     @staticmethod
     def shape(xi: float, he: float, valid: np.ndarray) -> np.ndarray:
+        """Hermite shape functions of a beam element at local coordinate `xi` (length `he`); 0 where not `valid`."""
         x2 = xi * xi
         x3 = x2 * xi
         N = np.array([1 - 3 * x2 + 2 * x3, he * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, he * (x3 - x2)])
@@ -279,6 +280,7 @@ class CoupledSimulation:
                                     "native": True})
 
     def locate(self, xp: float, e: int) -> tuple[int, float]:
+        """The element holding position `xp` (searched from element `e`) and the position of its left node."""
         x = self.fe.x
         last = x.size - 2
         while e < last and xp > x[e + 1]:
@@ -288,10 +290,12 @@ class CoupledSimulation:
         return e, x[e]
 
     def static_solve(self, rhs: np.ndarray) -> np.ndarray:
+        """The static displacement K^-1 rhs of the catenary."""
         from scipy.sparse.linalg import spsolve
         return spsolve(self.K.tocsc(), rhs)
 
     def static_compliance(self, Nl: np.ndarray, dofs: np.ndarray) -> float:
+        """The static compliance at a point load with shape values `Nl` on `dofs` (m/N)."""
         if not np.any(Nl != 0):
             return 0.0
         rhs = np.zeros(self.fe.n)

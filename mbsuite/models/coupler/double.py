@@ -117,6 +117,8 @@ def _double_tilt(p: CouplerParams, inp: np.ndarray) -> float:
 
 
 def ramp_double(p: CouplerParams, inp: np.ndarray, n: int = 8) -> np.ndarray:
+    """The double coupler's FPP solution at input `inp`: from the nominal pose at its first component, the other
+    components ramped in over `n` continuation steps."""
     base = inp.copy()
     base[1:] = 0.0
     u = double_nominal(p, base)

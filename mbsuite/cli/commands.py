@@ -141,7 +141,7 @@ def cmd_hardcases(args: argparse.Namespace) -> None:
 
 def cmd_perturb(args: argparse.Namespace) -> None:
     """`mbsuite perturb`: stability under relative perturbations of every scene or hard case given."""
-    from .. import hardcases, perturbation
+    from .. import hardcases, stability
 
     try:
         epsilons = [float(e) for e in args.eps.split(",")]
@@ -168,15 +168,15 @@ def cmd_perturb(args: argparse.Namespace) -> None:
         cases = [c for c in hardcases.cases(include_slow=not args.no_slow)
                  if (models is None or c.model in models) and not c.expected_failure]
     reports = []
-    targets = [(perturbation.check_scene, perturbation.shortened(sc, args.duration)) for sc in scenes]
-    for check, target in targets + [(perturbation.check_case, c) for c in cases]:
+    targets = [(stability.check_scene, stability.shortened(sc, args.duration)) for sc in scenes]
+    for check, target in targets + [(stability.check_case, c) for c in cases]:
         base = None  # the unperturbed run, made once for every eps
         for e in epsilons:
             reports.append(check(target, eps=e, draws=args.draws, seed=args.seed, base=base))
             base = reports[-1].base
             if args.verbose:
                 print(" ".join(map(str, reports[-1].row())), file=sys.stderr, flush=True)
-    emit(perturbation.report(reports), args, None)
+    emit(stability.report(reports), args, None)
     bad = sorted({r.target for r in reports if not r.ok})
     if bad:
         raise MbsuiteError("unstable under perturbation: " + ", ".join(bad))

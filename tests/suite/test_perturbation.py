@@ -12,7 +12,7 @@ import json
 import numpy as np
 import pytest
 
-from mbsuite import hardcases, load_scene, perturbation, run
+from mbsuite import hardcases, load_scene, perturbation, run, stability
 from mbsuite.registry import models
 
 FAST_SCENES = [("pantograph/lab", 1.0), ("coupler/double_friction", 1.0), ("drives/step_up_motor_resonant", 4.0),
@@ -22,21 +22,21 @@ FAST_CASES = ["drives_clutch_lock_unlock", "drives_engagement_mismatch", "pantog
 
 
 def _shortened(name: str, duration: float | None):
-    return perturbation.shortened(load_scene(name), duration)
+    return stability.shortened(load_scene(name), duration)
 
 
 @pytest.mark.parametrize("name,duration", FAST_SCENES, ids=[n for n, _ in FAST_SCENES])
 def test_scene_stable_under_1e12(name, duration):
     """Invariants (health figures) within their bounds in every copy; every headline output within KAPPA_MAX
     (measured max kappa on these: pantograph 5.5, coupler 2.2e3, drives 3.3e2 / 1.9e3, IFToMM 21, catenary 13)."""
-    rep = perturbation.check_scene(_shortened(name, duration), eps=1e-12, draws=2)
+    rep = stability.check_scene(_shortened(name, duration), eps=1e-12, draws=2)
     assert rep.ok, rep.to_dict()["errors"] or [o for o in rep.outputs if not o.ok]
     assert rep.invariants, "every run of every model reports at least one invariant"
 
 
 @pytest.mark.parametrize("name", FAST_CASES)
 def test_hard_case_stable_under_1e12(name):
-    rep = perturbation.check_case(hardcases.get(name), eps=1e-12, draws=2)
+    rep = stability.check_case(hardcases.get(name), eps=1e-12, draws=2)
     assert rep.ok, rep.errors
 
 
@@ -91,11 +91,11 @@ def test_the_check_catches_a_last_bit_discontinuity(monkeypatch):
         if hasattr(m, "assemble"):
             monkeypatch.setattr(m, "assemble", assembled_twice)
     sc = load_scene("catenary/en50318")
-    rep = perturbation.check_scene(sc, eps=1e-12, draws=2)
+    rep = stability.check_scene(sc, eps=1e-12, draws=2)
     assert not rep.ok
     assert "stats.sigma" in {o.name for o in rep.jumps()}
     # a jump a model declares (pattern -> why) is accepted and reported with its reason; the others still fail
-    declared = perturbation.check_scene(sc, eps=1e-12, draws=2, base=rep.base, jumps={"stats.*": "declared"})
+    declared = stability.check_scene(sc, eps=1e-12, draws=2, base=rep.base, jumps={"stats.*": "declared"})
     assert {o.jump for o in declared.jumps() if o.name.startswith("stats.")} == {"declared"}
     assert not declared.ok and all(o.ok for o in declared.outputs if o.name.startswith("stats."))
 
@@ -106,17 +106,17 @@ def _all_scenes():
 
 
 @pytest.mark.parametrize("name", _all_scenes())
-@pytest.mark.parametrize("eps", perturbation.EPSILONS)
+@pytest.mark.parametrize("eps", stability.EPSILONS)
 def test_every_scene_stable(name, eps):
-    rep = perturbation.check_scene(load_scene(name), eps=eps, draws=2)
+    rep = stability.check_scene(load_scene(name), eps=eps, draws=2)
     assert rep.ok, rep.to_dict()["errors"] or [o for o in rep.outputs if not o.ok]
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [c.name for c in hardcases.registry() if not c.expected_failure])
 def test_every_hard_case_stable(case):
-    for eps in perturbation.EPSILONS:
-        rep = perturbation.check_case(hardcases.get(case), eps=eps, draws=2)
+    for eps in stability.EPSILONS:
+        rep = stability.check_case(hardcases.get(case), eps=eps, draws=2)
         assert rep.ok, rep.errors
 
 
@@ -130,7 +130,7 @@ def test_cli_perturb(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["total"] == data["passed"] == 2
     assert [(r["target"], r["eps"]) for r in data["reports"]] == [("iftomm/fourbar", 1e-12), ("iftomm/fourbar", 1e-9)]
-    assert all(r["invariants"] and r["max_kappa"] < perturbation.KAPPA_MAX for r in data["reports"])
+    assert all(r["invariants"] and r["max_kappa"] < stability.KAPPA_MAX for r in data["reports"])
     assert main(["perturb", "iftomm", "--hardcases-only", "--eps", "1e-12", "--draws", "1", "--no-slow",
                  "--json"]) == 0
     data = json.loads(capsys.readouterr().out)

@@ -89,11 +89,6 @@ def positive(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) 
     return Limit(lo=0.0, lo_open=True, hi=hi, unit=unit, doc=doc, **kw)
 
 
-def non_negative(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) -> Limit:
-    """A number >= 0 (optionally <= hi)."""
-    return Limit(lo=0.0, hi=hi, unit=unit, doc=doc, **kw)
-
-
 def param(default: Any, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
           hi_open: bool = False, unit: str = "", doc: str = "", kind: type = float,
           choices: tuple[Any, ...] | None = None) -> Any:

@@ -58,7 +58,8 @@ class ModelSpec:
 
     - `paths`: the path table, engine key (what scenes write in `solver.engine`) -> `RunPath`; `engines` lists its keys
     - `solver`: the model's default solver settings (a scene's `[solver]` overrides them key by key)
-    - `equilibrium(scene) -> dict`, `modes(scene) -> dict`, `freqresp(scene, freqs, progress) -> dict`
+    - `equilibrium(scene) -> Report`, `modes(scene) -> Report`, `freqresp(scene, f_min, f_max, df, methods, workers,
+      progress, options, time_histories) -> Report` (the pantograph's)
     Any hook may be None: the CLI then says the model does not support that analysis.
 
     Suite declarations (read by the model-agnostic suite layer, which names no model):
@@ -72,9 +73,10 @@ class ModelSpec:
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     - `mujoco_model(scene) -> (MjModel, MjData)`: the MuJoCo model of exactly the scene's effects, in its initial state
       (what `mbsuite view` shows; None: the model has no MuJoCo model).
-    - `file_checks`: model-file stem -> `check(path, engine, model)` run by the engines' loaders on a file of that
-      name (engine "mujoco" with an MjModel, "pinocchio" or "urdf" with a pin.Model); raises ModelFileError naming
-      the file, the body and the residual (e.g. a loop that cannot close at the stated link lengths).
+    - `file_checks`: model-file stem -> `check(path, engine, model)`, handed to the engines' loaders for a file of
+      that name by `mbsuite.load_model_file` (engine "mujoco" with an MjModel, "pinocchio" or "urdf" with a
+      pin.Model); raises ModelFileError naming the file, the body and the residual (e.g. a loop that cannot close at
+      the stated link lengths).
     """
 
     name: str

@@ -34,7 +34,7 @@ from mbsuite.scenes import load_scene, shipped_scenes
 
 
 def setup(scene):
-    """(sim, run arguments, make_controller) of a scene on the MuJoCo path, as `model.simulate_scene` builds them."""
+    """(sim, run arguments, make_controller) of a scene on the MuJoCo path, as `analysis.simulate_scene` builds them."""
     eff = dict(scene.effects)
     sv = scene.solver
     mech = eff["mechanism"]

@@ -494,11 +494,16 @@ def model_attempts() -> Iterator[Attempt]:
     a = "model"
     mj = "from mbsuite.engines.mujoco_engine import load_model\n"
     pe = "from mbsuite.engines.pinocchio_engine import load_urdf, load_mjcf\n"
+    # a shipped model file with the checks its model declares (the engine loaders alone name no model)
+    mjf = "from mbsuite import load_model_file as load_model\n"
+    pef = ("from mbsuite import load_model_file\n"
+           "def load_urdf(p): return load_model_file(p, 'pinocchio')\n"
+           "def load_mjcf(p): return load_model_file(p, 'pinocchio')\n")
     yield snip("fourbar-rocker-5m-mujoco", a, "iftomm four-bar with the rocker pivot at 5 m (loop cannot close): "
-               "mujoco_engine.load_model", mj + f"m = load_model('{DIR}/models/mjcf/iftomm_fourbar.xml')\n"
+               "mbsuite.load_model_file", mjf + f"m = load_model('{DIR}/models/mjcf/iftomm_fourbar.xml')\n"
                "print(m.nq, m.neq)\n", culprit="iftomm_fourbar|closure", setup=ROCKER_5M)
-    yield snip("fourbar-rocker-5m-pinocchio", a, "the same file through pinocchio_engine.load_mjcf",
-               pe + f"m = load_mjcf('{DIR}/models/mjcf/iftomm_fourbar.xml')\nprint(m.nq)\n",
+    yield snip("fourbar-rocker-5m-pinocchio", a, "the same file through mbsuite.load_model_file(..., 'pinocchio')",
+               pef + f"m = load_mjcf('{DIR}/models/mjcf/iftomm_fourbar.xml')\nprint(m.nq)\n",
                culprit="iftomm_fourbar|closure", setup=ROCKER_5M)
     yield snip("fourbar-rocker-5m-run", a, "the same file as the shipped model (MBSUITE_MODELS_DIR): "
                "mbsuite.run('iftomm/fourbar')", "import mbsuite\nr = mbsuite.run('iftomm/fourbar')\n"
@@ -509,10 +514,11 @@ def model_attempts() -> Iterator[Attempt]:
               "run iftomm/fourbar --engine reference --json", culprit="closure", setup=ROCKER_5M, env=MODELS_ENV,
               timeout=120)
     yield snip("coupler-link-1.5-mujoco", a, "coupler_single.xml with link1's closure length 0.944 -> 1.5 m: "
-               "mujoco_engine.load_model", mj + f"m = load_model('{DIR}/models/mjcf/coupler_single.xml')\n"
+               "mbsuite.load_model_file", mjf + f"m = load_model('{DIR}/models/mjcf/coupler_single.xml')\n"
                "print(m.neq)\n", culprit="link1|closure", setup=COUPLER_LINK)
-    yield snip("coupler-link-1.5-urdf", a, "coupler_single.urdf with link1's closure length 1.5 m: load_urdf",
-               pe + f"m = load_urdf('{DIR}/models/models_urdf/coupler_single.urdf')\nprint(m.nq)\n",
+    yield snip("coupler-link-1.5-urdf", a, "coupler_single.urdf with link1's closure length 1.5 m: "
+               "mbsuite.load_model_file(..., 'pinocchio')",
+               pef + f"m = load_urdf('{DIR}/models/models_urdf/coupler_single.urdf')\nprint(m.nq)\n",
                culprit="link1|closure", setup=COUPLER_LINK)
     for kind in ("single", "double"):
         yield snip(f"coupler-link-1.5-pincoupler-{kind}", a, f"the changed coupler_{kind}.urdf as the shipped model "

@@ -46,7 +46,7 @@ def _load(builder, kind: str, path: str | Path, check: FileCheck | None) -> pin.
 
     read_model_text(p)
     if kind == "MJCF":  # MuJoCo's parser is strict (types, ranges); Pinocchio's ignores what it does not read
-        load_model(p)
+        load_model(p, check=check)
     try:
         with _native_stderr() as said:
             model = builder(str(p))

@@ -1,5 +1,6 @@
-"""Regression tests of the robustness corpus' IFToMM findings: the file checks the engines' loaders run on an IFToMM
-model file (`mechanisms.check_model_file`), e.g. a four-bar whose rocker pivot moved to 5 m (the loop cannot close)."""
+"""Regression tests of the robustness corpus' IFToMM findings: the file checks the model hands to the loaders for
+an IFToMM model file (`modelfiles.check_model_file`), e.g. a four-bar whose rocker pivot moved to 5 m (the loop
+cannot close)."""
 
 from __future__ import annotations
 

@@ -38,10 +38,6 @@ class CriticalSpeedWarning(UserWarning):
     """The train speed approaches the contact wire's wave propagation speed sqrt(T/rho)."""
 
 
-class ContactLostWarning(UserWarning):
-    """The pantograph left the wire for the whole statistics window (no contact to analyse)."""
-
-
 def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
     """Wave speed, speed ratio and Doppler factor (c - V)/(c + V) of the contact wire; raises for V >= c and warns
     (CriticalSpeedWarning) above 70 % and 90 % of c."""

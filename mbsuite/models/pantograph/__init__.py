@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from .freqresp import freqresp
+from .freqresp import freqresp as freqresp_report
 from .inputs import INPUTS
 from .mujoco import run_mujoco, view_model
 from .outputs import UNITS
@@ -48,7 +48,7 @@ SPEC = ModelSpec(
     },
     equilibrium=equilibrium_report,
     modes=modes_report,
-    freqresp=freqresp,
+    freqresp=freqresp_report,
     under_wire=under_wire,
     mujoco_model=view_model,
     cases="mbsuite.models.pantograph.cases",

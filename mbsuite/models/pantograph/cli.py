@@ -96,7 +96,8 @@ def freq_args(args: argparse.Namespace) -> dict:
 def cmd_freqresp(args: argparse.Namespace) -> None:
     """The frequency response; its sweeps run where `--executor/--scheduler/--store/--max-points` say."""
     scene = _scene(args, "freqresp")
-    report = scene.spec.freqresp(scene, **freq_args(args), options=sweep_options(args))
+    report = scene.spec.freqresp(scene, **freq_args(args), options=sweep_options(args),
+                                 time_histories=getattr(args, "out", None) is not None)  # only the figure needs them
     args.emit(report, args, scene.to_dict())
 
 

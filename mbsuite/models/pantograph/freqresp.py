@@ -120,10 +120,12 @@ def peaks(freqs: np.ndarray, amp: np.ndarray) -> list[float]:
 
 def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 0.5,
              methods: str | tuple[str, ...] = ("linear", "mujoco", "reference"), workers: int = 0,
-             progress: bool | None = None, options: SweepOptions | None = None) -> Report:
+             progress: bool | None = None, options: SweepOptions | None = None,
+             time_histories: bool = True) -> Report:
     """The `freqresp` hook: frequency response from (i) the linearisation, (ii) the reference time simulation,
     (iii) MuJoCo (with and without Coulomb friction), and MuJoCo time histories at the thesis' frequencies for the
-    writer's figure. `options` (`SweepOptions`): where and how the sweeps run (executor, store, size guard)."""
+    writer's figure (`time_histories=False` leaves them out: no figure of them is written). `options`
+    (`SweepOptions`): where and how the sweeps run (executor, store, size guard)."""
     if isinstance(methods, str):
         methods = tuple(m.strip() for m in methods.split(",") if m.strip())
     bad = sorted(set(methods) - {"linear", "mujoco", "reference"})
@@ -194,7 +196,7 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
             lines.append(f"  {s}: " + "; ".join(f"{r['f_hz']:.2f} Hz {r['with']:.3f} -> {r['without']:.3f}"
                                                  for r in rows_))
 
-    histories = time_history_runs(scene)  # the thesis' Figs 5-1..5-6, drawn by the writer
+    histories = time_history_runs(scene) if time_histories else None  # the thesis' Figs 5-1..5-6 for the writer
 
     def write(out: Path) -> list[Path]:
         cols = [("f", "Hz", freqs)]
@@ -207,7 +209,8 @@ def freqresp(scene: Scene, f_min: float = 1.0, f_max: float = 30.0, df: float = 
         from .plots import plot_freqresp, plot_time_histories
 
         files.append(save(plot_freqresp(freqs, curves), out / "freqresp.png"))
-        files.append(save(plot_time_histories(histories), out / "time_histories.png"))
+        if histories is not None:
+            files.append(save(plot_time_histories(histories), out / "time_histories.png"))
         return files
 
     return Report(data, "\n".join(lines), write)

@@ -1,5 +1,5 @@
 /* The pantograph's effects as MuJoCo engine plugins (Eppinger 1984, "An experimental and analytical study of
- * pantograph dynamics"; equations as in mbsuite/models/pantograph/reference.py, which stays the readable reference; a test holds the two
+ * pantograph dynamics"; equations as in mbsuite/models/pantograph/equations.py, which stays the readable reference; a test holds the two
  * to 1e-12 on every scene).
  *
  * mbsuite.pantograph.cylinder (actuator plugin, one activation = the cylinder state, declared with actdim="1"):

@@ -24,3 +24,30 @@ class StepObject(Protocol):
 
     def run(self, t_end: float) -> object:
         """Step until `t >= t_end` or `status != "running"`."""
+
+
+class Stepping:
+    """`step()` and `run(t_end)` of the protocol for a class that advances itself in `_one_step()` (one step of its own
+    kind) and keeps `t` and `status`: stepping an object that is no longer running is an error, and an exception out
+    of `_one_step()` leaves it "failed"."""
+
+    t: float
+    status: str
+
+    def _one_step(self) -> None:
+        raise NotImplementedError
+
+    def step(self) -> None:
+        """Advance one step (`_one_step`); `status` becomes "failed" if it raises."""
+        if self.status != "running":
+            raise RuntimeError(f"{type(self).__name__} is {self.status}; start a new one")
+        try:
+            self._one_step()
+        except Exception:
+            self.status = "failed"
+            raise
+
+    def run(self, t_end: float) -> None:
+        """`step()` until `t >= t_end` or the object is no longer running."""
+        while self.status == "running" and self.t < t_end:
+            self.step()

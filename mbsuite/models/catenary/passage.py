@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SolverError
+from ...stepping import Stepping
 from .fe import CW_W, NDOF_NODE
 
 #: steps between the plausibility checks of a passage (and the progress calls of `CoupledSimulation.run`)
@@ -52,7 +53,7 @@ class CoupledResult:
     energy: dict[str, np.ndarray] | None = None  # energy diagnostics (record_energy=True), see Passage.energy_terms
 
 
-class Passage:
+class Passage(Stepping):
     """One passage of the pantograph under the catenary in progress, in the spirit of scipy's `OdeSolver`: the coupled
     state after `n` steps and `step()`, which advances it by one time step of the scheme in `sim.py`'s docstring, with
     the method of `sim` (a `sim.CoupledSimulation`); a `mbsuite.stepping.StepObject`.
@@ -125,23 +126,8 @@ class Passage:
         self.Nl = self.sim.shape(dx / he, he, valid)
 
     # --- one step ---------------------------------------------------------------------------------------------
-    def step(self) -> None:
-        """Advance the coupled state by one time step dt (raises SolverError on a failure; `status` is then
-        "failed")."""
-        if self.status != "running":
-            raise RuntimeError(f"the passage is {self.status}; start a new one")
-        try:
-            self._step()
-        except Exception:
-            self.status = "failed"
-            raise
-
-    def run(self, t_end: float) -> None:
-        """`step()` until t >= t_end or the passage is no longer running."""
-        while self.status == "running" and self.t < t_end:
-            self.step()
-
-    def _step(self) -> None:
+    def _one_step(self) -> None:
+        """Advance the coupled state by one time step dt (raises SolverError on a failure)."""
         sim = self.sim
         n = self.n + 1
         t_new = n * sim.dt

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SolverError
+from ...stepping import Stepping
 from .config import HEAD_WIDTH, PassageConfig
 from .fe import CatenaryFE, assemble
 from .native_core import NativeCore
@@ -73,7 +74,7 @@ class TrainRun:
     engine_warnings: list[dict[str, int]] = field(default_factory=list)  # per pantograph: its engine's warnings
 
 
-class TrainPassage:
+class TrainPassage(Stepping):
     """A passage of the pantographs `pans` (leading first, `offsets` m behind the leading one) stepped in the compiled
     core (module docstring), a `mbsuite.stepping.StepObject`: `step()` runs one chunk of C steps up to the next entry
     (`compiled`, every pantograph a 2-mass one) or one coupled step through the core's stages; the records
@@ -140,25 +141,14 @@ class TrainPassage:
         if self.compiled:
             pan.pack(core.pm[16 * k:16 * k + 16], self.dt)
 
-    def step(self) -> None:
+    def _one_step(self) -> None:
         """One chunk of C steps up to the next entry (compiled) or one coupled step (stages); SolverError on a
-        failure (`status` is then "failed")."""
-        if self.status != "running":
-            raise RuntimeError(f"the passage is {self.status}; start a new one")
-        try:
-            self._chunk() if self.compiled else self._stage_step()
-        except Exception:
-            self.status = "failed"
-            raise
+        failure."""
+        self._chunk() if self.compiled else self._stage_step()
         self.t = self.n * self.dt
         if self.n >= self.nsteps:
             self.status = "finished"
             self._finish()
-
-    def run(self, t_end: float) -> None:
-        """`step()` until t >= t_end or the passage is no longer running."""
-        while self.status == "running" and self.t < t_end:
-            self.step()
 
     def _chunk(self) -> None:
         stop = next(s for s in self._stops if s > self.n)

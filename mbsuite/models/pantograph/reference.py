@@ -20,6 +20,7 @@ from scipy.integrate import solve_ivp
 from ...errors import SolverError
 from ...results import SimResult, assemble
 from ...scenes import Scene
+from ...stepping import Stepping
 from .equations import G_JOINTS, JOINT_NAMES, FrictionModes, PantographODE
 from .health import excursion
 from .inputs import config_of, input_of, start_of
@@ -37,7 +38,7 @@ class RefSolution:
     nsegments: int
 
 
-class EventExactIntegrator:
+class EventExactIntegrator(Stepping):
     """The reference path's step object (`mbsuite.stepping.StepObject`): `solve_ivp` from one friction/contact event
     to the next. `step()` integrates one smooth segment (to the next event or to `t_end`) and re-decides the friction
     modes after an event (stick if the constraint torque is within c, otherwise slide in the direction the free motion
@@ -68,22 +69,8 @@ class EventExactIntegrator:
         self._loss_start = None if self.in_contact else 0.0
         self.status = "running" if self.t < t_end else "finished"
 
-    def step(self) -> None:
+    def _one_step(self) -> None:
         """Integrate one smooth segment: to the next friction/contact event or to `t_end`."""
-        if self.status != "running":
-            return
-        try:
-            self._segment()
-        except Exception:
-            self.status = "failed"
-            raise
-
-    def run(self, t_end: float) -> None:
-        """Step until `t >= t_end` or the integration has finished (at the `t_end` it was built for) or failed."""
-        while self.status == "running" and self.t < t_end:
-            self.step()
-
-    def _segment(self) -> None:
         ode, y_w, t0, t_end, modes = self.ode, self.y_w, self.t, self.t_end, self.modes
         self.nsegments += 1
         if self.nsegments > self.max_events:

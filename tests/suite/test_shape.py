@@ -96,3 +96,62 @@ def test_readme_files_table_names_every_module(name):
     table = table[: table.find("\n## ", 1)] if "\n## " in table[1:] else table
     missing = [f.name for f in sorted(folder.glob("*.py")) if f.name != "__init__.py" and f"`{f.name}`" not in table]
     assert not missing, f"{name}: README files table does not name {missing}"
+
+
+def _module_graph() -> dict[str, set[str]]:
+    """Module -> the mbsuite modules it imports (at module level or inside functions): `from pkg import name` is an
+    import of `pkg.name` when that is a module, else of `pkg`."""
+    files = {".".join(f.relative_to(ROOT.parent).with_suffix("").parts).removesuffix(".__init__"): f
+             for f in ROOT.rglob("*.py")}
+    graph: dict[str, set[str]] = {}
+    for mod, f in files.items():
+        pkg = mod if f.name == "__init__.py" else mod.rpartition(".")[0]
+        deps: set[str] = set()
+        for node in ast.walk(ast.parse(f.read_text())):
+            if isinstance(node, ast.Import):
+                deps.update(a.name for a in node.names if a.name in files)
+            elif isinstance(node, ast.ImportFrom):
+                parts = pkg.split(".")
+                base = ".".join(parts[: len(parts) - node.level + 1]) if node.level else ""
+                src = ".".join(x for x in (base, node.module or "") if x)
+                for a in node.names:
+                    deps.add(f"{src}.{a.name}" if f"{src}.{a.name}" in files else src)
+        graph[mod] = (deps & set(files)) - {mod}
+    return graph
+
+
+def test_no_import_circle_in_the_package():
+    """No module of mbsuite reaches itself through imports (Tarjan's strongly connected components; a package's
+    `__init__` counts only for what it imports itself)."""
+    graph = _module_graph()
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    circles: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                circles.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    assert not circles, f"import circles: {circles}"

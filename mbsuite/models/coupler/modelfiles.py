@@ -18,18 +18,17 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import ModelFileError
+from ...modeltext import number
 from .geometry import NEXT, Closure, check_kind, closures, mounted_points
 from .params import CouplerParams
 
-
-def _f(x: float) -> str:
-    s = f"{float(x):.15g}"
-    return "0" if s in ("-0", "0") else s
+_f = partial(number, digits=15)  # the coupler's files hold 15 significant digits
 
 
 def _v(v) -> str:

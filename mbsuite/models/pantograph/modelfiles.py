@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...modeltext import number
 from ...paths import models_root
 from .elbow import Elbow
 from .equations import PantographConfig, PantographODE
@@ -40,8 +41,7 @@ RIGID_FIT_RANGE = (0.15, 0.75)  # theta_1 range (rad) of the rigid-elbow polynom
 FLOOR_DEPTH = 0.28
 
 
-def _f(x: float) -> str:
-    return repr(float(x))
+_f = number  # the shortest text that reads back as the same double
 
 
 def _inertia(I: float) -> tuple[float, float, float]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import tomllib
 
 import numpy as np
 import pytest
@@ -341,8 +342,14 @@ def test_delay_samples_one_conversion():
 def test_anti_windup_default_and_printed_variant():
     """Energy-packet PI: anti-windup unless a scene asks otherwise; the step-up closed-loop scene selects
     the printed, winding-up t_k PI explicitly (the thesis reproduction)."""
+    spec = get_model("drives")
+    assert spec.effects["anti_windup"].default is True
     sc = load_scene("drives/susd_500w_step")
-    assert "anti_windup" not in sc.to_dict().get("effects", {}) or sc.effects["anti_windup"] is True
+    with open(spec.scene_files()["susd_500w_step"], "rb") as fh:
+        assert "anti_windup" not in tomllib.load(fh)["effects"]  # the scene does not ask: the default applies
+    p = sc.build_params().resolved(sc.effects["param_set"])
+    unset = {k: v for k, v in sc.effects.items() if k != "anti_windup"}
+    assert drive.build_controller("step_up_down", "energy_packet", p, unset).anti_windup is True
     _, ctrl, _ = simulate_scene(sc.replace(solver={"duration": 0.6, "t_settle": 0.0}))
     assert ctrl.anti_windup is True
     assert abs(ctrl.eps_state) <= ctrl.E_max * (1 + 1e-12)  # the stored state never leaves the clamp
@@ -356,13 +363,28 @@ def test_anti_windup_default_and_printed_variant():
 
 
 def test_windowed_energy_balance_and_zero_input(susd_pair):
-    """Any window closes, including the kinetic energy removed by plastic locks inside it (MuJoCo)."""
+    """Any window closes, including the kinetic energy removed by plastic locks inside it (MuJoCo).
+
+    The recorded lock-impact energy against the energy the rest of the books leave unaccounted in the window: the
+    source work minus every other recorded loss minus the change of 1/2 J w^2 + 1/2 K x^2 computed here from the
+    recorded states. Measured relative differences 3.5e-4, 6.8e-4, 2.7e-5 over the three windows (1.4e-3, 5.3e-4,
+    9.9e-4 J of lock impact; the difference is the balance residual, <= 4.9e-7 J of 252 J); bound 5e-3 (7.4x the
+    worst)."""
     _, rb, _, sys_ = susd_pair["mujoco"]
-    for a, b in ((0, -1), (500, 1500), (1000, rb.t.size - 1)):
+
+    def stored(i: int) -> float:
+        q, w = rb.q[:, i], rb.w[:, i]
+        return 0.5 * float(np.sum(sys_.J * w * w)) + sum(
+            0.5 * s.K * (q[s.a] - (q[s.b] if s.b >= 0 else 0.0)) ** 2 for s in sys_.springs)
+
+    for a, b in ((0, rb.t.size - 1), (500, 1500), (1000, rb.t.size - 1)):
         bal = drive.energy_balance(sys_, rb, a, b)
         # measured 1.9e-9, 3.5e-9, 1.8e-10 over the three windows: bound 3e-8, 8.5x the worst
         assert bal.losses["lock_impact"] > 0 and abs(bal.relative) < 3e-8, (a, b, bal)
-    assert rb.energy["lock_impact"][-1] == pytest.approx(rb.stats["reset_energy"])
+        d = {k: float(v[b] - v[a]) for k, v in rb.energy.items()}
+        impact = d.pop("lock_impact")
+        unaccounted = d.pop("source") - sum(d.values()) - (stored(b) - stored(a))
+        assert impact > 1e-4 and abs(unaccounted / impact - 1) < 5e-3, (a, b, impact, unaccounted)
     zero = drive.Balance(0.0, 0.0, {}, 0.0, 0.0)
     assert zero.relative == 0.0
     assert drive.Balance(0.0, 0.0, {"x": 1.0}, 0.0, -1.0).relative == -1.0

@@ -159,7 +159,9 @@ def test_cli_design_and_run(capsys):
     assert d["K"] == pytest.approx(7.07, rel=0.01)
     assert main(["drive", "run", "drives/step_up_pwm", "--duration", "0.5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert abs(out["stats"]["energy_balance"]["relative"]) < 2e-7  # measured 3.0e-9 (hand path, 0.5 s)
+    # measured 3.0e-9 (hand path, 0.5 s); bound 3e-8 (10x). The clutch's sliding torque 1 % off in the dynamics
+    # (not in its loss) gives 1.3e-4, the brake's 7.1e-4, a bearing's >= 2.9e-4: caught with a margin of >= 4000
+    assert abs(out["stats"]["energy_balance"]["relative"]) < 3e-8
     assert main(["drive", "run", "drives/nope"]) == 2
     assert "no scene" in capsys.readouterr().err
     assert main(["drive", "design", "springsz", "--K", "1", "--xmax", "2", "--fatigue", "2"]) == 2

@@ -18,6 +18,8 @@ from mbsuite.models.catenary.train import simulate_train
 
 STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "loss_pct")
 P5 = CatenaryParams(element_length=0.5, n_spans=5, x_end=150.0, window_start=60.0, window_end=120.0)
+# the two Eppinger paths as a trailing pantograph: bounds on the statistics' differences (N; loss in %)
+TRAIL_BOUND = {"Fm": 0.03, "sigma": 0.2, "stat_max": 0.2, "stat_min": 0.2, "max": 0.2, "min": 0.05, "loss_pct": 0.3}
 
 
 def _panto(p, F0=None):
@@ -27,13 +29,21 @@ def _panto(p, F0=None):
 def test_leading_pantograph_is_the_single_one_when_the_trailing_waves_cannot_reach_it():
     """100 m behind at 250 km/h the trailing pantograph enters at t = 1.44 s; its waves (at most ~1.2 c with the
     wires' bending) cannot reach the leading one before it leaves the window at t = 1.73 s: the leading pantograph's
-    statistics are the single passage's (measured equal to 4e-11 N; bound 1e-6 N)."""
+    statistics are the single passage's (measured 2.9e-12 N; bound 3e-11 N, 10x), and so is its whole record to
+    x_end (measured 4.5e-11 N; bound 4.5e-10 N, 10x).
+
+    The trailing one meets the wave the leading one leaves in the wire (without it, it is the single pantograph:
+    `test_trailing_pantograph_behind_a_lowered_one_is_the_single_one`): the single pantograph holds the wire all
+    along the window (minimum 69 N, statistical minimum 39 N), the trailing one leaves it (0.53 % of the window,
+    statistical minimum -19 N) and its standard deviation is 1.77x the single's (44.2 vs 25.0 N; asserted > 1.5x)."""
     single = simulate(P5, 250.0, 2e-4)
     tr = simulate_train(P5, 250.0, 2e-4, ["reference2mass", "reference2mass"], [100.0])
     for k in STATS:
-        assert tr.stats[0][k] == pytest.approx(single.stats[k], abs=1e-6), k
-    assert np.max(np.abs(tr.results[0].force - single.result.force)) < 1e-6  # its whole record (to x_end) too
-    assert tr.stats[1]["sigma"] != pytest.approx(single.stats["sigma"], abs=0.1)  # the trailing one feels the wave
+        assert tr.stats[0][k] == pytest.approx(single.stats[k], abs=3e-11), k
+    assert np.max(np.abs(tr.results[0].force - single.result.force)) < 4.5e-10
+    assert single.stats["loss_pct"] == 0.0 and single.stats["stat_min"] > 0.0
+    assert tr.stats[1]["loss_pct"] > 0.0 and tr.stats[1]["stat_min"] < 0.0
+    assert tr.stats[1]["sigma"] > 1.5 * single.stats["sigma"]
 
 
 def test_trailing_pantograph_behind_a_lowered_one_is_the_single_one():
@@ -88,17 +98,19 @@ def test_energy_balance_of_two_pantographs_closes():
 @pytest.mark.slow
 def test_eppinger_trailing_pantograph_on_both_engine_paths_agrees():
     """A 2-mass leading pantograph and an Eppinger trailing one 100 m behind (it loses contact in the wave): its
-    hand-derived and MuJoCo paths agree as in the single case (measured: sigma 0.04 N, max/min 0.07 N, Fm 0.003 N,
-    loss 0.1 %; bounds 0.2 N and 0.3 %); the leading pantograph is the same on both."""
+    hand-derived and MuJoCo paths agree as in the single case. Measured differences: Fm 0.0031 N, sigma 0.044 N,
+    stat_max 0.13 N, stat_min 0.14 N, max 0.066 N, min 0.0059 N, loss 0.097 %; bounds `TRAIL_BOUND` (1.5x-10x).
+    The leading pantograph is the same on both (measured 1.3e-11 N; bound 1e-10 N, 7.5x), and so is the trailing
+    one's static force (measured 1.5e-11 N; bound 1.5e-10 N, 10x)."""
     p = CatenaryParams(element_length=0.5, n_spans=4, x_end=120.0, window_start=60.0, window_end=110.0)
     a = simulate_train(p, 250.0, 1e-4, ["reference2mass", "eppinger"], [100.0], engine="reference")
     b = simulate_train(p, 250.0, 1e-4, ["reference2mass", "eppinger"], [100.0], engine="mujoco")
     assert a.engines == ["reference", "reference"] and b.engines == ["reference", "mujoco"]
-    for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min"):
-        assert abs(a.stats[1][k] - b.stats[1][k]) < 0.2, k
-        assert abs(a.stats[0][k] - b.stats[0][k]) < 1e-9, k
-    assert abs(a.stats[1]["loss_pct"] - b.stats[1]["loss_pct"]) < 0.3
-    assert a.static_forces[1] == pytest.approx(88.77, abs=0.01)
+    for k, bound in TRAIL_BOUND.items():
+        assert abs(a.stats[1][k] - b.stats[1][k]) < bound, k
+        if k != "loss_pct":
+            assert abs(a.stats[0][k] - b.stats[0][k]) < 1e-10, k
+    assert a.static_forces[1] == pytest.approx(b.static_forces[1], abs=1.5e-10)
 
 
 def test_bad_spacings_name_the_value():

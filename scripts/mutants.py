@@ -1,36 +1,62 @@
-"""Seeded defects: does the default test suite catch realistic physics mistakes?
+"""Seeded defects: does the default test suite catch realistic physics mistakes with a failing physics assertion?
 
-Each mutation below is one plausible error in the physics code — a sign flipped in an equation of motion, an operating
+Each mutation below is one plausible error in the physics code (a sign flipped in an equation of motion, an operating
 point shifted, a regularisation band widened, a loss term dropped, a bound scaled by 1 %, an event one step late, a
-Jacobian row swapped... It is applied, one at a time, to a scratch copy of the repository (its committed tree), and the
-default suite (`pytest -m "not slow"`) runs against it with `-x`, the mutated model's own tests first. A mutation is
-caught when a test fails; the report names the first failing test. Every mutation must be caught.
+Jacobian row swapped...). The mutations run one at a time in a scratch copy of the committed tree (`git archive HEAD`;
+the checkout itself is never edited). For each mutation:
 
-    python scripts/mutants.py                  # all mutations (tens of minutes on 2 cores)
-    python scripts/mutants.py --list           # the mutations, without running
-    python scripts/mutants.py --only NAME ...  # some of them
-    python scripts/mutants.py --json out/mutants.json
+1. the text edit is applied; its `old` text must occur exactly once in the file, else the check stops naming it;
+2. the mutation's own test folder (or file) runs as one pytest run: default suite (`-m "not slow"`), no `-x`, every
+   failing test recorded;
+3. only if that run holds no physics catch, the rest of `tests/` runs as a second, separate run (`--ignore` of the
+   folder);
+4. the file is restored, also on Ctrl-C or SIGTERM, and its SHA-256 compared with the original's.
+
+Every failing test is classified by a pytest plugin loaded into each run (`-p`), which sees the exception object:
+JUnit XML drops the type of a rewritten `assert` and does not say in which file an exception was raised.
+
+- physics: an AssertionError (`assert`, `pytest.approx`, `numpy.testing`) or a pytest failure (`pytest.raises` that
+  did not raise, `pytest.fail`) whose innermost frame in the repository is in `tests/`, in a test not on NON_PHYSICS;
+- non-physics: a test on NON_PHYSICS (generated model file equal to the shipped file, printed or listed text, CLI
+  error text and table layout, documentation), whatever it raised;
+- raised: any other exception, or an AssertionError raised inside the package: a crash is not a catch;
+- broken: an error at collection or import, or a pytest run that ended without running its tests.
+
+Verdict: `caught` when a physics failure is recorded; else `broken` when a run was broken; else `hung` when a run hit
+the timeout; else `NOT CAUGHT`. Before any mutation the unmutated copy runs as the same two runs (the chosen
+mutations' test folders, then the rest of `tests/`); a failing test there stops the check, naming it.
+
+    python scripts/mutants.py --list                        # the mutations, without running
+    python scripts/mutants.py --only NAME[,NAME] --jobs 1   # some of them
+    python scripts/mutants.py --doc docs/mutations.md       # all of them (make mutants; an hour or more on 2 cores)
+
+Outcomes are merged by name into `--json` (default out/mutants.json; a mutation not run keeps its earlier outcome
+with the commit it ran on); `--doc` renders that file as Markdown. pytest's output of each run is kept in
+out/mutants/<mutation>.<run>.log.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
-import re
+import signal
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+PLUGIN = "mbsuite_mutant_probe"
 
 
 @dataclass(frozen=True)
 class Mutation:
-    """Replace the one occurrence of `old` in `path` by `new`; `tests` run first (then the whole default suite)."""
+    """Replace the one occurrence of `old` in `path` by `new`; `tests` is the mutated model's own test folder/file."""
 
     name: str
     path: str
@@ -38,6 +64,32 @@ class Mutation:
     new: str
     doc: str
     tests: str
+
+
+# Tests whose failure is not a physics catch, by node id: a test file, or `file::test` (all its parametrisations).
+NON_PHYSICS: tuple[tuple[str, str], ...] = (
+    ("tests/pantograph/test_model_files.py::test_shipped_files_equal_generator",
+     "generated model file equal to the shipped file"),
+    ("tests/coupler/test_modelfiles.py::test_shipped_files_equal_generated_baseline",
+     "generated model file equal to the shipped file"),
+    ("tests/pantograph/test_cli.py::test_freqresp_small", "printed text of a command"),
+    ("tests/pantograph/test_cli.py::test_list_json", "listing of models and scenes"),
+    ("tests/pantograph/test_cli.py::test_run_writes_csv_with_units_and_summary", "file names, headers and units"),
+    ("tests/pantograph/test_cli.py::test_errors_exit_2_with_message", "CLI error text"),
+    ("tests/pantograph/test_cli.py::test_pantograph_group_equals_the_top_level_aliases",
+     "two spellings of a command print the same"),
+    ("tests/coupler/test_cli.py::test_criteria_quick_writes_plots", "table width, file names and headers"),
+    ("tests/coupler/test_cli.py::test_fpp_writes_csv_png_summary", "table width and file names"),
+    ("tests/coupler/test_cli.py::test_figures_draw_on_given_axes", "figure layout"),
+    ("tests/coupler/test_cli.py::test_bad_input_exit_code_2", "CLI error text"),
+    ("tests/coupler/test_cli.py::test_dynamics_table_has_units_and_fits", "table width and units"),
+    ("tests/suite/test_cli.py::test_hardcases_listing_json", "listing of the hard cases"),
+    ("tests/suite/test_cli.py::test_list_shows_each_models_paths_and_groups", "listing of models and paths"),
+    ("tests/suite/test_cli.py::test_engine_override_takes_a_path_key_or_label_and_names_the_flag", "CLI error text"),
+    ("tests/suite/test_docs.py", "documentation examples run and parse"),
+    ("tests/suite/test_api_docs.py", "docstrings"),
+    ("tests/suite/test_render.py", "rendered images"),
+)
 
 
 MUTATIONS: tuple[Mutation, ...] = (
@@ -135,91 +187,374 @@ MUTATIONS: tuple[Mutation, ...] = (
              "tests/suite/test_store.py"),
 )
 
+# The plugin loaded into every pytest run: it records each failing test with its exception's type, whether it is an
+# assertion, and the innermost frame inside the repository; and from where `mbsuite` was imported.
+PROBE = '''
+import json, os, sys
+import pytest
 
-def _scratch_copy(dest: Path) -> None:
-    """The committed tree (HEAD) in `dest`: a stable snapshot, whatever is being edited in the checkout."""
-    archive = subprocess.run(["git", "archive", "--format=tar", "HEAD"], cwd=ROOT, capture_output=True, check=True)
+_root = os.path.realpath(os.environ["MBSUITE_MUTANT_ROOT"])
+_rows = []
+
+
+def _origin(excinfo):
+    for entry in reversed(excinfo.traceback):
+        p = os.path.realpath(str(entry.path))
+        if p.startswith(_root + os.sep):
+            return os.path.relpath(p, _root)
+    return ""
+
+
+def _first_line(text):
+    lines = [x for x in str(text).strip().splitlines() if x.strip()]
+    return lines[-1][:300] if lines else ""
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item, call):
+    rep = yield
+    if rep.failed:
+        exc = call.excinfo
+        if exc is None:
+            _rows.append({"nodeid": rep.nodeid, "when": rep.when, "type": "", "assertion": False, "origin": "",
+                          "message": _first_line(rep.longrepr)})
+        else:
+            assertion = exc.errisinstance(AssertionError) or exc.errisinstance(pytest.fail.Exception)
+            msg = " ".join(x.strip() for x in exc.exconly(tryshort=False).splitlines() if x.strip())
+            _rows.append({"nodeid": rep.nodeid, "when": rep.when, "type": exc.typename, "assertion": bool(assertion),
+                          "origin": _origin(exc), "message": msg[:300]})
+    return rep
+
+
+def pytest_collectreport(report):
+    if report.failed:
+        _rows.append({"nodeid": report.nodeid, "when": "collect", "type": "", "assertion": False, "origin": "",
+                      "message": _first_line(report.longrepr)})
+
+
+def pytest_sessionfinish(session, exitstatus):
+    mod = sys.modules.get("mbsuite")
+    with open(os.environ["MBSUITE_MUTANT_RECORD"], "w") as fh:
+        json.dump({"rows": _rows, "exitstatus": int(exitstatus), "collected": session.testscollected,
+                   "mbsuite": getattr(mod, "__file__", None)}, fh)
+'''
+
+
+@dataclass
+class Failure:
+    """One failing test (or collection error) of a run, classified."""
+
+    nodeid: str
+    when: str
+    kind: str  # physics | non-physics | raised | broken
+    detail: str
+
+
+@dataclass
+class Run:
+    """One pytest run: its paths, how it ended, its failures in the order they happened."""
+
+    label: str
+    paths: list[str]
+    ignore: list[str]
+    status: str  # ok | failed | broken | hung
+    exitstatus: int | None
+    collected: int
+    seconds: float
+    log: str
+    failures: list[Failure] = field(default_factory=list)
+
+    def physics(self) -> list[Failure]:
+        return [f for f in self.failures if f.kind == "physics"]
+
+
+class CheckError(Exception):
+    """The check cannot go on (a mutation does not apply, a file was not restored, the wrong package was tested)."""
+
+
+def non_physics_reason(nodeid: str) -> str | None:
+    """Why a failure of `nodeid` is not a physics catch, or None."""
+    for pattern, reason in NON_PHYSICS:
+        if nodeid == pattern or nodeid.startswith((pattern + "[", pattern + "::")):
+            return reason
+    return None
+
+
+def classify(row: dict) -> Failure:
+    """A recorded failure as physics, non-physics, raised or broken (module docstring)."""
+    nodeid, when = row["nodeid"], row["when"]
+    what = f"{row['type']}: {row['message']}" if row["type"] and not row["message"].startswith(row["type"]) \
+        else row["message"]
+    if when == "collect":
+        return Failure(nodeid, when, "broken", f"collection/import error: {row['message']}")
+    reason = non_physics_reason(nodeid)
+    if reason:
+        return Failure(nodeid, when, "non-physics", f"{reason} ({what})")
+    if row["assertion"] and row["origin"].startswith("tests/"):
+        return Failure(nodeid, when, "physics", what)
+    where = f" in {row['origin']}" if row["origin"] else ""
+    return Failure(nodeid, when, "raised", f"{what}{where} (at {when})")
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _scratch_copy(dest: Path) -> str:
+    """The committed tree (HEAD) in `dest`, whatever is being edited in the checkout; returns the commit."""
+    commit = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=ROOT, capture_output=True, text=True,
+                            check=True).stdout.strip()
+    archive = subprocess.run(["git", "archive", "--format=tar", commit], cwd=ROOT, capture_output=True, check=True)
     subprocess.run(["tar", "-x", "-C", str(dest)], input=archive.stdout, check=True)
+    return commit
 
 
-def _apply(root: Path, m: Mutation) -> str:
+def check_applies(root: Path, m: Mutation) -> str:
+    """The file's text; CheckError unless `m.old` occurs exactly once in it."""
     path = root / m.path
+    if not path.is_file():
+        raise CheckError(f"mutation {m.name}: {m.path} does not exist; update the mutation")
     text = path.read_text()
     n = text.count(m.old)
     if n != 1:
-        raise SystemExit(f"mutation {m.name}: the text to replace occurs {n} times in {m.path} (must be once); the "
-                         "code has moved on: update the mutation")
-    path.write_text(text.replace(m.old, m.new))
+        raise CheckError(f"mutation {m.name}: its text occurs {n} times in {m.path} (must be exactly once); "
+                         f"the code has moved on: update the mutation. Text:\n{textwrap.indent(m.old, '    ')}")
     return text
 
 
-def _suite(root: Path, first: str, python: str, timeout: float) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(root), "MPLBACKEND": "Agg",
-           "MBSUITE_NATIVE_DIR": str(root / ".native-cache")}
-    return subprocess.run([python, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-m", "not slow", first,
-                           "tests"], cwd=root, env=env, capture_output=True, text=True, timeout=timeout)
+def _kill_group(proc: subprocess.Popen) -> None:
+    """End the pytest process and everything it started (it runs in a session of its own)."""
+    for sig, wait in ((signal.SIGTERM, 10.0), (signal.SIGKILL, 30.0)):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.wait(timeout=wait)
+            return
+        except subprocess.TimeoutExpired:
+            continue
 
 
-def run_one(root: Path, m: Mutation, python: str, timeout: float) -> dict:
-    """Apply `m` in `root`, run the default suite (`m.tests` first, stop at the first failure), restore."""
-    original = _apply(root, m)
+def pytest_run(root: Path, probe_dir: Path, label: str, paths: list[str], ignore: list[str], timeout: float,
+               log_dir: Path) -> Run:
+    """One pytest run of `paths` (minus `ignore`) in the scratch copy, every failing test recorded and classified."""
+    record = probe_dir / f"{label}.json"
+    record.unlink(missing_ok=True)
+    log = log_dir / f"{label}.log"
+    env = {**os.environ, "PYTHONPATH": f"{root}{os.pathsep}{probe_dir}", "MPLBACKEND": "Agg",
+           "MBSUITE_NATIVE_DIR": str(root / ".native-cache"), "PYTHONDONTWRITEBYTECODE": "1",
+           "MBSUITE_MUTANT_ROOT": str(root), "MBSUITE_MUTANT_RECORD": str(record)}
+    cmd = [sys.executable, "-m", "pytest", "-q", "-rA", "-p", "no:cacheprovider", "-p", PLUGIN, "-m", "not slow",
+           "--continue-on-collection-errors", *paths, *(f"--ignore={p}" for p in ignore)]
     t0 = time.perf_counter()
+    with open(log, "w") as out:
+        out.write(" ".join(cmd) + "\n\n")
+        out.flush()
+        proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            exitstatus: int | None = proc.wait(timeout=timeout)
+            hung = False
+        except subprocess.TimeoutExpired:
+            _kill_group(proc)
+            exitstatus, hung = None, True
+        except BaseException:
+            _kill_group(proc)
+            raise
+    seconds = round(time.perf_counter() - t0, 1)
+    data = json.loads(record.read_text()) if record.is_file() else {"rows": [], "collected": 0, "mbsuite": None}
+    imported = data.get("mbsuite")
+    if imported and not Path(imported).resolve().is_relative_to(root.resolve()):
+        raise CheckError(f"run {label}: the tests imported mbsuite from {imported}, not from the scratch copy {root}")
+    failures = [classify(r) for r in data["rows"]]
+    if hung:
+        status = "hung"
+    elif exitstatus not in (0, 1) or not record.is_file():
+        status = "broken"
+        failures.append(Failure(label, "session", "broken", f"pytest exit status {exitstatus} (see {log})"))
+    else:
+        status = "ok" if exitstatus == 0 and not failures else "failed"
+    return Run(label, paths, ignore, status, exitstatus, int(data.get("collected", 0)), seconds, str(log), failures)
+
+
+def _without_nested(paths: list[str]) -> list[str]:
+    """The paths, each once, none inside another (pytest merges overlapping path arguments)."""
+    uniq = sorted(set(paths))
+    return [p for p in uniq if not any(p != q and p.startswith(q.rstrip("/") + "/") for q in uniq)]
+
+
+def run_mutation(root: Path, probe_dir: Path, m: Mutation, timeout: float, log_dir: Path) -> list[Run]:
+    """Apply `m`, run its own tests and, without a physics catch there, the rest; restore and verify the file."""
+    path = root / m.path
+    text = check_applies(root, m)
+    original, digest = path.read_bytes(), _sha256(path)
+    runs: list[Run] = []
     try:
-        proc = _suite(root, m.tests, python, timeout)
-        out = proc.stdout + proc.stderr
-        failed = re.findall(r"^(?:FAILED|ERROR) (\S+)", out, re.M)
-        caught = proc.returncode != 0
-        by = failed[0] if failed else (out.strip().splitlines() or ["?"])[-1]
-    except subprocess.TimeoutExpired:
-        caught, by = True, f"timeout after {timeout:.0f} s (the suite hung: counted as caught, look at it)"
+        path.write_text(text.replace(m.old, m.new, 1))
+        runs.append(pytest_run(root, probe_dir, f"{m.name}.own", [m.tests], [], timeout, log_dir))
+        if not runs[0].physics():
+            runs.append(pytest_run(root, probe_dir, f"{m.name}.rest", ["tests"], [m.tests], timeout, log_dir))
     finally:
-        (root / m.path).write_text(original)
-    return {"name": m.name, "caught": caught, "by": by if caught else "",
-            "seconds": round(time.perf_counter() - t0, 1), "doc": m.doc}
+        path.write_bytes(original)
+        if _sha256(path) != digest:
+            raise CheckError(f"{m.path} was not restored: its SHA-256 differs from the original's")
+    return runs
+
+
+def verdict(runs: list[Run]) -> str:
+    """caught | broken | hung | NOT CAUGHT (module docstring)."""
+    if any(r.physics() for r in runs):
+        return "caught"
+    for status, name in (("broken", "broken"), ("hung", "hung")):
+        if any(r.status == status or any(f.kind == status for f in r.failures) for r in runs):
+            return name
+    return "NOT CAUGHT"
+
+
+def outcome(m: Mutation, runs: list[Run], commit: str) -> dict:
+    """A mutation's outcome as stored in the JSON file and rendered in the Markdown."""
+    failures = [f for r in runs for f in r.failures if f.when != "session"]
+    physics = [f for f in failures if f.kind == "physics"]
+    return {"name": m.name, "path": m.path, "doc": m.doc, "tests": m.tests, "commit": commit,
+            "date": time.strftime("%Y-%m-%d"), "verdict": verdict(runs),
+            "first_physics": physics[0].nodeid if physics else "", "n_failing": len(failures),
+            "n_physics": len(physics), "runs": [asdict(r) for r in runs]}
+
+
+def _md(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def render(outcomes: dict[str, dict], mutations: tuple[Mutation, ...] = ()) -> str:
+    """docs/mutations.md from the outcomes, one row per mutation of the list (`not run` where none is stored)."""
+    mutations = mutations or MUTATIONS
+    lines = ["# Mutation check", "",
+             "Generated by `scripts/mutants.py` (`make mutants`; a subset: `python scripts/mutants.py --only NAME "
+             "--doc docs/mutations.md`). Each mutation seeds one physics defect into a scratch copy of the committed "
+             "tree, runs its model's own tests, and, when none of them fails with a physics assertion, the rest of "
+             "`tests/`. A catch is a failing assertion (`assert`, `pytest.approx`, `numpy.testing`, `pytest.raises` "
+             "that did not raise) raised in a test that does not only compare generated files with shipped files, "
+             "printed text or documentation (the list below); an exception inside the package, a collection or "
+             "import error, or a timeout is not a catch. The unmutated copy passes the same runs first.", "",
+             "| mutation | file | what it breaks | verdict | first physics catch | failing tests (physics / all) "
+             "| commit |", "|---|---|---|---|---|---|---|"]
+    counts: dict[str, int] = {}
+    for m in mutations:
+        o = outcomes.get(m.name)
+        v = o["verdict"] if o else "not run"
+        counts[v] = counts.get(v, 0) + 1
+        catch = f"`{o['first_physics']}`" if o and o["first_physics"] else "—"
+        tally = f"{o['n_physics']} / {o['n_failing']}" if o else "—"
+        lines.append(f"| `{m.name}` | `{m.path}` | {_md(m.doc)} | {'**' + v + '**' if v != 'caught' else v} | "
+                     f"{_md(catch)} | {tally} | {o['commit'] if o else '—'} |")
+    order = ("caught", "NOT CAUGHT", "broken", "hung", "not run")
+    lines += ["", "Totals: " + ", ".join(f"{k} {counts[k]}" for k in order if k in counts)
+              + f" (of {len(mutations)} mutations).", "", "## Failures that are not catches", "",
+              "Per mutation, the failing tests that do not count, each with its reason: a test on the non-physics "
+              "list, an exception that is not an assertion (raised), or an error at collection or import (broken).",
+              ""]
+    none = True
+    for m in mutations:
+        o = outcomes.get(m.name)
+        other = [f for r in (o["runs"] if o else []) for f in r["failures"] if f["kind"] != "physics"]
+        if other:
+            none = False
+            lines.append(f"- `{m.name}`:")
+            lines += [f"    - {f['kind']}: `{f['nodeid']}`: {_md(f['detail'])}" for f in other]
+    if none:
+        lines.append("None.")
+    lines += ["", "## Tests whose failure is not a physics catch", "",
+              "A test file, or a test with all its parametrisations (`NON_PHYSICS` in `scripts/mutants.py`):", ""]
+    lines += [f"- `{p}`: {reason}" for p, reason in NON_PHYSICS]
+    return "\n".join(lines) + "\n"
+
+
+def _load(path: Path) -> dict[str, dict]:
+    if not path.is_file():
+        return {}
+    return {o["name"]: o for o in json.loads(path.read_text()).get("outcomes", [])}
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--only", nargs="*", help="run only these mutations")
+    ap.add_argument("--only", action="append", metavar="NAME[,NAME]", help="run only these mutations")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
-    ap.add_argument("--json", metavar="PATH", help="write the outcomes as JSON")
-    ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per mutation (default 1800)")
-    ap.add_argument("--no-baseline", action="store_true",
-                    help="skip the control run of the unmutated copy (it must pass for the results to mean anything)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="mutations at a time: 1 (they edit the source tree, so they never run in parallel)")
+    ap.add_argument("--json", metavar="PATH", default=str(ROOT / "out" / "mutants.json"),
+                    help="outcomes, merged by mutation name (default out/mutants.json)")
+    ap.add_argument("--doc", metavar="PATH", help="write the outcomes in --json as Markdown (docs/mutations.md)")
+    ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per pytest run (default 3600)")
     args = ap.parse_args(argv)
-    chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
-    unknown = sorted(set(args.only or ()) - {m.name for m in MUTATIONS})
+    if args.jobs != 1:
+        ap.error("--jobs must be 1: a mutation edits the source tree the tests import, so mutations run one at a time")
+    names = [n.strip() for group in args.only or () for n in group.split(",") if n.strip()]
+    unknown = sorted(set(names) - {m.name for m in MUTATIONS})
     if unknown:
-        print(f"unknown mutation(s): {unknown}", file=sys.stderr)
-        return 2
+        ap.error(f"unknown mutation(s): {', '.join(unknown)} (see --list)")
+    chosen = [m for m in MUTATIONS if not names or m.name in names]
     if args.list:
         for m in chosen:
-            print(f"{m.name:38s} {m.doc}")
+            print(f"{m.name:40s} {m.path:44s} {m.tests}\n{'':40s} {m.doc}")
         return 0
-    rows = []
-    with tempfile.TemporaryDirectory(prefix="mbsuite-mutants-") as tmp:
-        root = Path(tmp)
-        _scratch_copy(root)
-        for m in chosen:  # every mutation must apply to the code as it is
-            original = _apply(root, m)
-            (root / m.path).write_text(original)
-        if not args.no_baseline:
-            base = _suite(root, "tests", sys.executable, args.timeout)
-            if base.returncode != 0:
-                tail = (base.stdout + base.stderr).strip().splitlines()[-5:]
-                print("the unmutated copy fails its own suite; fix that first:\n" + "\n".join(tail), file=sys.stderr)
-                return 2
-            print("control: the unmutated copy passes the default suite", flush=True)
-        for i, m in enumerate(chosen, 1):
-            r = run_one(root, m, sys.executable, args.timeout)
-            rows.append(r)
-            print(f"[{i}/{len(chosen)}] {m.name}: {'caught by ' + r['by'] if r['caught'] else 'NOT CAUGHT'} "
-                  f"({r['seconds']} s)", flush=True)
-    missed = [r["name"] for r in rows if not r["caught"]]
-    print(f"\n{len(rows) - len(missed)}/{len(rows)} mutations caught" + (f"; missed: {missed}" if missed else ""))
-    if args.json:
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps({"mutations": [asdict(m) for m in chosen], "outcomes": rows}, indent=2))
+    signal.signal(signal.SIGTERM, _on_sigterm)
+    log_dir = ROOT / "out" / "mutants"
+    log_dir.mkdir(parents=True, exist_ok=True)
+    store = Path(args.json)
+    outcomes = _load(store)
+    rows: list[dict] = []
+    try:
+        with tempfile.TemporaryDirectory(prefix="mbsuite-mutants-") as tmp:
+            root, probe_dir = Path(tmp) / "tree", Path(tmp) / "probe"
+            root.mkdir()
+            probe_dir.mkdir()
+            (probe_dir / f"{PLUGIN}.py").write_text(PROBE)
+            commit = _scratch_copy(root)
+            for m in chosen:  # every mutation must apply to the code as it is, before anything runs
+                check_applies(root, m)
+            own = _without_nested([m.tests for m in chosen])
+            print(f"commit {commit}: the unmutated copy, {', '.join(own)} and then the rest of tests/", flush=True)
+            for label, paths, ignore in (("baseline.own", own, []), ("baseline.rest", ["tests"], own)):
+                run = pytest_run(root, probe_dir, label, paths, ignore, args.timeout, log_dir)
+                if run.status != "ok":
+                    print(f"the unmutated copy does not pass {label} ({run.status}, exit status {run.exitstatus}); "
+                          f"fix that first (log: {run.log}):", file=sys.stderr)
+                    for f in run.failures:
+                        print(f"    {f.kind}: {f.nodeid}: {f.detail}", file=sys.stderr)
+                    return 2
+                print(f"    {label}: {run.collected} tests pass ({run.seconds} s)", flush=True)
+            for i, m in enumerate(chosen, 1):
+                t0 = time.perf_counter()
+                runs = run_mutation(root, probe_dir, m, args.timeout, log_dir)
+                o = outcome(m, runs, commit)
+                rows.append(o)
+                outcomes[m.name] = o
+                other = o["n_failing"] - o["n_physics"]
+                by = f" by {o['first_physics']}" if o["first_physics"] else ""
+                print(f"[{i}/{len(chosen)}] {m.name}: {o['verdict']}{by}; {o['n_physics']} physics failures, "
+                      f"{other} others; runs: {', '.join(r.label.split('.')[-1] + '=' + r.status for r in runs)} "
+                      f"({time.perf_counter() - t0:.0f} s; restored, hash verified)", flush=True)
+    except CheckError as e:
+        print(f"mutation check stopped: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted; a mutated file was restored (hash verified); the outcomes so far are kept", file=sys.stderr)
+        return 130
+    finally:
+        if rows:
+            store.parent.mkdir(parents=True, exist_ok=True)
+            order = {m.name: i for i, m in enumerate(MUTATIONS)}
+            ordered = sorted(outcomes.values(), key=lambda o: order.get(o["name"], len(order)))
+            store.write_text(json.dumps({"outcomes": ordered}, indent=1) + "\n")
+            if args.doc:
+                Path(args.doc).write_text(render(outcomes))
+    missed = [o["name"] for o in rows if o["verdict"] != "caught"]
+    print(f"\n{len(rows) - len(missed)}/{len(rows)} mutations caught by a physics assertion"
+          + (f"; not caught: {', '.join(missed)}" if missed else ""))
     return 1 if missed else 0
 
 

@@ -205,7 +205,7 @@ def _origin(excinfo):
     return ""
 
 
-def _first_line(text):
+def _last_line(text):
     lines = [x for x in str(text).strip().splitlines() if x.strip()]
     return lines[-1][:300] if lines else ""
 
@@ -217,7 +217,7 @@ def pytest_runtest_makereport(item, call):
         exc = call.excinfo
         if exc is None:
             _rows.append({"nodeid": rep.nodeid, "when": rep.when, "type": "", "assertion": False, "origin": "",
-                          "message": _first_line(rep.longrepr)})
+                          "message": _last_line(rep.longrepr)})
         else:
             assertion = exc.errisinstance(AssertionError) or exc.errisinstance(pytest.fail.Exception)
             msg = " ".join(x.strip() for x in exc.exconly(tryshort=False).splitlines() if x.strip())
@@ -229,7 +229,7 @@ def pytest_runtest_makereport(item, call):
 def pytest_collectreport(report):
     if report.failed:
         _rows.append({"nodeid": report.nodeid, "when": "collect", "type": "", "assertion": False, "origin": "",
-                      "message": _first_line(report.longrepr)})
+                      "message": _last_line(report.longrepr)})
 
 
 def pytest_sessionfinish(session, exitstatus):

@@ -8,6 +8,7 @@ import json
 import math
 import os
 import pickle
+import re
 import subprocess
 import sys
 import tempfile
@@ -198,16 +199,35 @@ def test_newer_schema_version_is_refused(tmp_path):
         SweepStore(store).load()
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")
-def test_read_only_folder_is_a_clear_error(tmp_path):  # pragma: no cover - CI runs as a user
-    ro = tmp_path / "ro"
-    ro.mkdir()
-    ro.chmod(0o500)
+def _read_only_folder(folder: Path) -> None:
+    folder.chmod(0o500)
+
+
+def _lock_place_taken_by_a_folder(folder: Path) -> None:
+    (folder / "s.jsonl.lock").mkdir()  # no file can be opened for writing there, not even by root
+
+
+def _writers_place_taken_by_a_file(folder: Path) -> None:
+    (folder / "s.jsonl.owners").write_text("x")  # the writers' folder cannot be made, not even by root
+
+
+@pytest.mark.parametrize("spoil", [
+    pytest.param(_read_only_folder, marks=pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")),
+    _lock_place_taken_by_a_folder,
+    _writers_place_taken_by_a_file,
+])
+def test_folder_where_the_store_cannot_write_is_a_clear_error(tmp_path, spoil):
+    """A store whose folder refuses its files is a StoreError naming the file, before any point is computed."""
+    folder = tmp_path / "place"
+    folder.mkdir()
+    spoil(folder)
+    calls = []
     try:
-        with pytest.raises(StoreError, match="cannot"):
-            run_sweep(_double, [1], workers=1, store=ro / "s.jsonl")
+        with pytest.raises(StoreError, match=rf"sweep store {re.escape(str(folder))}/s\.jsonl\S*: cannot "):
+            run_sweep(calls.append, [1], workers=1, store=folder / "s.jsonl")
     finally:
-        ro.chmod(0o700)
+        folder.chmod(0o700)
+    assert calls == []
 
 
 def test_unstorable_result_is_a_store_error_naming_the_point(tmp_path):
@@ -337,10 +357,18 @@ def test_encoding_round_trips_any_storable_value_exactly(value):
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.lists(_values, min_size=1, max_size=3))
 def test_store_round_trips_results_exactly(results):
+    calls: list[int] = []
+
+    def f(i: int):
+        calls.append(i)
+        return results[i]
+
     with tempfile.TemporaryDirectory() as d, warnings.catch_warnings():
         warnings.simplefilter("error", StoreWarning)  # nothing written by us may be reported
         store = Path(d) / "s.jsonl"
-        computed = run_sweep(results.__getitem__, list(range(len(results))), workers=1, store=store)
-        resumed = run_sweep(results.__getitem__, list(range(len(results))), workers=1, store=store)
+        computed = run_sweep(f, list(range(len(results))), workers=1, store=store)
+        assert calls == list(range(len(results)))
+        resumed = run_sweep(f, list(range(len(results))), workers=1, store=store)
+        assert calls == list(range(len(results)))  # every result came from the store: none computed again
         assert all(_same(a, b) for a, b in zip(computed, results, strict=True))
         assert all(_same(a, b) for a, b in zip(resumed, results, strict=True))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import json
 import os
@@ -36,6 +37,18 @@ def _jobs(n: int = 4) -> list:
     """Short pantograph runs at different frequencies (MuJoCo path with its engine plugins)."""
     sc = load_scene("pantograph").replace(solver={"duration": 0.3, "t_settle": 0.0})
     return [(sc.to_dict(), {"input": {"frequency": 2.0 + 1.5 * i}}) for i in range(n)]
+
+
+def _logged_scene_point(calls: str, job: tuple[dict, dict]) -> dict:
+    """`scene_point` that first appends the point's frequency to the file `calls` (one line per evaluation, from any
+    process): the count of points a sweep really computed."""
+    with open(calls, "a") as fh:
+        fh.write(f"{job[1]['input']['frequency']}\n")
+    return scene_point(job)
+
+
+def _computed(calls: Path) -> list[float]:
+    return sorted(float(x) for x in calls.read_text().split()) if calls.exists() else []
 
 
 def test_local_pool_equals_serial_and_keeps_order():
@@ -259,8 +272,13 @@ def test_too_many_points_fail_before_anything_is_built():
 
 
 def test_scene_points_resume_from_the_store_identical(tmp_path):
-    """Real scene results (nested dicts of numpy-derived numbers) come back from the store equal to a fresh run."""
+    """Real scene results (nested dicts of numpy-derived numbers) come back from the store equal to a fresh run, and
+    the resumed sweep computes none of them again."""
     jobs = _jobs(2)
-    store = tmp_path / "scene.jsonl"
-    fresh = run_sweep(scene_point, jobs, workers=1, store=store)
-    assert run_sweep(scene_point, jobs, workers=1, store=store) == fresh == run_sweep(scene_point, jobs, workers=1)
+    store, calls = tmp_path / "scene.jsonl", tmp_path / "calls.txt"
+    logged = functools.partial(_logged_scene_point, str(calls))
+    stored = run_sweep(logged, jobs, workers=1, store=store)
+    freqs = sorted(job[1]["input"]["frequency"] for job in jobs)
+    assert _computed(calls) == freqs
+    assert run_sweep(logged, jobs, workers=1, store=store) == stored == run_sweep(scene_point, jobs, workers=1)
+    assert _computed(calls) == freqs  # served from the store: no point computed twice

@@ -215,25 +215,25 @@ def test_rotor_stepper_step_and_advance():
     sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=DT)
     whole = sim.run(cc.Q0, cc.W0, 0.8, sample_dt=1e-3, stepper="python")
     st = RotorStepper(RotorRun(sim, cc.Q0, cc.W0, 0.8, sample_dt=1e-3))
-    st.advance(0.3)
+    st.run(0.3)
     assert st.k == 3000
     st.step()
-    st.advance(0.71)
-    res = st.advance(0.8).result()
+    st.run(0.71)
+    res = st.run(0.8).result()
     _same(res, whole, t_tol=0.0, w_tol=0.0)
 
 
 def test_reference_simulator_step_object():
-    """The hand path's step object: one solver step at a time / advance in pieces = simulate_reference."""
+    """The hand path's step object: one solver step at a time / run in pieces = simulate_reference."""
     sys_ = cc.build_system()
     whole = simulate_reference(sys_, cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
     sim = ReferenceSimulator(sys_, cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
     for _ in range(5):
         sim.step()
     assert 0.0 < sim.t < 0.4 and sim.solver is not None
-    sim.advance(0.75)
+    sim.run(0.75)
     assert 0.75 <= sim.t and [e["to"] for e in sim.events] == ["backward", "stuck", "stuck"][:len(sim.events)]
-    res = sim.advance(cc.T_END).result()
+    res = sim.run(cc.T_END).result()
     assert sim.done and res.events == whole.events and np.array_equal(res.w, whole.w)
     assert res.stats == whole.stats
 

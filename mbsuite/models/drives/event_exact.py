@@ -15,7 +15,7 @@ that the state machine reads in one place.
 `simulate_reference` integrates the smooth pieces with scipy's DOP853 (dense output) and locates every lock/break
 event by root finding on the dense output (brentq, |dt| ~ 1e-14 s); time breakpoints (controller actions, normal-force
 steps) truncate the step exactly. A discrete controller is sampled at its period through the dense output. It drives
-the step object `ReferenceSimulator` (`step()` = one DOP853 step of the current smooth piece, `advance(t)`).
+the step object `ReferenceSimulator` (`step()` = one DOP853 step of the current smooth piece, `run(t)`).
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class ReferenceSimulator:
     """The event-exact hand path as a step object (in the spirit of scipy's `OdeSolver.step`): it holds the state -
     time, state vector with the energy terms, modes, commands, the DOP853 solver of the current smooth piece - and
     `step()` makes one step of that solver (locating lock/break events on its dense output and stopping at time
-    breakpoints: schedule jumps, actuations, controller samples); `advance(t)` steps until t, `result()` returns the
+    breakpoints: schedule jumps, actuations, controller samples); `run(t)` steps until t, `result()` returns the
     sampled `RefResult`. `simulate_reference` drives it from 0 to t_end. See the module docstring for the semantics.
 
     State vector: q (n), w (n), then the energy terms [source, viscous per rotor (n), per part]."""
@@ -477,9 +477,9 @@ class ReferenceSimulator:
             return True
         return False
 
-    def advance(self, t: float) -> ReferenceSimulator:
-        """Step until time t (at most t_end); returns self."""
-        t = min(t, self.t_end)
+    def run(self, t_end: float) -> ReferenceSimulator:
+        """Step until time t_end (at most the run's t_end; `mbsuite.stepping.StepObject`); returns self."""
+        t = min(t_end, self.t_end)
         while not self.done and (self.t < t - 1e-15 or (t >= self.t_end - 1e-15 and self.solver is not None)):
             self.step()
         if t >= self.t_end - 1e-15:
@@ -491,11 +491,6 @@ class ReferenceSimulator:
         """"running" until the run reached t_end, then "finished" (`mbsuite.stepping.StepObject`; a failing step
         raises SolverError)."""
         return "finished" if self.done else "running"
-
-    def run(self, t_end: float) -> None:
-        """Step until t >= t_end or the run is finished (`mbsuite.stepping.StepObject`; = `advance(t_end)`)."""
-        self.advance(t_end)
-
     def _finish(self) -> None:
         if not self.done:
             y = self.y
@@ -503,7 +498,7 @@ class ReferenceSimulator:
             self.done = True
 
     def result(self) -> RefResult:
-        """The sampled result of the steps made so far (the whole run after `advance(t_end)`)."""
+        """The sampled result of the steps made so far (the whole run after `run(t_end)`)."""
         n, m = self.n, self._i_out
         Y = self._out_y[:m]
         e_names = (["source"] + [f"viscous_{nm}" for nm in self.sys.names] + self.labels
@@ -533,4 +528,4 @@ def simulate_reference(
     """Event-exact simulation of `sys` from (q0, w0) to t_end (`ReferenceSimulator`); see the module docstring."""
     return ReferenceSimulator(sys, q0, w0, t_end, controller=controller, u0=u0, sample_dt=sample_dt, rtol=rtol,
                               atol=atol, max_step=max_step, v_tol=v_tol,
-                              max_events_at_instant=max_events_at_instant).advance(t_end).result()
+                              max_events_at_instant=max_events_at_instant).run(t_end).result()

@@ -139,7 +139,7 @@ class MujocoRotorSim:
         run = RotorRun(self, q0, w0, t_end, controller=controller, u0=u0, sample_dt=sample_dt)
         if stepper == "native":
             return NativeRotorRun(run).run()
-        return RotorStepper(run).advance(t_end).result()
+        return RotorStepper(run).run(t_end).result()
 
 
 

@@ -6,7 +6,7 @@ controller at its sample instants; `mj_forward` at the current state and control
 t_k, the lock trials, the events, the sliding torques held over the step and the forward the integrator needs - the C
 hook's POST_FORWARD stage); the row recorded every `every` steps; the model's
 integrator; `work` (the energy terms of the step - the POST_STEP stage); MuJoCo's warnings and a finite state
-checked. `advance(t)` steps up to t and `result()` makes the final decision at t_end and returns the `RefResult`.
+checked. `run(t)` steps up to t and `result()` makes the final decision at t_end and returns the `RefResult`.
 
 Every method mirrors the C function of the same name statement for statement (plain loops, the same floating-point
 operations in the same order), so that a test can hold the two paths equal. It exists to be read and to check the
@@ -496,9 +496,9 @@ class RotorStepper:
         self._check()
         self.k += 1
 
-    def advance(self, t: float) -> RotorStepper:
-        """Step up to time t (at most the run's end); returns self."""
-        k_end = min(self.rotor_run.nstep, int(round(t / self.rotor_run.dt)))
+    def run(self, t_end: float) -> RotorStepper:
+        """Step up to time t_end (at most the run's end; `mbsuite.stepping.StepObject`); returns self."""
+        k_end = min(self.rotor_run.nstep, int(round(t_end / self.rotor_run.dt)))
         while self.k < k_end:
             self.step()
         return self
@@ -513,16 +513,11 @@ class RotorStepper:
         """"running" until every step of the run is made, then "finished" (`mbsuite.stepping.StepObject`; a failing
         step raises SolverError)."""
         return "finished" if self.k >= self.rotor_run.nstep else "running"
-
-    def run(self, t_end: float) -> None:
-        """Step up to t_end (at most the run's end; `mbsuite.stepping.StepObject`; = `advance(t_end)`)."""
-        self.advance(t_end)
-
     def result(self) -> RefResult:
         """The final decision at the end of the run (recorded if on the output grid) and the RefResult."""
         run = self.rotor_run
         if self.k < run.nstep:
-            self.advance(run.nstep * run.dt)
+            self.run(run.nstep * run.dt)
         if not self.done:
             self._forward()
             self.decide(self.k)

@@ -60,7 +60,7 @@ docs: $(STAMP)  ## the documentation site (API reference, model pages, gallery) 
 	$(BIN)/python scripts/build_docs.py
 
 mutants: $(STAMP)  ## seeded physics defects, one at a time: each caught by a physics assertion? (an hour or more)
-	$(BIN)/python scripts/mutants.py --jobs 1 --json out/mutants.json --doc docs/mutations.md
+	$(BIN)/python scripts/mutants.py --json out/mutants.json --doc docs/mutations.md
 
 corpus: $(STAMP)  ## the hostile robustness corpus: every outcome classified (about 15 minutes on 2 cores)
 	$(BIN)/python scripts/robustness_corpus.py --workers 2 --json-out out/robustness_corpus.json

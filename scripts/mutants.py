@@ -1,13 +1,14 @@
 """Seeded defects: does the default test suite catch realistic physics mistakes with a failing physics assertion?
 
-Each mutation below is one plausible error in the physics code (a sign flipped in an equation of motion, an operating
-point shifted, a regularisation band widened, a loss term dropped, a bound scaled by 1 %, an event one step late, a
-Jacobian row swapped...). The mutations run one at a time in a scratch copy of the committed tree (`git archive HEAD`;
-the checkout itself is never edited). For each mutation:
+Each mutation (`scripts/mutations/`, one module per model) is one plausible error in the physics code (a sign flipped
+in an equation of motion, an operating point shifted, a regularisation band widened, a loss term dropped, a bound scaled
+by 1 %, an event one step late, a Jacobian row swapped...). Mutations run in scratch copies of the committed tree (`git
+archive HEAD`; the checkout itself is never edited), `--jobs` at a time (default 2), each copy holding one mutation at a
+time. For each mutation:
 
 1. the text edit is applied; its `old` text must occur exactly once in the file, else the check stops naming it;
-2. the mutation's own test folder (or file) runs as one pytest run: default suite (`-m "not slow"`), no `-x`, every
-   failing test recorded;
+2. the mutation's own tests (the test folder or file named with it) run as one pytest run: default suite
+   (`-m "not slow"`), no `-x`, every failing test recorded;
 3. only if that run holds no physics catch, the rest of `tests/` runs as a second, separate run (`--ignore` of the
    folder);
 4. the file is restored, also on Ctrl-C or SIGTERM, and its SHA-256 compared with the original's.
@@ -23,11 +24,12 @@ JUnit XML drops the type of a rewritten `assert` and does not say in which file 
 - broken: an error at collection or import, or a pytest run that ended without running its tests.
 
 Verdict: `caught` when a physics failure is recorded; else `broken` when a run was broken; else `hung` when a run hit
-the timeout; else `NOT CAUGHT`. Before any mutation the unmutated copy runs as the same two runs (the chosen
-mutations' test folders, then the rest of `tests/`); a failing test there stops the check, naming it.
+the timeout; else `NOT CAUGHT`. Before any mutation the unmutated copy runs twice as the same two runs (the chosen
+mutations' own tests, then the rest of `tests/`); a failing test in either pass stops the check, naming it (a test that
+fails now and then must not pass for a catch).
 
     python scripts/mutants.py --list                        # the mutations, without running
-    python scripts/mutants.py --only NAME[,NAME] --jobs 1   # some of them
+    python scripts/mutants.py --only NAME[,NAME]            # some of them
     python scripts/mutants.py --doc docs/mutations.md       # all of them (make mutants; an hour or more on 2 cores)
 
 Outcomes are merged by name into `--json` (default out/mutants.json; a mutation not run keeps its earlier outcome
@@ -46,24 +48,16 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from mutations import MUTATIONS, Mutation
+
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = "mbsuite_mutant_probe"
-
-
-@dataclass(frozen=True)
-class Mutation:
-    """Replace the one occurrence of `old` in `path` by `new`; `tests` is the mutated model's own test folder/file."""
-
-    name: str
-    path: str
-    old: str
-    new: str
-    doc: str
-    tests: str
 
 
 # Tests whose failure is not a physics catch, by node id: a test file, or `file::test` (all its parametrisations).
@@ -91,101 +85,6 @@ NON_PHYSICS: tuple[tuple[str, str], ...] = (
     ("tests/suite/test_render.py", "rendered images"),
 )
 
-
-MUTATIONS: tuple[Mutation, ...] = (
-    # --- coupler: kinematics -----------------------------------------------------------------------------------------
-    Mutation("coupler_jacobian_row_swapped", "mbsuite/models/coupler/jacobian.py",
-             "    return np.hstack([lh, np.cross(links_to - o, lh)])",
-             "    J = np.hstack([lh, np.cross(links_to - o, lh)])\n    return J[[1, 0, *range(2, len(J))]]",
-             "two rows of the mechanism Jacobian swapped (links mislabelled)", "tests/coupler"),
-    Mutation("coupler_jacobian_moment_sign", "mbsuite/models/coupler/jacobian.py",
-             "    return np.hstack([lh, np.cross(links_to - o, lh)])",
-             "    return np.hstack([lh, np.cross(lh, links_to - o)])",
-             "the moment part of the Jacobian with the cross product reversed (sign flipped)", "tests/coupler"),
-    Mutation("coupler_cond_R_not_squared", "mbsuite/models/coupler/jacobian.py",
-             "    s_moment = 2 * p.R * math.cos(math.pi / 4 - p.gamma) * l0 / l",
-             "    s_moment = 2 * math.cos(math.pi / 4 - p.gamma) * l0 / l",
-             "the closed-form condition number missing a factor R", "tests/coupler"),
-    # --- IFToMM ------------------------------------------------------------------------------------------------------
-    Mutation("iftomm_mujoco_gravity_sign", "mbsuite/models/iftomm/mujoco.py",
-             "    m.opt.gravity[:] = [0.0, -gravity, 0.0]", "    m.opt.gravity[:] = [0.0, gravity, 0.0]",
-             "gravity pointing up in the MuJoCo model of the benchmarks (a sign in the equations of motion)",
-             "tests/iftomm"),
-    # --- drives ------------------------------------------------------------------------------------------------------
-    Mutation("drives_breakaway_scaled_1pct", "mbsuite/models/drives/event_exact.py",
-             "        return float(self.peaks[e] * el[e])", "        return float(1.01 * self.peaks[e] * el[e])",
-             "a clutch's stuck-torque bound (breakaway) scaled by 1.01 on the hand path", "tests/drives"),
-    Mutation("drives_lock_impact_dropped", "mbsuite/models/drives/drive.py",
-             "    resid = e_in - e_out - sum(d.values()) - stored",
-             "    resid = e_in - e_out - sum(v for k, v in d.items() if k != 'lock_impact') - stored",
-             "a loss term (the kinetic energy removed by plastic locks) dropped from the energy balance",
-             "tests/drives"),
-    Mutation("drives_event_one_step_late", "mbsuite/models/drives/native/drives.c",
-             "  row[0] = te;", "  row[0] = te + S->dt;",
-             "every mode change of the MuJoCo path located one step late", "tests/drives"),
-    Mutation("drives_storage_time_truncated", "mbsuite/models/drives/commands.py",
-             "        return int(math.floor(x + 0.5))", "        return int(math.floor(x))",
-             "durations converted to controller samples by truncation where the thesis means whole samples",
-             "tests/drives"),
-    Mutation("drives_sliding_torque_scaled_1pct", "mbsuite/models/drives/event_exact.py",
-             "            sys.apply(f, e, d * el[e])", "            sys.apply(f, e, 1.01 * d * el[e])",
-             "a slipping clutch's torque scaled by 1.01 in the dynamics (its loss bookkeeping unchanged)",
-             "tests/drives"),
-    Mutation("drives_damper_loss_dropped", "mbsuite/models/drives/event_exact.py",
-             "            dE[k0 + i] = s.D * d_w * d_w", "            dE[k0 + i] = 0.0",
-             "a spring-damper's dissipation dropped from the energy bookkeeping", "tests/drives"),
-    Mutation("iftomm_pinocchio_gravity_scaled", "mbsuite/models/iftomm/pinocchio.py",
-             "        self.model.gravity.linear = np.array([0.0, -gravity, 0.0])",
-             "        self.model.gravity.linear = np.array([0.0, -0.999 * gravity, 0.0])",
-             "gravity 0.1 % weak in the Pinocchio path of the benchmarks", "tests/iftomm"),
-    Mutation("coupler_friction_off_in_output_bearing", "mbsuite/models/coupler/mujoco.py",
-             "    spec.joint(\"phi_c\").frictionloss = p.joint_friction if effects[\"friction\"] else 0.0",
-             "    spec.joint(\"phi_c\").frictionloss = 0.0",
-             "the output bearing's friction left out of the MuJoCo coupler", "tests/coupler"),
-    # --- pantograph --------------------------------------------------------------------------------------------------
-    Mutation("pantograph_eom_centripetal_sign", "mbsuite/models/pantograph/equations.py",
-             "self.K12 * td[1] ** 2 * s12 + self.K13 * td[2] ** 2 * math.sin(t[2] - t[0]),",
-             "self.K12 * td[1] ** 2 * s12 + self.K13 * td[2] ** 2 * math.sin(t[0] - t[2]),",
-             "a sign flipped in a centripetal term of the hand-derived equations of motion (Eq 3.10)",
-             "tests/pantograph"),
-    Mutation("pantograph_operating_point_at_y_op", "mbsuite/models/pantograph/inputs.py",
-             "        return p.y_op + u.amplitude\n", "        return p.y_op\n",
-             "the linearisation point shifted by the input amplitude (y_op instead of the mean input y_op + A)",
-             "tests/pantograph"),
-    Mutation("pantograph_laminar_band_x10", "mbsuite/models/pantograph/params.py",
-             "R_LAMINAR = 0.99999", "R_LAMINAR = 0.9999",
-             "the orifice's laminar band widened ten times", "tests/pantograph"),
-    Mutation("pantograph_elbow_spring_sign_in_plugin", "mbsuite/models/pantograph/native/pantograph.c",
-             "  double Te = e->ke * (te - M_PI + q1 + q2);", "  double Te = -e->ke * (te - M_PI + q1 + q2);",
-             "the elbow spring's torque with its sign flipped in the MuJoCo plugin", "tests/pantograph"),
-    Mutation("health_stability_figure_under_reads", "mbsuite/health.py",
-             'Figure("stability_margin", h * omega_max,', 'Figure("stability_margin", 0.1 * h * omega_max,',
-             "the stability-margin figure under-reads ten times (inaccurate timesteps pass quietly)",
-             "tests/pantograph"),
-    # --- catenary ----------------------------------------------------------------------------------------------------
-    Mutation("catenary_droppers_bilateral", "mbsuite/models/catenary/sim.py",
-             "        self.slack = dropper_law == \"slack\"", "        self.slack = False",
-             "droppers made bilateral (they push as well as pull) in the slack-dropper scenes", "tests/catenary"),
-    # --- engine core, signals, scenes, store -------------------------------------------------------------------------
-    Mutation("core_input_row_one_step_late", "mbsuite/engines/native/core.c",
-             "      const double* row = J->ctrl + k * J->ctrl_ncol;",
-             "      const double* row = J->ctrl + (k > 0 ? k - 1 : 0) * J->ctrl_ncol;",
-             "the input row applied one step late (each step gets the previous step's input)", "tests/engines"),
-    Mutation("signals_c_sine_phase", "mbsuite/engines/native/core.c",
-             "s[2] * sin(2.0 * M_PI * s[3] * (t - s[5]) + s[4])",
-             "s[2] * sin(2.0 * M_PI * s[3] * (t - s[5]) + 1.001 * s[4])",
-             "the C evaluation of a sine input with its phase off by 0.1 %", "tests/engines"),
-    Mutation("limits_upper_end_ignored", "mbsuite/limits.py",
-             "        if self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi)):",
-             "        if False:",
-             "every declared upper limit ignored (too large values accepted silently)",
-             "tests/suite/test_reliability.py"),
-    Mutation("store_checksum_not_verified", "mbsuite/analysis/sweep/store.py",
-             "        if digest(body) != rec[\"sha256\"]:\n            self._report(n, offset, \"checksum mismatch",
-             "        if False:\n            self._report(n, offset, \"checksum mismatch",
-             "the sweep store trusts records whose checksum fails (a forged result comes back)",
-             "tests/suite/test_store.py"),
-)
 
 # The plugin loaded into every pytest run: it records each failing test with its exception's type, whether it is an
 # assertion, and the innermost frame inside the repository; and from where `mbsuite` was imported.
@@ -484,19 +383,29 @@ def _on_sigterm(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _baseline(root: Path, probe_dir: Path, own: list[str], n: int, timeout: float, log_dir: Path) -> list[Run]:
+    """The unmutated copy's two runs (the chosen mutations' own tests, then the rest), labelled with pass `n`."""
+    runs = []
+    for label, paths, ignore in ((f"baseline{n}.own", own, []), (f"baseline{n}.rest", ["tests"], own)):
+        runs.append(pytest_run(root, probe_dir, label, paths, ignore, timeout, log_dir))
+        if runs[-1].status != "ok":
+            break
+    return runs
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", action="append", metavar="NAME[,NAME]", help="run only these mutations")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
-    ap.add_argument("--jobs", type=int, default=1,
-                    help="mutations at a time: 1 (they edit the source tree, so they never run in parallel)")
+    ap.add_argument("--jobs", type=int, default=2,
+                    help="mutations at a time, each in a scratch copy of its own (default 2)")
     ap.add_argument("--json", metavar="PATH", default=str(ROOT / "out" / "mutants.json"),
                     help="outcomes, merged by mutation name (default out/mutants.json)")
     ap.add_argument("--doc", metavar="PATH", help="write the outcomes in --json as Markdown (docs/mutations.md)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per pytest run (default 3600)")
     args = ap.parse_args(argv)
-    if args.jobs != 1:
-        ap.error("--jobs must be 1: a mutation edits the source tree the tests import, so mutations run one at a time")
+    if args.jobs < 1:
+        ap.error(f"--jobs must be at least 1, got {args.jobs}")
     names = [n.strip() for group in args.only or () for n in group.split(",") if n.strip()]
     unknown = sorted(set(names) - {m.name for m in MUTATIONS})
     if unknown:
@@ -512,37 +421,68 @@ def main(argv: list[str] | None = None) -> int:
     store = Path(args.json)
     outcomes = _load(store)
     rows: list[dict] = []
+    lock = threading.Lock()
     try:
         with tempfile.TemporaryDirectory(prefix="mbsuite-mutants-") as tmp:
-            root, probe_dir = Path(tmp) / "tree", Path(tmp) / "probe"
-            root.mkdir()
+            probe_dir = Path(tmp) / "probe"
             probe_dir.mkdir()
             (probe_dir / f"{PLUGIN}.py").write_text(PROBE)
-            commit = _scratch_copy(root)
+            jobs = min(args.jobs, len(chosen)) or 1
+            roots = [Path(tmp) / f"tree{i}" for i in range(max(jobs, 2 if jobs > 1 else 1))]
+            commits = set()
+            for root in roots:
+                root.mkdir()
+                commits.add(_scratch_copy(root))
+            if len(commits) != 1:
+                raise CheckError(f"HEAD moved while the scratch copies were made ({', '.join(sorted(commits))})")
+            commit = commits.pop()
             for m in chosen:  # every mutation must apply to the code as it is, before anything runs
-                check_applies(root, m)
+                check_applies(roots[0], m)
             own = _without_nested([m.tests for m in chosen])
-            print(f"commit {commit}: the unmutated copy, {', '.join(own)} and then the rest of tests/", flush=True)
-            for label, paths, ignore in (("baseline.own", own, []), ("baseline.rest", ["tests"], own)):
-                run = pytest_run(root, probe_dir, label, paths, ignore, args.timeout, log_dir)
-                if run.status != "ok":
-                    print(f"the unmutated copy does not pass {label} ({run.status}, exit status {run.exitstatus}); "
-                          f"fix that first (log: {run.log}):", file=sys.stderr)
-                    for f in run.failures:
-                        print(f"    {f.kind}: {f.nodeid}: {f.detail}", file=sys.stderr)
-                    return 2
-                print(f"    {label}: {run.collected} tests pass ({run.seconds} s)", flush=True)
-            for i, m in enumerate(chosen, 1):
-                t0 = time.perf_counter()
-                runs = run_mutation(root, probe_dir, m, args.timeout, log_dir)
-                o = outcome(m, runs, commit)
-                rows.append(o)
-                outcomes[m.name] = o
-                other = o["n_failing"] - o["n_physics"]
-                by = f" by {o['first_physics']}" if o["first_physics"] else ""
-                print(f"[{i}/{len(chosen)}] {m.name}: {o['verdict']}{by}; {o['n_physics']} physics failures, "
-                      f"{other} others; runs: {', '.join(r.label.split('.')[-1] + '=' + r.status for r in runs)} "
-                      f"({time.perf_counter() - t0:.0f} s; restored, hash verified)", flush=True)
+            print(f"commit {commit}: the unmutated copy twice, {', '.join(own)} and then the rest of tests/",
+                  flush=True)
+            # Twice, so that a test that fails now and then is found before it can pass for a catch; with two copies
+            # both passes run at once, and each copy builds its native code before any mutation.
+            passes = [(roots[0], 1), (roots[1 % len(roots)], 2)]
+            with ThreadPoolExecutor(max_workers=len(roots)) as pool:
+                if len(roots) > 1:
+                    results = list(pool.map(lambda rn: _baseline(rn[0], probe_dir, own, rn[1], args.timeout,
+                                                                 log_dir), passes))
+                else:
+                    results = [_baseline(root, probe_dir, own, n, args.timeout, log_dir) for root, n in passes]
+            for runs in results:
+                for run in runs:
+                    if run.status != "ok":
+                        print(f"the unmutated copy does not pass {run.label} ({run.status}, exit status "
+                              f"{run.exitstatus}); fix that first (log: {run.log}):", file=sys.stderr)
+                        for f in run.failures:
+                            print(f"    {f.kind}: {f.nodeid}: {f.detail}", file=sys.stderr)
+                        return 2
+                    print(f"    {run.label}: {run.collected} tests pass ({run.seconds} s)", flush=True)
+            queue = list(reversed(chosen))
+
+            def worker(root: Path) -> None:
+                while True:
+                    with lock:
+                        if not queue:
+                            return
+                        m = queue.pop()
+                    t0 = time.perf_counter()
+                    runs = run_mutation(root, probe_dir, m, args.timeout, log_dir)
+                    o = outcome(m, runs, commit)
+                    with lock:
+                        rows.append(o)
+                        outcomes[m.name] = o
+                        other = o["n_failing"] - o["n_physics"]
+                        by = f" by {o['first_physics']}" if o["first_physics"] else ""
+                        print(f"[{len(rows)}/{len(chosen)}] {m.name}: {o['verdict']}{by}; {o['n_physics']} physics "
+                              f"failures, {other} others; runs: "
+                              f"{', '.join(r.label.split('.')[-1] + '=' + r.status for r in runs)} "
+                              f"({time.perf_counter() - t0:.0f} s; restored, hash verified)", flush=True)
+
+            with ThreadPoolExecutor(max_workers=jobs) as pool:
+                for f in [pool.submit(worker, root) for root in roots[:jobs]]:
+                    f.result()
     except CheckError as e:
         print(f"mutation check stopped: {e}", file=sys.stderr)
         return 2

@@ -5,7 +5,6 @@ named by their sample time, and runs in concurrent threads."""
 from __future__ import annotations
 
 import math
-import threading
 
 import mujoco
 import numpy as np
@@ -230,28 +229,3 @@ def test_servo_too_weak_for_the_load_is_named():
     with pytest.raises(SolverError, match=r"torque_in = .* outside its plausible range \[-500, 500\].*kv_drive"):
         mbsuite.run(sc)
     assert cm.servo_bound(sc.build_params(), scene_inputs(sc)) == 500.0
-
-
-def test_coupler_and_pantograph_in_threads_equal_each_alone():
-    """A coupler run and a pantograph run (engine plugins) in two threads at the same time give results bitwise
-    identical to each run alone: the native core keeps no process-global state."""
-    coupler = load_scene("coupler/double_phibc90").replace(solver={"duration": 0.6, "t_settle": 0.3})
-    panto = load_scene("pantograph/nonlinear_cylinder").replace(solver={"duration": 1.0, "t_settle": 0.5})
-    alone = {"coupler": mbsuite.run(coupler), "pantograph": mbsuite.run(panto)}
-    for _ in range(2):
-        got: dict = {}
-        start = threading.Barrier(2)
-
-        def work(name, scene, got=got, start=start):
-            start.wait()
-            got[name] = mbsuite.run(scene)
-
-        threads = [threading.Thread(target=work, args=a) for a in (("coupler", coupler), ("pantograph", panto))]
-        for th in threads:
-            th.start()
-        for th in threads:
-            th.join()
-        for name, res in alone.items():
-            assert np.array_equal(got[name].t, res.t)
-            for sig, v in res.signals.items():
-                assert np.array_equal(got[name][sig], v), (name, sig)

@@ -3,12 +3,9 @@ hand path; threads; a chattering state machine; bad input; the step objects of b
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 import pytest
 
-import mbsuite
 from mbsuite.engines.signals import Pulse, Step
 from mbsuite.errors import ParameterError, SceneError, SolverError
 from mbsuite.models.drives import coupled_clutches as cc
@@ -145,23 +142,6 @@ def test_output_grid_as_before():
         r = sim.run(cc.Q0, cc.W0, 0.1005, sample_dt=1e-3, stepper=stepper)
         assert r.t.size == 101 and np.array_equal(r.t, np.arange(101) * 10 * DT)
         assert r.w.shape == (4, 101) and all(v.size == 101 for v in r.energy.values())
-
-
-def test_concurrent_threads_give_identical_results(cc_native):
-    """The native core releases the GIL and keeps no global state: a drives run in one thread while another model
-    (the pantograph) and another drives scene run in others gives the serial results exactly."""
-    sc_d = load_scene("drives/susd_500w_open").replace(solver={"engine": "mujoco", "duration": 0.2, "t_settle": 0.0})
-    sc_p = load_scene("pantograph").replace(solver={"duration": 0.5, "t_settle": 0.25})
-    serial_d, serial_p = mbsuite.run(sc_d), mbsuite.run(sc_p)
-    with ThreadPoolExecutor(max_workers=3) as ex:
-        f_cc, f_d, f_p = ex.submit(_cc), ex.submit(mbsuite.run, sc_d), ex.submit(mbsuite.run, sc_p)
-        par_cc, par_d, par_p = f_cc.result(), f_d.result(), f_p.result()
-    _same(par_cc, cc_native, t_tol=0.0, w_tol=0.0)
-    for a, b in ((par_d, serial_d), (par_p, serial_p)):
-        assert a.signals.keys() == b.signals.keys()
-        for k in a.signals:
-            assert np.array_equal(a[k], b[k]), k
-    assert par_d.events == serial_d.events
 
 
 @pytest.mark.parametrize("stepper", ["native", "python"])

@@ -4,7 +4,6 @@ failure, no mixing between models in concurrent threads, and `mujoco.rollout` ov
 from __future__ import annotations
 
 import math
-import threading
 
 import mujoco
 import numpy as np
@@ -141,37 +140,6 @@ def test_bad_arguments_are_value_errors():
         Stepper(m, None, [Channel("q", "qpos", 0, 2)])
     with pytest.raises(ValueError, match="ctrl must have shape"):
         Stepper(m).run(10, ctrl=np.zeros(5), ctrl_idx=[0])
-
-
-def _scene_run(ref: str, duration: float) -> dict:
-    sc = mbsuite.load_scene(ref).replace(solver={"duration": duration, "t_settle": 0.0})
-    res = mbsuite.run(sc)
-    return {k: v.copy() for k, v in res.signals.items()}
-
-
-def test_two_models_in_two_threads_do_not_mix():
-    """Different scenes in two Python threads at the same time give results identical to each run alone (with
-    process-global Python callbacks the effects of one model acted on the other's steps)."""
-    jobs = [("pantograph/lab", 3.0), ("iftomm/fourbar", 3.0), ("pantograph/nonlinear_cylinder", 2.0)]
-    alone = [_scene_run(*j) for j in jobs]
-    together: list[dict | None] = [None] * len(jobs)
-    errors = []
-
-    def work(i):
-        try:
-            together[i] = _scene_run(*jobs[i])
-        except Exception as exc:  # noqa: BLE001 - reported below
-            errors.append(exc)
-
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(jobs))]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    assert not errors, errors
-    for a, b in zip(alone, together, strict=True):
-        assert a.keys() == b.keys()
-        assert all(np.array_equal(a[k], b[k]) for k in a)
 
 
 def test_map_threads_keeps_order_and_equals_serial():

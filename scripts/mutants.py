@@ -282,7 +282,8 @@ def _without_nested(paths: list[str]) -> list[str]:
     return [p for p in uniq if not any(p != q and p.startswith(q.rstrip("/") + "/") for q in uniq)]
 
 
-def run_mutation(root: Path, probe_dir: Path, m: Mutation, timeout: float, log_dir: Path) -> list[Run]:
+def run_mutation(root: Path, probe_dir: Path, m: Mutation, timeout: float, log_dir: Path,
+                 own_only: bool = False) -> list[Run]:
     """Apply `m`, run its own tests and, without a physics catch there, the rest; restore and verify the file."""
     path = root / m.path
     text = check_applies(root, m)
@@ -291,7 +292,7 @@ def run_mutation(root: Path, probe_dir: Path, m: Mutation, timeout: float, log_d
     try:
         path.write_text(text.replace(m.old, m.new, 1))
         runs.append(pytest_run(root, probe_dir, f"{m.name}.own", [m.tests], [], timeout, log_dir))
-        if not runs[0].physics():
+        if not runs[0].physics() and not own_only:
             runs.append(pytest_run(root, probe_dir, f"{m.name}.rest", ["tests"], [m.tests], timeout, log_dir))
     finally:
         path.write_bytes(original)
@@ -403,6 +404,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="outcomes, merged by mutation name (default out/mutants.json)")
     ap.add_argument("--doc", metavar="PATH", help="write the outcomes in --json as Markdown (docs/mutations.md)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per pytest run (default 3600)")
+    ap.add_argument("--try", dest="trial", action="store_true",
+                    help="while writing a mutation and its test: no baseline, only the mutation's own tests, outcomes "
+                         "printed and not stored (the docs table comes from a full run)")
     args = ap.parse_args(argv)
     if args.jobs < 1:
         ap.error(f"--jobs must be at least 1, got {args.jobs}")
@@ -428,7 +432,7 @@ def main(argv: list[str] | None = None) -> int:
             probe_dir.mkdir()
             (probe_dir / f"{PLUGIN}.py").write_text(PROBE)
             jobs = min(args.jobs, len(chosen)) or 1
-            roots = [Path(tmp) / f"tree{i}" for i in range(max(jobs, 2 if jobs > 1 else 1))]
+            roots = [Path(tmp) / f"tree{i}" for i in range(jobs)]
             commits = set()
             for root in roots:
                 root.mkdir()
@@ -439,13 +443,14 @@ def main(argv: list[str] | None = None) -> int:
             for m in chosen:  # every mutation must apply to the code as it is, before anything runs
                 check_applies(roots[0], m)
             own = _without_nested([m.tests for m in chosen])
-            print(f"commit {commit}: the unmutated copy twice, {', '.join(own)} and then the rest of tests/",
-                  flush=True)
+            if not args.trial:
+                print(f"commit {commit}: the unmutated copy twice, {', '.join(own)} and then the rest of tests/",
+                      flush=True)
             # Twice, so that a test that fails now and then is found before it can pass for a catch; with two copies
             # both passes run at once, and each copy builds its native code before any mutation.
-            passes = [(roots[0], 1), (roots[1 % len(roots)], 2)]
+            passes = [] if args.trial else [(roots[0], 1), (roots[1 % len(roots)], 2)]
             with ThreadPoolExecutor(max_workers=len(roots)) as pool:
-                if len(roots) > 1:
+                if len(roots) > 1 and passes:
                     results = list(pool.map(lambda rn: _baseline(rn[0], probe_dir, own, rn[1], args.timeout,
                                                                  log_dir), passes))
                 else:
@@ -468,7 +473,7 @@ def main(argv: list[str] | None = None) -> int:
                             return
                         m = queue.pop()
                     t0 = time.perf_counter()
-                    runs = run_mutation(root, probe_dir, m, args.timeout, log_dir)
+                    runs = run_mutation(root, probe_dir, m, args.timeout, log_dir, own_only=args.trial)
                     o = outcome(m, runs, commit)
                     with lock:
                         rows.append(o)
@@ -490,7 +495,12 @@ def main(argv: list[str] | None = None) -> int:
         print("interrupted; a mutated file was restored (hash verified); the outcomes so far are kept", file=sys.stderr)
         return 130
     finally:
-        if rows:
+        if rows and args.trial:
+            for o in rows:
+                for r in o["runs"]:
+                    for f in r["failures"]:
+                        print(f"    {o['name']}: {f['kind']}: {f['nodeid']}: {_short(f['detail'], 160)}")
+        elif rows:
             store.parent.mkdir(parents=True, exist_ok=True)
             order = {m.name: i for i, m in enumerate(MUTATIONS)}
             ordered = sorted(outcomes.values(), key=lambda o: order.get(o["name"], len(order)))

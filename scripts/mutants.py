@@ -54,7 +54,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from mutations import MUTATIONS, Mutation
+from mutations import GROUPS, MUTATIONS, Mutation
 
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = "mbsuite_mutant_probe"
@@ -354,7 +354,13 @@ def render(outcomes: dict[str, dict], mutations: tuple[Mutation, ...] = ()) -> s
                      f"{_md(catch)} | {tally} | {o['commit'] if o else '—'} |")
     order = ("caught", "NOT CAUGHT", "broken", "hung", "not run")
     lines += ["", "Totals: " + ", ".join(f"{k} {counts[k]}" for k in order if k in counts)
-              + f" (of {len(mutations)} mutations).", "", "## Failures that are not catches", "", *textwrap.wrap(
+              + f" (of {len(mutations)} mutations).", "", "| model or layer | mutations | caught |", "|---|---|---|"]
+    for group, members in GROUPS.items():
+        here = [m for m in members if m in mutations]
+        if here:
+            caught = sum(1 for m in here if outcomes.get(m.name, {}).get("verdict") == "caught")
+            lines.append(f"| {group} | {len(here)} | {caught} |")
+    lines += ["", "## Failures that are not catches", "", *textwrap.wrap(
               "Per mutation, the failing tests that do not count, each with its reason: a test on the non-physics "
               "list, an exception that is not an assertion (raised), or an error at collection or import (broken).",
               120), ""]

@@ -3,7 +3,9 @@
 from mutations import catenary, coupler, drives, iftomm, layers, pantograph
 from mutations.mutation import Mutation
 
-MUTATIONS: tuple[Mutation, ...] = (*coupler.MUTATIONS, *iftomm.MUTATIONS, *drives.MUTATIONS, *pantograph.MUTATIONS,
-                                   *catenary.MUTATIONS, *layers.MUTATIONS)
+GROUPS: dict[str, tuple[Mutation, ...]] = {
+    "coupler": coupler.MUTATIONS, "iftomm": iftomm.MUTATIONS, "drives": drives.MUTATIONS,
+    "pantograph": pantograph.MUTATIONS, "catenary": catenary.MUTATIONS, "layers below the models": layers.MUTATIONS}
+MUTATIONS: tuple[Mutation, ...] = tuple(m for group in GROUPS.values() for m in group)
 
-__all__ = ["MUTATIONS", "Mutation"]
+__all__ = ["GROUPS", "MUTATIONS", "Mutation"]

@@ -372,3 +372,101 @@ def test_store_round_trips_results_exactly(results):
         assert calls == list(range(len(results)))  # every result came from the store: none computed again
         assert all(_same(a, b) for a, b in zip(computed, results, strict=True))
         assert all(_same(a, b) for a, b in zip(resumed, results, strict=True))
+
+
+# ------------------------------------------------------------------------------------------------ keys and codec
+def _typed(x):
+    """A result that names the point's type and value: two points served the same result are told apart."""
+    return f"{type(x).__module__}.{type(x).__qualname__} {x!r}"
+
+
+# points equal under ==, or with the same plain JSON, that are different points of a study
+_LOOKALIKES = [1, 1.0, True, "1", (1,), [1], {"1": 1}, {1: 1}, np.int64(1), np.int32(1), np.float32(1.0),
+               np.float64(1.0), np.array([1.0]), np.array([1.0], dtype=np.float32), np.array([[1.0]]),
+               0.0, -0.0, complex(1.0, 0.0), np.str_("1"), np.bool_(True)]
+
+
+def test_points_that_look_alike_never_share_a_key_and_each_gets_its_own_result(tmp_path):
+    """Every pair of different points has its own key (equal under == or in plain JSON is not the same point), so a
+    sweep computes each of them and a resumed one serves each its own result."""
+    keys = [point_key(_typed, p) for p in _LOOKALIKES]
+    assert len(set(keys)) == len(_LOOKALIKES)
+    assert point_key(_typed, 1) != point_key(_double, 1)  # the function is part of the key
+    store, calls = tmp_path / "s.jsonl", []
+
+    def f(x):
+        calls.append(x)
+        return _typed(x)
+
+    f.__qualname__ = "typed_point"
+    expect = [_typed(p) for p in _LOOKALIKES]
+    assert run_sweep(f, _LOOKALIKES, workers=1, store=store) == expect
+    assert len(calls) == len(_LOOKALIKES)  # none served another point's result
+    calls.clear()
+    assert run_sweep(f, _LOOKALIKES, workers=1, store=store) == expect
+    assert calls == []  # every one from the store, each its own
+
+
+def _scaled(x: float, *, scale: float, offset: float = 0.0) -> float:
+    return scale * x + offset
+
+
+@pytest.mark.parametrize("changed", [{"scale": 3.0}, {"offset": 0.5}, {"scale": 2.0, "offset": -0.0}])
+def test_a_changed_parameter_of_the_function_never_returns_a_stored_result(tmp_path, changed):
+    """The same points of a function with another keyword argument (a study's parameter bound with
+    functools.partial) are other points: computed anew, never served the first study's results."""
+    import functools
+
+    store = tmp_path / "s.jsonl"
+    first = functools.partial(_scaled, scale=2.0)
+    assert run_sweep(first, [1.0, 2.0], workers=1, store=store) == [2.0, 4.0]
+    second = functools.partial(_scaled, **{"scale": 2.0, **changed})
+    assert point_key(first, 1.0) != point_key(second, 1.0)
+    want = [_scaled(x, **{"scale": 2.0, **changed}) for x in (1.0, 2.0)]
+    got = run_sweep(second, [1.0, 2.0], workers=1, store=store)
+    assert got == want and [math.copysign(1, v) for v in got] == [math.copysign(1, v) for v in want]
+    assert run_sweep(first, [1.0, 2.0], workers=1, store=store) == [2.0, 4.0]  # the first study still its own
+
+
+_DTYPES = ["?", "i1", "<i2", "<i4", "<i8", "u1", "<u2", "<u4", "<u8", "<f2", "<f4", "<f8", ">f8", ">i4", "<c8",
+           "<c16", "<U3"]
+_SHAPES = [(), (0,), (4,), (2, 3), (2, 0, 3), (1, 1, 2), (3, 1)]
+
+
+def _sample(dtype: np.dtype, shape: tuple[int, ...]) -> np.ndarray:
+    """An array of `dtype` and `shape` holding the dtype's extremes (min, max, tiny, nan, inf, -0.0, words)."""
+    n = math.prod(shape)
+    if dtype.kind == "b":
+        pool = [True, False]
+    elif dtype.kind in "iu":
+        info = np.iinfo(dtype)
+        pool = [info.min, info.max, 0, 1, info.max // 3]
+    elif dtype.kind in "fc":
+        info = np.finfo(dtype)
+        pool = [info.max, -info.max, info.tiny, -0.0, np.inf, -np.inf, np.nan, 1 / 3]
+        if dtype.kind == "c":
+            pool = [complex(a, b) for a, b in zip(pool, pool[::-1], strict=True)]
+    else:
+        pool = ["", "a", "xyz", "é€"]
+    return np.array([pool[i % len(pool)] for i in range(n)], dtype=dtype).reshape(shape)
+
+
+@pytest.mark.parametrize("shape", _SHAPES, ids=str)
+@pytest.mark.parametrize("dtype", _DTYPES)
+def test_every_dtype_and_shape_round_trips_bit_for_bit(dtype, shape):
+    """Arrays of every storable dtype (byte order included) and shape (0-d, empty, column, ...) and their scalars come
+    back from plain JSON with the same dtype, shape and bytes."""
+    a = _sample(np.dtype(dtype), shape)
+    back = decode_value(json.loads(json.dumps(encode_value(a), allow_nan=False)))
+    assert type(back) is np.ndarray and back.dtype == a.dtype and back.shape == a.shape
+    if a.dtype.kind not in "fc":
+        assert back.tobytes() == a.tobytes()
+    else:  # NaN payloads are not kept (encode_value's docstring): every NaN made the plain NaN, part by part
+        for part in ((np.real, np.imag) if a.dtype.kind == "c" else (np.real,)):
+            x, y = part(a), part(back)
+            assert np.array_equal(np.isnan(x), np.isnan(y))
+            assert np.where(np.isnan(y), 0, y).tobytes() == np.where(np.isnan(x), 0, x).tobytes()
+    for s in a.ravel()[:3]:
+        sb = decode_value(json.loads(json.dumps(encode_value(s), allow_nan=False)))
+        assert type(sb) is type(s) and sb.dtype == s.dtype
+        assert _same(sb, s)

@@ -36,12 +36,12 @@ def encode_value(obj: Any) -> Any:
     plain NaN: its sign and payload are not kept). Holds None, bool, int, float
     (also nan/inf), complex, str, list, tuple, dict, numpy scalars and numeric/str arrays; anything else is a
     `StoreError` naming its type (nothing is ever pickled)."""
-    if obj is None or isinstance(obj, bool | str):
-        return obj
-    if isinstance(obj, np.generic):  # before float: np.float64 is a float subclass
+    if isinstance(obj, np.generic):  # before float and str: np.float64 and np.str_ are their subclasses
         if obj.dtype.kind not in _NUMERIC_KINDS:
             raise StoreError(f"cannot store a numpy scalar of dtype {obj.dtype}")
         return {_TAG: "scalar", "dtype": obj.dtype.str, "v": encode_value(obj.item())}
+    if obj is None or isinstance(obj, bool | str):
+        return obj
     if isinstance(obj, int):
         return int(obj)
     if isinstance(obj, float):

@@ -249,3 +249,30 @@ def test_a_run_longer_than_one_c_call_is_one_run(monkeypatch):
     pieces = Stepper(m, _start(m), chans, every=7).run(n, ctrl=u, ctrl_idx=[0])
     assert np.array_equal(whole.t, pieces.t) and np.array_equal(whole["q"], pieces["q"])
     assert np.array_equal(whole["P"], pieces["P"]) and whole.steps == pieces.steps == n
+
+
+@pytest.mark.parametrize("n, every", [(10, 3), (9, 3), (7, 1), (5, 8)])
+def test_decimated_rows_hold_the_state_of_their_step(n, every):
+    """Row j of a run recorded every `every` steps holds the state after k_j = j every steps (and the final state),
+    each channel in its own columns: bitwise equal to a Python mj_step loop read at the same steps (the time column
+    is the core's, never a channel's)."""
+    m = mbsuite.engines.mujoco_engine.load_model(PENDULUM, from_string=True)
+    d = mujoco.MjData(m)
+    d.qpos[0], d.qvel[0] = 0.3, -1.2
+    tr = Stepper(m, d, [Channel("q", "qpos"), Channel("v", "qvel"), Channel("u", "ctrl")], every=every).run(
+        n, ctrl=np.linspace(0.5, 1.5, n), ctrl_idx=[0])
+    d2 = mujoco.MjData(m)
+    d2.qpos[0], d2.qvel[0] = 0.3, -1.2
+    u = np.linspace(0.5, 1.5, n)
+    rows = [(d2.qpos[0], d2.qvel[0], d2.ctrl[0])]
+    for k in range(n):
+        d2.ctrl[0] = u[k]
+        mujoco.mj_step(m, d2)
+        rows.append((d2.qpos[0], d2.qvel[0], d2.ctrl[0]))
+    steps = sorted(set(range(0, n + 1, every)) | {n})
+    want = np.array(rows)[steps]
+    # the control recorded at step k is the input of step k (the final row keeps the last one applied)
+    want[:-1, 2] = [u[k] for k in steps[:-1]]
+    assert np.array_equal(tr["q"], want[:, 0]) and np.array_equal(tr["v"], want[:, 1])
+    assert np.array_equal(tr["u"], want[:, 2])
+    assert np.array_equal(tr.t, np.array(steps) * m.opt.timestep)

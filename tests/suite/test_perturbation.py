@@ -139,3 +139,34 @@ def test_cli_perturb(capsys):
                       (["--duration", "-1"], "--duration")):
         assert main(["perturb", "iftomm/fourbar", *bad]) == 2
         assert word in capsys.readouterr().err
+
+
+def test_draws_are_standard_normal_relative_changes():
+    """x (1 + eps z), z a standard normal: 4000 quantities under their own names at eps = 1e-9. Sample mean of z
+    within 4 sigma of 0 (sigma = 1 / sqrt(4000) = 0.016: bound 0.064), sample sd within 0.06 of 1 (its sigma
+    1 / sqrt(8000) = 0.011: 5.3 sigma), 50 % +- 4 sigma (3.2 %) of the draws negative, and the largest |z| below 5."""
+    eps, n = 1e-9, 4000
+    with perturbation.perturbed(eps, 11):
+        y = np.array([perturbation.value(2.0, key=f"q{i}") for i in range(n)])
+    z = (y / 2.0 - 1.0) / eps
+    assert abs(z.mean()) < 4 / np.sqrt(n)
+    assert abs(z.std() - 1.0) < 0.06
+    assert abs(np.mean(z < 0) - 0.5) < 4 * 0.5 / np.sqrt(n)
+    assert 2.5 < np.max(np.abs(z)) < 5.0  # 4000 normal draws: the largest |z| is 3.5 give or take 0.4
+
+
+def test_a_draw_that_would_cross_a_range_end_is_mirrored():
+    """A value at its upper limit: a draw that would cross it is mirrored, x (1 - eps z) (the same size of change,
+    inside the range); one that stays inside is kept. Half of 400 draws go each way (+- 4 sigma = 20 %)."""
+    from mbsuite.limits import Limit
+
+    eps, x, n = 1e-9, 5.0, 400
+    lim = Limit(lo=0.0, hi=x, hi_open=False)
+    with perturbation.perturbed(eps, 5):
+        free = np.array([perturbation.value(x, key=f"p{i}") for i in range(n)])
+        kept = np.array([perturbation.value(x, lim, key=f"p{i}") for i in range(n)])
+    crossing = free > x
+    assert 0.3 < crossing.mean() < 0.7
+    np.testing.assert_array_equal(kept[~crossing], free[~crossing])
+    np.testing.assert_allclose(kept[crossing], 2 * x - free[crossing], rtol=0, atol=4 * np.spacing(x))
+    assert np.all(kept <= x)

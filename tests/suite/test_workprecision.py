@@ -27,3 +27,13 @@ def test_unknown_model_is_a_clear_error():
         workprecision(load_scene("catenary"), repeats=1, quick=True)
     with pytest.raises(MbsuiteError, match="four-bar"):
         workprecision(load_scene("iftomm/bricard"), repeats=1, quick=True)
+
+
+@pytest.mark.parametrize("a, b, expect", [(1.1, 1.0, 0.1), (0.9, 1.0, 0.1), (-3.0, -2.0, 0.5), (2.0, -2.0, 2.0),
+                                          (1e-310, 0.0, 1e-10)])
+def test_relative_error_is_measured_against_the_reference(a, b, expect):
+    """|a - b| / |b|, b the reference (a run reading 10 % high is 0.1 off, not 0.1 / 1.1); a reference of 0 divides
+    by the floor 1e-300. Hand values; rounding of the decimal inputs: measured 8.3e-16 relative, bound 1e-14."""
+    from mbsuite.analysis.workprecision import _rel
+
+    assert _rel(a, b) == pytest.approx(expect, rel=1e-14)

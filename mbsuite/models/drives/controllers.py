@@ -187,8 +187,9 @@ class EnergyPacketController:
     1. extraction and transfer waits use `match_time` (root by enumeration with the sign condition of Tables B.1/B.2),
        which removes the negative extraction delay for w_e < 0, w_t < 0;
     2. no real root: wait for the spring's peak speed toward the target instead of the printed `disc <= 0` branch;
-    3. the clutch delay is subtracted from both waits, and the end of extraction is predicted (release when
-       |theta| >= theta_target - |w_src| C_d), like the transfer release.
+    3. the engagement delay C_d is subtracted from both waits, and the end of extraction is predicted (release when
+       |theta| >= theta_target - |w_src| R_d, R_d the release delay), like the transfer release (|theta| <= |w_s| R_d);
+       the printed code has one clutch delay for both (R_d = C_d, every shipped parameter set).
     Closed loop: velocity-squared energy-packet PI, once per energy cycle (Eq 5.29),
     eps_k = eps_{k-1} + (Kp + Ki t_s) e_k - Kp e_{k-1} with e = sign(r)(|r| r - |w| w), clamped to the spring capacity
     +-1/2 K x_max^2 with the clamped value stored (anti-windup, the default; `anti_windup=False` stores the unclamped
@@ -203,6 +204,7 @@ class EnergyPacketController:
     Omega: float
     clutch_delay: float
     spring_max: float
+    release_delay: float | None = None  # None: the same as clutch_delay (every shipped parameter set)
     min_motor_vel: float = 70.0
     min_load_vel: float = 0.0
     closed_loop: bool = False
@@ -218,14 +220,16 @@ class EnergyPacketController:
             v = getattr(self, nm)
             if not (math.isfinite(v) and v > 0):
                 raise ParameterError(f"energy-packet controller: {nm} must be positive, got {v!r}")
-        for nm in ("clutch_delay", "min_motor_vel", "min_load_vel"):
+        if self.release_delay is None:
+            self.release_delay = self.clutch_delay
+        for nm in ("clutch_delay", "release_delay", "min_motor_vel", "min_load_vel"):
             v = getattr(self, nm)
             if not (math.isfinite(v) and v >= 0):
                 raise ParameterError(f"energy-packet controller: {nm} must be >= 0, got {v!r}")
         self.dt = 1.0 / self.fs
-        if self.clutch_delay >= 2 * math.pi / self.Omega:
-            raise ParameterError(f"clutch delay {self.clutch_delay} s is longer than a free-oscillation cycle "
-                                 f"2 pi/Omega = {2 * math.pi / self.Omega:.4g} s")
+        if max(self.clutch_delay, self.release_delay) >= 2 * math.pi / self.Omega:
+            raise ParameterError(f"clutch delay {max(self.clutch_delay, self.release_delay)} s is longer than a "
+                                 f"free-oscillation cycle 2 pi/Omega = {2 * math.pi / self.Omega:.4g} s")
         self.E_max = 0.5 * self.K * self.spring_max**2
         self.eps = 0.0
         self.eps_state = 0.0
@@ -287,7 +291,7 @@ class EnergyPacketController:
             src = wm if self.E_dir == 1 else wl
             min_v = self.min_motor_vel if self.E_dir == 1 else self.min_load_vel
             # packet full (predicted at the actual release), source too slow, or source reversed (nothing left)
-            if (abs(ths) >= self.target - abs(src) * self.clutch_delay or abs(src) < min_v
+            if (abs(ths) >= self.target - abs(src) * self.release_delay or abs(src) < min_v
                     or src * self.src_sign <= 0):
                 out["ca" if self.E_dir == 1 else "cb"] = 0
                 if self.E_dir == 1:
@@ -295,15 +299,15 @@ class EnergyPacketController:
                 else:
                     tgt, push = wm, (1 if wm >= 0 else -1)
                 # predict the state at the actual release (after the clutch delay) with the source's speed
-                th_rel = ths + ws * self.clutch_delay
+                th_rel = ths + ws * self.release_delay
                 tt, ok = match_time(self.Omega, th_rel, ws, tgt, -push)
-                self.count = max(0, time_to_samples(tt + self.clutch_delay, self.fs, "floor", "transfer wait")
+                self.count = max(0, time_to_samples(tt + self.release_delay, self.fs, "floor", "transfer wait")
                                  - self.cd)
                 self.i = 0
                 self.state = 4
                 self.log.append({"t": t, "event": "extracted", "theta": ths, "root": ok,
                                  "clutch": "ca" if self.E_dir == 1 else "cb",
-                                 "wait_samples": (tt + self.clutch_delay) * self.fs})
+                                 "wait_samples": (tt + self.release_delay) * self.fs})
                 return out
         if self.state == 4:  # WAIT_ENERGY_TRANSFER
             self.i += 1
@@ -315,7 +319,7 @@ class EnergyPacketController:
                 return out
         if self.state == 5:  # ENERGY_TRANSFER: predictive release
             self.th_peak = max(self.th_peak, abs(ths))
-            if abs(ths) <= abs(ws * self.clutch_delay):
+            if abs(ths) <= abs(ws * self.release_delay):
                 out["cb" if self.E_dir == 1 else "ca"] = 0
                 self.state = 1
                 self.log.append({"t": t, "event": "transferred", "theta_peak": self.th_peak,

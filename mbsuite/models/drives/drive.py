@@ -89,11 +89,15 @@ def _given(p: Mapping[str, Any], key: str, default: float) -> float:
 
 
 def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: Mapping[str, Any], ref=None):
-    """Controller of a drive from resolved parameters. The clutch delay it compensates is the one actually applied:
-    `delay_samples(d_on, fs) / fs` (the command queue quantises the same way)."""
+    """Controller of a drive from resolved parameters. The delays it compensates are the ones actually applied:
+    `delay_samples(d, fs) / fs` (the command queue quantises the same way): step-up clutch matching subtracts the
+    clutch's engagement delay minus the brake's release delay from the loiter time (Sec. 2.1.3: the spring starts
+    when the brake lets go, the clutch acts when it engages); the energy-packet controller waits d_on less before an
+    engagement and predicts each release d_off ahead."""
     fs = float(p["fs"])
     delays = effects.get("clutch_delays", True)
-    cd = delay_samples(p["d_on"], fs) / fs if delays else 0.0
+    cd = delay_samples(p["d_on"], fs) / fs if delays else 0.0  # engagement delay applied
+    rd = delay_samples(p["d_off"], fs) / fs if delays else 0.0  # release delay applied
     closed = bool(effects.get("closed_loop", False))
     anti_windup = bool(effects.get("anti_windup", True))
     if mechanism == "step_up":
@@ -113,7 +117,7 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
         return StepUpController(kind=kind, fs=fs, t_l=p["t_l"], duty=p["duty"], t_n=p["t_n"],
                                 twist_tol=twist_tol, min_vel=p["min_vel"], max_vel=p["max_vel"],
                                 clutch_matching=bool(effects.get("clutch_matching", False)),
-                                Omega=math.sqrt(p["K"] / p["J_s"]), delay_comp=0.0, closed_loop=closed,
+                                Omega=math.sqrt(p["K"] / p["J_s"]), delay_comp=cd - rd, closed_loop=closed,
                                 Kp=p["Kp"], Ki=p["Ki"], ref=p["ref"], max_tk=p["max_tk"], anti_windup=anti_windup)
     if kind != "energy_packet":
         raise SceneError(f"unknown controller {kind!r} for the step-up/step-down drive; valid: ['energy_packet']")
@@ -124,7 +128,7 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
     K_ctrl = _given(p, "K_ctrl", p["K"])
     Om = _given(p, "Omega_ctrl", math.sqrt(p["K"] / p["J_s"]))
     x_max = _given(p, "spring_max", min(p["tau_c1"], p["tau_c2"]) / p["K"])
-    return EnergyPacketController(fs=fs, K=K_ctrl, Omega=Om, clutch_delay=cd, spring_max=x_max,
+    return EnergyPacketController(fs=fs, K=K_ctrl, Omega=Om, clutch_delay=cd, release_delay=rd, spring_max=x_max,
                                   min_motor_vel=_given(p, "min_motor_vel", 70.0),
                                   min_load_vel=_given(p, "min_load_vel", 0.0),
                                   closed_loop=closed, Kp=p["Kp"], Ki=p["Ki"], ref=ref if ref is not None else p["ref"],

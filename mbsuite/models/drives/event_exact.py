@@ -182,7 +182,7 @@ class ReferenceSimulator:
         lam = self._cfg.L[r] @ self.forces(t, y[:n], y[n:2 * n], el)
         if self.one_way[e]:  # a freewheel holds any torque toward w_rel < 0
             return self.capacity(e, el) - lam
-        return self.peaks[e] * el[e] - abs(lam)
+        return self.capacity(e, el) - abs(lam)
 
     def capacity(self, e: int, el: np.ndarray) -> float:
         """Breakaway torque of element e at element levels el (a one-way clutch: peak x level while engaged, its

@@ -112,6 +112,11 @@ def setup(scene: Scene) -> RunSetup:
     ctrl = drive.build_controller(mech, kind, p, eff, ref=ref)
     if mech == "step_up" and callable(ref):
         raise SceneError("the step-up drive takes a constant reference (input.value)")
+    if mech == "step_up" and not eff.get("closed_loop", False) and "value" in scene.input:
+        # open loop the step-up controllers switch on duty x t_l, t_n or the motor speed band: no reference acts
+        raise SceneError(f"input.value = {scene.input['value']!r} rad/s has no effect on the open-loop step-up drive "
+                         f"(controller {kind!r} switches on its duty/timing parameters); leave input.value out, or "
+                         f"set effects.closed_loop = true for the PI on t_k to track it")
     if mech == "step_up" and not callable(ref):
         ctrl.ref = ref
     dt_c = 1.0 / p["fs"]

@@ -323,6 +323,11 @@ class PantographODE:
             )
         th0 = math.asin(s)
         guess = np.array([th0, th0, 0.0]) if self.nq == 3 else np.array([th0, 0.0])
+        if self.cfg.contact == "unilateral":
+            # the guess puts y_d = y_w, on the kink of the clipped force, where fsolve stalls: start from the closed
+            # contact's (smooth) equilibrium, which is this one whenever it pushes the wire (f_s <= 0)
+            closed = PantographODE(p, PantographConfig(**{**self.cfg.__dict__, "contact": "bilateral"}))
+            guess = closed.equilibrium(y_w)[: self.nq]
         q, info, ier, msg = fsolve(lambda q: self.static_residual(q, y_w), guess, xtol=1e-14, full_output=True)
         res = np.max(np.abs(self.static_residual(q, y_w)))
         if ier != 1 and res > 1e-8:

@@ -18,7 +18,7 @@ from ...errors import GeometryError
 from ...paths import mjcf_path, urdf_path
 from .elbow import Elbow
 from .equations import PantographConfig, PantographODE
-from .modelfiles import E_THETA_Q, q_to_theta, theta_to_q
+from .modelfiles import E_THETA_Q, q_to_theta, theta_to_q, urdf_text
 from .params import PantographParams
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -31,14 +31,16 @@ class PinocchioPantograph:
                  source: str = "urdf"):
         self.p = params or PantographParams()
         self.cfg = config or PantographConfig()
-        if source == "urdf":
-            self.model = load_urdf(urdf_path("pantograph"))
-        elif source == "mjcf":
-            self.model = load_mjcf(mjcf_path("pantograph"))
-        else:
+        if source not in ("urdf", "mjcf"):
             raise ValueError(f"source must be 'urdf' or 'mjcf', got {source!r}")
-        if self.p != PantographParams():
-            raise NotImplementedError("the Pinocchio path reads the shipped Table 3-I files; regenerate them first")
+        if self.p != PantographParams():  # the shipped files hold Table 3-I: the URDF of these parameters instead
+            if source != "urdf":
+                raise NotImplementedError("the Pinocchio path reads other parameters from their URDF (source='urdf')")
+            self.model = pin.buildModelFromXML(urdf_text(self.p))
+        elif source == "urdf":
+            self.model = load_urdf(urdf_path("pantograph"))
+        else:
+            self.model = load_mjcf(mjcf_path("pantograph"))
         self.model.gravity.linear[:] = [0.0, 0.0, -(self.p.g if self.cfg.gravity else 0.0)]
         self.data = self.model.createData()
         self.f_contact = frame_id(self.model, "contact_point")
@@ -67,12 +69,13 @@ class PinocchioPantograph:
         """Height y_d of the contact point at joint positions q."""
         return float(self.frame_position(q, self.f_contact)[2])
 
-    def static_generalized_force(self, q: np.ndarray, y_w: float) -> np.ndarray:
-        """Sum of static generalised forces in q (zero at equilibrium), friction-free, cylinder at Pg Ap."""
+    def static_generalized_force(self, q: np.ndarray, y_w: float, closed: bool = False) -> np.ndarray:
+        """Sum of static generalised forces in q (zero at equilibrium), friction-free, cylinder at Pg Ap (`closed`:
+        the contact held closed, bilateral)."""
         p = self.p
         y_d = self.contact_height(q)
         f_s = p.ks * (y_w - y_d)
-        if self.cfg.contact == "unilateral":
+        if self.cfg.contact == "unilateral" and not closed:
             f_s = min(f_s, 0.0)
         Q = -self.gravity(q)
         Q += f_s * self.frame_jacobian(q, self.f_contact)[2]
@@ -93,8 +96,11 @@ class PinocchioPantograph:
         if not 0 < s < 1:
             raise GeometryError(f"operating height {y_w} m is out of the frame's reach")
         t0 = math.asin(s)
-        q, _, ier, msg = fsolve(lambda q: self.static_generalized_force(q, y_w), theta_to_q(np.array([t0, t0, 0.0])),
-                                xtol=1e-14, full_output=True)
+        guess = theta_to_q(np.array([t0, t0, 0.0]))
+        if self.cfg.contact == "unilateral":  # the guess lies on the kink of the clipped force: start closed
+            guess = fsolve(lambda q: self.static_generalized_force(q, y_w, closed=True), guess, xtol=1e-14,
+                           full_output=True)[0]
+        q, _, ier, msg = fsolve(lambda q: self.static_generalized_force(q, y_w), guess, xtol=1e-14, full_output=True)
         for _ in range(6):
             r = self.static_generalized_force(q, y_w)
             h = 1e-7

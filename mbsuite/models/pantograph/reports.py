@@ -18,7 +18,6 @@ from .inputs import config_of, operating_height
 from .linearise import linear_model, modes_from_eigs
 from .modelfiles import q_to_theta
 from .mujoco import MODES_TIMESTEP, MujocoPantograph, mujoco_modes
-from .params import PantographParams
 
 
 def equilibrium_all_paths(scene: Scene) -> dict:
@@ -33,7 +32,7 @@ def equilibrium_all_paths(scene: Scene) -> dict:
     out = {"reference": th_ref}
     mp = MujocoPantograph(p, cfg, scene.solver.integrator, scene.solver.timestep)
     out["mujoco"] = q_to_theta(mp.equilibrium())
-    if cfg.elbow == "compliant" and p == PantographParams():
+    if cfg.elbow == "compliant":
         out["pinocchio"] = q_to_theta(PinocchioPantograph(p, cfg).equilibrium())
     return out
 

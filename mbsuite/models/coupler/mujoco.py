@@ -71,6 +71,10 @@ def mjspec_variant(p: CouplerParams, kind: str, base: str | Path | None = None):
         spec.joint(f"{name}_ball").damping = [p.joint_damping, 0.0, 0.0]
 
     set_sites("A")
+    # the shafts' axial inertias (the generator's inertial: mass 1, diag(I/2, I, I/2) about the shaft axis y)
+    out_body = "platform_b" if kind == "single" else "shaft_c"
+    for body, i_axial in (("shaft_a", p.i_shaft_a), (out_body, p.i_shaft_c)):
+        spec.body(body).inertia = [i_axial / 2, i_axial, i_axial / 2]
     driven = "B" if kind == "single" else "BA"
     set_sites(driven)
     eB = pts[driven] + np.array([0.0, p.e_y, 0.0])

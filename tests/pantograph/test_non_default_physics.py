@@ -248,25 +248,33 @@ def _inputs_scene(inp: dict):
 
 @pytest.mark.parametrize("inp", [
     {"type": "step", "height": -3e-3, "t_step": 0.05},
+    {"type": "step", "height": 2e-3, "t_step": 0.2, "initial": "fortran"},
     {"type": "sine", "initial": "fortran", "frequency": 3.0, "amplitude": 2.5e-3},
-], ids=["step", "fortran"])
+    {"type": "static", "initial": "fortran"},
+], ids=["step", "step-fortran", "sine-fortran", "static-fortran"])
 def test_step_and_fortran_start_mujoco_equals_reference(inp):
-    """A step of the ram (-3 mm at 0.05 s; defaults 1 mm, 0.1 s) and the thesis' FORTRAN start (erratum 18: theta_1 =
-    theta_2 = asin((y_op + A) / 2 l1), theta_h = 0, not an equilibrium; A = 2.5 mm, 3 Hz), Coulomb off, 0.5 s: the
-    ram is the scene's (closed form), and MuJoCo (RK4 1 ms) follows the reference path (LSODA rtol 1e-8) to 1e-4 of
-    each signal's excursion (measured: step 1.7e-5, FORTRAN 2.0e-5; 5-6x)."""
+    """A step of the ram (-3 mm at 0.05 s, 2 mm at 0.2 s; defaults 1 mm, 0.1 s) and the thesis' FORTRAN start
+    (erratum 18: theta_1 = theta_2 = asin((y_op + A) / 2 l1) with A the amplitude or step height, theta_h = 0, not an
+    equilibrium) for each input type, Coulomb off, 0.5 s: the ram is the scene's (closed form), and MuJoCo (RK4 1 ms)
+    follows the reference path (LSODA rtol 1e-8) to 1e-4 of each signal's excursion (measured: step 1.7e-5, FORTRAN
+    starts <= 2.0e-5; 5x)."""
     sc = _inputs_scene(inp)
     a, b = run(sc), run(sc.replace(solver={"engine": "reference"}))
     assert np.array_equal(a.t, b.t)
     y_op = sc.build_params().y_op
+    A = inp.get("amplitude", inp.get("height", 0.0))
     if inp["type"] == "step":
         ram = y_op + np.where(a.t >= inp["t_step"], inp["height"], 0.0)
+    elif inp["type"] == "sine":
+        ram = y_op + A * (1.0 - np.cos(2.0 * math.pi * inp["frequency"] * a.t))
+    else:
+        ram = np.full(a.t.size, y_op)
+    if inp.get("initial") == "fortran":
+        t1 = math.asin((y_op + A) / (2.0 * sc.build_params().l1))
+        assert b["theta1"][0] == pytest.approx(t1, abs=1e-15) and b["thetah"][0] == 0.0
+    else:
         before = a.t < inp["t_step"]
         assert np.max(np.abs(b["contact_force"][before] - b["contact_force"][0])) < 1e-6  # at rest until the step
-    else:
-        ram = y_op + inp["amplitude"] * (1.0 - np.cos(2.0 * math.pi * inp["frequency"] * a.t))
-        t1 = math.asin((y_op + inp["amplitude"]) / (2.0 * sc.build_params().l1))
-        assert b["theta1"][0] == pytest.approx(t1, abs=1e-15) and b["thetah"][0] == 0.0
     assert np.max(np.abs(a["y_w"] - ram)) < 1e-15 and np.max(np.abs(b["y_w"] - ram)) < 1e-15
     for s in ("F1", "HD", "y_d", "contact_force"):
         assert np.max(np.abs(a[s] - b[s])) < 1e-4 * np.ptp(b[s]), s

@@ -56,11 +56,12 @@ def test_default_band_converged_at_supply_pressure_start(scene):
 
 @pytest.mark.slow
 def test_default_band_converged_over_the_whole_sweep(scene):
-    """Every frequency of 1-30 Hz (0.5 Hz grid), the scene's 10 s runs (measured: <= 1.2e-4 in amplitude, 4e-5 rad in
-    phase); and the next wider band, 1e-4, fails the same criterion (0.35 % at 1 Hz): the default is the widest
-    converged band of the decades tried."""
+    """Every frequency of 1-30 Hz (0.5 Hz grid), the scene's 10 s runs: the default band against a 10x narrower one
+    (measured: <= 1.2e-4 in amplitude, 4.2e-5 rad in phase, both at 1 Hz; bounds 5e-4 and 2e-4, 4.2x and 4.8x); and
+    the next wider band, 1e-4, fails the criterion 1e-3 (0.35 % at 1 Hz): the default is the widest converged band
+    of the decades tried."""
     freqs = np.round(np.arange(1.0, 30.25, 0.5), 10)
     pts = orifice_band.sweep(scene, [10.0 * WIDTH, WIDTH, WIDTH / 10.0], freqs)
     for f, (amp, ph) in zip(freqs, _worst(pts, WIDTH, WIDTH / 10.0, freqs), strict=True):
-        assert amp < orifice_band.TOLERANCE and ph < orifice_band.TOLERANCE, f
+        assert amp < 5e-4 and ph < 2e-4, f
     assert max(a for a, _ in _worst(pts, 10.0 * WIDTH, WIDTH, freqs)) > 2.0 * orifice_band.TOLERANCE

@@ -19,7 +19,7 @@ from mbsuite.models.coupler.single import ramp_single
 from mbsuite.paths import mjcf_path, urdf_path
 
 VARIANT = CouplerParams(gamma=0.11, e_y=0.2, l_b=3.0, phi_bc=math.pi / 2, R=1.3, i_shaft_a=7.0, i_shaft_c=45.0,
-                        m_link=3.0)
+                        m_link=3.0, link_radius=0.03, m_shaft_b=100.0, i_shaft_b_axial=25.0, i_shaft_b_trans=45.0)
 KINDS = ["single", "double"]
 
 FIELDS = ("body_pos", "body_quat", "body_ipos", "body_iquat", "body_mass", "body_inertia", "body_parentid",

@@ -72,3 +72,26 @@ def test_contact_loss_events_counted_by_hand():
     assert [e["x_start"] for e in ev] == pytest.approx([45.0, 55.0, 70.0], abs=1e-9)
     assert s["loss_counts"] == {"short_lt_5ms": 1, "damaging_5_20ms": 1, "power_loss_gt_20ms": 1}
     assert s["loss_pct"] == pytest.approx(100 * 40 / 801, rel=1e-12)
+
+
+def test_uplift_charged_to_a_pantograph_of_a_train_only_near_the_arm():
+    """On a train each pantograph is charged with a steady arm's uplift only while it is within 30 m of it (the model
+    README): a constructed record where the arm at 50 m is lifted 80 mm while this pantograph is at 10 m (another
+    pantograph passing it) and 40 mm when this one passes; the arm at 75 m 60 mm while it is at 20 m and 30 mm when it
+    passes. Charged: 40 and 30 mm (measured exact; bound 1e-12 mm); alone, the whole record counts (80 and 60 mm)."""
+    from mbsuite.models.catenary.passage import CoupledResult
+    from mbsuite.models.catenary.train import _statistics
+
+    def bump(xc: float, a: float) -> np.ndarray:
+        return a * np.exp(-(((X - xc) / 3.0) ** 2))
+
+    up = np.zeros((T.size, SUPPORTS.size))
+    up[:, 2] = bump(10.0, 0.08) + bump(50.0, 0.04)
+    up[:, 3] = bump(20.0, 0.06) + bump(75.0, 0.03)
+    res = CoupledResult(t=T, x=X, force=np.full(T.size, 100.0), head=np.zeros(T.size), wire=np.zeros(T.size),
+                        uplift=up, n_slack=np.zeros(T.size, dtype=np.int32), panto={}, support_x=SUPPORTS)
+    train, _ = _statistics(res, DT, P, alone=False)
+    assert train["uplift_at_supports_mm"] == pytest.approx({"50": 40.0, "75": 30.0}, abs=1e-12)
+    assert train["uplift_mm"] == pytest.approx(40.0, abs=1e-12)
+    single, _ = _statistics(res, DT, P, alone=True)
+    assert single["uplift_at_supports_mm"] == pytest.approx({"50": 80.0, "75": 60.0}, abs=1e-12)

@@ -45,11 +45,6 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    u = lhat @ R_P.T",
              "the link direction turned into the platform frame by the inverse rotation: wrong beta angles, c3 and "
              "c4", _C),
-    Mutation("coupler_periodic_mean_counts_closing_sample", "mbsuite/models/coupler/criteria.py",
-             "    return float(v[:-1].mean())",
-             "    return float(v.mean())",
-             "the mean over a revolution counts the closing sample twice (off by one): c1 and c5 measured about a "
-             "biased mean", _C),
     Mutation("coupler_c5_sampled_not_refined", "mbsuite/models/coupler/criteria.py",
              "return {\"c5\": fl[\"c\"],",
              "return {\"c5\": fl[\"c_sampled\"],",

@@ -76,7 +76,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation("drives_loiter_eq_2_1_denominator", "mbsuite/models/drives/controllers.py",
              "    d = w_l - 2.0 * w_m", "    d = w_l - w_m",
              "Eq 2.1's half-angle quadratic with w_l - w_m for w_l - 2 w_m (the clutch loiter time wrong)",
-             "tests/drives/test_controllers.py"),
+             "tests/drives/test_drives.py"),
     Mutation("drives_design_sr_printed_eq_5_13", "mbsuite/models/drives/design.py",
              "    b = 2 * V_m * math.sqrt(K * J_s) * A + 2 * P", "    b = V_m * math.sqrt(K * J_s) * A + 2 * P",
              "the maximum switching rate from the printed Eq 5.13 (factor 2 missing: Sr 13 % high)",

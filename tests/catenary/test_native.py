@@ -86,11 +86,11 @@ def test_native_core_reports_a_diverging_state():
 @pytest.mark.slow
 @pytest.mark.parametrize("speed", [250.0, 300.0])
 def test_reference_scene_statistics_unchanged(speed):
-    """The shipped EN 50318 setting: the core's eight statistics equal the Python path's within 1e-8 N / 1e-8 mm
-    (measured <= 1e-11: the same scheme to rounding; 1000x). Its cost is measured by
-    `scripts/catenary_benchmark.py`, not asserted here."""
+    """The shipped EN 50318 setting: the core's eight statistics equal the Python path's, the same scheme to
+    rounding: measured <= 7.6e-11 N (the actual max at 300 km/h; Fm and sigma <= 4.3e-12 N) and 1.7e-11 mm of
+    uplift; bound 7.5e-10 N / mm (10x). Its cost is measured by `scripts/catenary_benchmark.py`, not asserted here."""
     p = CatenaryParams(element_length=0.5)
     py = simulate(p, speed, 2e-4, native=False)
     nat = simulate(p, speed, 2e-4)
     for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct"):
-        assert abs(nat.stats[k] - py.stats[k]) < 1e-8, k
+        assert abs(nat.stats[k] - py.stats[k]) < 7.5e-10, k

@@ -196,10 +196,10 @@ def test_elbow_damper_dissipates_at_its_rate():
 @pytest.mark.parametrize("yf", [0.142, 0.2])
 def test_unilateral_equilibrium_exists_where_the_contact_is_closed(yf):
     """Scene pantograph/unilateral at yf = 0.142 and 0.2 m (0.17 default): the bilateral equilibrium pushes the wire
-    (contact force ks (y_d - y_w) = 126 N and 56 N > 0), so it is the push-only contact's equilibrium too. Formerly
-    fsolve started on the kink of the clipped force (guess y_d = y_w) and failed; now found, with a zero static
-    residual, equal to the bilateral one and to MuJoCo's and Pinocchio's own solutions (measured <= 7.3e-16 rad;
-    bound 1e-10)."""
+    (contact force ks (y_d - y_w) = 126 N and 56 N > 0), so it is the push-only contact's equilibrium too (fsolve
+    started at the geometric guess y_d = y_w, on the kink of the clipped force, stalls: the search starts from the
+    closed contact's equilibrium). Found with a zero static residual, equal to the bilateral one and to MuJoCo's and
+    Pinocchio's own solutions (measured <= 7.3e-16 rad; bound 1e-10)."""
     q = PantographParams(yf=yf)
     uni = PantographODE(q, PantographConfig(contact="unilateral"))
     bil = PantographODE(q, PantographConfig(contact="bilateral"))

@@ -47,7 +47,7 @@ MUTATIONS: tuple[Mutation, ...] = (
              "the knuckle joint's Coulomb friction read from the head's (c2 = ch = 0.45 N m in Table 3-I)",
              NON_DEFAULT),
     Mutation("pantograph_orifice_never_choked", EQ,
-             "r = max(r, CHOKED_RATIO)", "r = max(r, 0.0)",
+             "r = max(r, self.r_crit)", "r = max(r, 0.0)",
              "the orifice flow below the critical pressure ratio follows the subsonic law (falls) instead of choking",
              NON_DEFAULT),
     Mutation("pantograph_smooth_coulomb_scale_inverted", EQ,

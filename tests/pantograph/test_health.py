@@ -41,6 +41,9 @@ def test_cross_field_checks_remain():
         PantographParams(d2=2.5)
     with pytest.raises(ParameterError, match="y_op = 4.4 m cannot be reached"):
         PantographParams(y_op=4.4)
+    # the laminar band must lie in subsonic flow: above the critical ratio (2/2.1)^11 = 0.584679 of gamma = 1.1
+    with pytest.raises(ParameterError, match=r"r_laminar = 0.56 must exceed the critical pressure ratio 0.584679 of"):
+        PantographParams(gamma=1.1, r_laminar=0.56)
 
 
 def test_input_defaults_are_part_of_the_scene():

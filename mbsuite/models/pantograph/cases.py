@@ -76,12 +76,14 @@ def _pantograph_orifice_choked(ck: Checker) -> None:
             ode.orifice_mass_flow(0.9 * p.Ps) > 0 > ode.orifice_mass_flow(1.1 * p.Ps)
             and ode.orifice_mass_flow(p.Ps) == 0.0)
     choked = [ode.orifice_mass_flow(r * p.Ps) for r in (0.1, 0.2, 0.3, 0.5)]
-    ck.le("choked plateau: flow independent of Pd/Pu < 0.528 (relative spread)", np.ptp(choked) / choked[0], 1e-12)
-    r = 0.528  # corrected Eq 3.17 at the choke ratio, in closed form (sqrt(T), erratum 10)
+    ck.le("choked plateau: flow independent of Pd/Pu below the critical ratio (relative spread)",
+          np.ptp(choked) / choked[0], 1e-12)
+    r = (2 / (p.gamma + 1)) ** (p.gamma / (p.gamma - 1))  # critical ratio, 0.52828 (the thesis' 0.528)
+    # corrected Eq 3.17 at the critical ratio, in closed form (sqrt(T), erratum 10)
     expect = p.cd * p.Ao * math.sqrt(2 * p.gamma / (p.R_gas * (p.gamma - 1))) * p.Ps / math.sqrt(p.T) \
         * r ** (1 / p.gamma) * math.sqrt(1 - r ** ((p.gamma - 1) / p.gamma))
-    ck.le("choked flow vs corrected Eq 3.17 at r = 0.528, relative", abs(choked[0] / expect - 1), 1e-12)
-    ck.le("continuity at the choke ratio 0.528 (relative jump)",
+    ck.le("choked flow vs corrected Eq 3.17 at the critical ratio, relative", abs(choked[0] / expect - 1), 1e-12)
+    ck.le("continuity at the critical ratio (relative jump)",
           abs(ode.orifice_mass_flow(r * p.Ps * (1 - 1e-9)) / ode.orifice_mass_flow(r * p.Ps * (1 + 1e-9)) - 1),
           1e-6)
     edge = p.r_laminar * p.Ps
@@ -275,10 +277,10 @@ HARD_CASES: tuple[HardCase, ...] = (
              "no NaN; reference RHS calls <= 2e4; no MuJoCo warning; MuJoCo vs reference F1, HD, P within 0.3 % "
              "and 0.5 deg; P oscillates about Ps (mean within 0.1 swing)", _pantograph_orifice_dp0),
     HardCase("pantograph_orifice_choked", "pantograph",
-             "choked flow below Pd/Pu = 0.528 and the laminar band: branch switches of the orifice law",
+             "choked flow below the critical Pd/Pu = 0.528 and the laminar band: branch switches of the orifice law",
              "PantographODE(cylinder='nonlinear').orifice_mass_flow over 0.05-1.5 Ps",
              "finite flow and slope; flow sign; choked plateau flat to 1e-12 and equal to corrected Eq 3.17; "
-             "continuous at 0.528 and the band edge",
+             "continuous at the critical ratio and the band edge",
              _pantograph_orifice_choked),
     HardCase("pantograph_unilateral_contact", "pantograph",
              "push-only contact: non-smooth force, repeated contact loss and impact",

@@ -31,7 +31,7 @@ from scipy.optimize import fsolve
 
 from ...errors import GeometryError, SceneError, SolverError
 from .elbow import Elbow
-from .params import CHOKED_RATIO, PantographParams  # CHOKED_RATIO: critical pressure ratio of Eq 3.17
+from .params import PantographParams, critical_ratio
 
 G_JOINTS = np.array([[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 1.0]])  # joint rates w = G theta' (A.15)
 JOINT_NAMES = ("base", "knuckle", "head")
@@ -87,6 +87,7 @@ class PantographODE:
         self.g = p.g if self.cfg.gravity else 0.0
         self.b = np.array([p.b1, p.b2, p.bh]) if self.cfg.viscous else np.zeros(3)
         self.c = np.array([p.c1, p.c2, p.ch]) if self.cfg.coulomb else np.zeros(3)
+        self.r_crit = critical_ratio(p.gamma)  # choking pressure ratio (Eq 3.17: 0.528 for gamma = 1.4)
         self.gas = p.cd * p.Ao * math.sqrt(2.0 * p.gamma / (p.R_gas * (p.gamma - 1.0))) / math.sqrt(p.T)
 
     # ---------------------------------------------------------------- kinematics
@@ -168,7 +169,8 @@ class PantographODE:
 
     def orifice_mass_flow(self, P: float) -> float:
         """Mass flow into the cylinder (kg/s), 3.17 corrected: sign(Ps - P) (erratum 12), Pu/sqrt(T) (erratum 10),
-        exponent (gamma-1)/gamma (erratum 14), choked below Pd/Pu = 0.528, linear in dp for Pd/Pu > r_laminar."""
+        exponent (gamma-1)/gamma (erratum 14), choked below the critical ratio (2/(gamma+1))^(gamma/(gamma-1))
+        (the thesis' 0.528 for gamma = 1.4), linear in dp for Pd/Pu > r_laminar."""
         p = self.p
         Ps = p.Ps
         Pu, Pd = (Ps, P) if P <= Ps else (P, Ps)
@@ -183,7 +185,7 @@ class PantographODE:
             rl = p.r_laminar
             m_l = self.gas * Pu_l * rl ** (1.0 / p.gamma) * math.sqrt(1.0 - rl ** ((p.gamma - 1.0) / p.gamma))
             return m_l * (Ps - P) / dp_l
-        r = max(r, CHOKED_RATIO)
+        r = max(r, self.r_crit)
         return sgn * self.gas * Pu * r ** (1.0 / p.gamma) * math.sqrt(1.0 - r ** ((p.gamma - 1.0) / p.gamma))
 
     def cylinder_rate(self, t1: float, t1d: float, P: float) -> float:

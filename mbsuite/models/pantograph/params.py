@@ -13,10 +13,16 @@ from dataclasses import dataclass
 from ...errors import ParameterError
 from ...limits import check_fields, param
 
-#: critical pressure ratio (2/(gamma+1))^(gamma/(gamma-1)) for gamma = 1.4, as in Eq 3.17
+#: the thesis' critical pressure ratio of Eq 3.17 (air, gamma = 1.4); the declared lower end of r_laminar. The orifice
+#: law chokes at `critical_ratio(gamma)` (0.52828 for gamma = 1.4)
 CHOKED_RATIO = 0.528
 #: default laminar band of the orifice: Pd/Pu > R_LAMINAR (band 1e-5), from the convergence study in the README
 R_LAMINAR = 0.99999
+
+
+def critical_ratio(gamma: float) -> float:
+    """Critical (choking) pressure ratio Pd/Pu = (2 / (gamma + 1))^(gamma / (gamma - 1)) of an isentropic nozzle."""
+    return (2.0 / (gamma + 1.0)) ** (gamma / (gamma - 1.0))
 
 
 def _pos(default: float, unit: str, doc: str, hi: float | None = None) -> float:
@@ -86,6 +92,11 @@ class PantographParams:
         for name, dist, length in (("d1", self.d1, self.l1), ("d2", self.d2, self.l2), ("dh", self.dh, self.lh)):
             if dist > length:
                 raise ParameterError(f"pantograph parameter {name} = {dist} lies beyond its link (length {length})")
+        if self.r_laminar <= critical_ratio(self.gamma):
+            raise ParameterError(
+                f"pantograph parameter r_laminar = {self.r_laminar} must exceed the critical pressure ratio "
+                f"{critical_ratio(self.gamma):.6g} of gamma = {self.gamma} (the laminar band lies in subsonic flow)"
+            )
         if self.y_op >= self.l1 + self.l2 + self.lh:
             raise ParameterError(
                 f"operating height y_op = {self.y_op} m cannot be reached: the linkage reaches at most "

@@ -8,7 +8,8 @@
  *                     force = (P - Pa) Ap                                                          (P in Pa)
  *   The actuator acts on the base joint (theta_1 = its length): x_p = lb cos(alpha - theta_1) (3.19, erratum 13),
  *   x_p' = lb sin(alpha - theta_1) theta_1', and its actuator force is the torque F lb sin(alpha - theta_1).
- *   mdot (3.17 corrected): choked below Pd/Pu = 0.528, linear in (Ps - P) for Pd/Pu > r_laminar.
+ *   mdot (3.17 corrected): choked below the critical ratio (2/(gamma+1))^(gamma/(gamma-1)) (0.528 for gamma = 1.4),
+ *   linear in (Ps - P) for Pd/Pu > r_laminar.
  * mbsuite.pantograph.elbow (passive plugin): the elbow spring of Eq 3.13 with the pinion angle theta_e(theta_1) of
  *   App. B (B.3-B.6, or the exact chain wrap), mapped onto the joints q1 = theta_1, q2 = pi - theta_1 - theta_2:
  *   Te = ke (theta_e - theta_2) + be (theta_e' - theta_2'),  qfrc_passive += -(Te (dte/dt1 + 1), Te).
@@ -19,7 +20,6 @@
 
 #include "mbsuite.h"
 
-#define CHOKED_RATIO 0.528
 #define ELBOW_NO_TANGENT "elbow chain has no tangent line to the pinion at this theta_1 (B^2 - 4AC)"
 
 /* ------------------------------------------------------------------------------------------------ cylinder */
@@ -31,7 +31,7 @@ typedef struct {
   int nonlinear;
   int actuator;
   double lb, alpha, kc, bc, Pg, Pa, Ap, V0, R, T, gamma, cd, Ao, r_lam;
-  double Ps, gas, m_lam, dp_lam;
+  double Ps, gas, m_lam, dp_lam, r_crit;
 } Cylinder;
 
 static int cyl_nstate(const mjModel* m, int instance) { return 0; }
@@ -71,7 +71,8 @@ static int cyl_init(const mjModel* m, mjData* d, int instance) {
   mbs_config_require(h, c->gamma > 1 && c->gamma < 2, "gamma", c->gamma);
   mbs_config_require(h, c->cd > 0 && c->cd <= 1, "cd", c->cd);
   mbs_config_require(h, c->Ao > 0, "Ao", c->Ao);
-  mbs_config_require(h, c->r_lam > CHOKED_RATIO && c->r_lam < 1, "r_laminar", c->r_lam);
+  c->r_crit = pow(2.0 / (c->gamma + 1.0), c->gamma / (c->gamma - 1.0));
+  mbs_config_require(h, c->r_lam > c->r_crit && c->r_lam < 1, "r_laminar", c->r_lam);
   c->actuator = -1;
   for (int i = 0; i < m->nu; i++) {
     if (m->actuator_plugin[i] == instance) c->actuator = i;
@@ -129,7 +130,7 @@ static double orifice_mass_flow(const Cylinder* c, double P) {
   double r = Pd / Pu;
   if (r > c->r_lam) return c->m_lam * (Ps - P) / c->dp_lam;
   double sgn = P <= Ps ? 1.0 : -1.0;
-  if (r < CHOKED_RATIO) r = CHOKED_RATIO;
+  if (r < c->r_crit) r = c->r_crit;
   return sgn * c->gas * Pu * pow(r, 1.0 / c->gamma) * sqrt(1.0 - pow(r, (c->gamma - 1.0) / c->gamma));
 }
 

@@ -24,14 +24,14 @@ def test_shipped_scenes_power_balance(name):
     """Power balance over the settled revolution (0.5-1 s at 2 rev/s): T_in w_a = T_load w_c + losses, with w_c = w_a
     on average. Without friction the only losses are the S joints' viscous damping and the closures' damping: mean
     T_in = T_load, measured |error| <= 7.0e-6 T_load (bound 7x). With friction the output bearing dissipates exactly
-    joint_friction x w_c, so T_in - T_load >= joint_friction; the S joints add 4.3 % of it (measured 2.087 N m for
-    2 N m; bound 10 %, 2.5x)."""
+    joint_friction x w_c, so T_in - T_load >= joint_friction; the S joints add 14 % of it (measured 2.280 N m for
+    2 N m, their dry-friction power: test_dissipation.py; bound 20 %)."""
     sc = load_scene(f"coupler/{name}").replace(solver={"duration": 1.0})
     res = mbsuite.run(sc)
     load, excess = sc.input["load_torque"], res.stats["torque_in_mean"] - sc.input["load_torque"]
     if sc.effects["friction"]:
         f = sc.build_params().joint_friction
-        assert f <= excess <= 1.1 * f
+        assert f <= excess <= 1.2 * f
     else:
         assert abs(excess) <= 5e-5 * load
 
@@ -116,16 +116,17 @@ def test_shaft_inertias_on_both_paths():
 
     Output shaft, i_shaft_c = 90 kg m^2 (3x), phi_bc = pi/2 (its speed fluctuates twice per revolution), shaft b
     heavier (m_shaft_b = 120 kg, inertias 30 / 60 kg m^2), omega = 3 pi rad/s, load 1.5 kN m, light links, no
-    gravity: the MuJoCo input torque follows the rigid reference's power balance within 5 % of its ripple + 0.2 N m
-    (measured 0.82 of 3.48 N m allowed, ripple 65.7 N m; the reference with i_shaft_c at the file's 30 differs by
-    18.7 N m).
-    Input shaft: raising i_shaft_a by 30 kg m^2 adds 30 alpha_a(t) to the torque during the start-up ramp on both paths
-    (MuJoCo: the difference of two runs, so the servo's lag and its implicit damping, which records kv h alpha_a more
-    than it applies, cancel): measured 89.9 N m of a 2262 N m peak; bound 10 % of the peak (2.5x)."""
+    gravity, a velocity servo half as stiff (kv_drive = 1e5): the MuJoCo input torque follows the rigid reference's
+    power balance within 5 % of its ripple + 0.2 N m (measured 1.19 of 3.48 N m allowed, 2.9x, ripple 65.7 N m; 0.82
+    at the default kv; the reference with i_shaft_c at the file's 30 differs by 18.7 N m).
+    Input shaft, start-up ramp t_ramp = 0.2 s (non-default): raising i_shaft_a by 30 kg m^2 adds 30 alpha_a(t) to the
+    torque during the ramp on both paths, alpha_a = omega s'(t) in closed form (MuJoCo: the difference of two runs,
+    so the servo's lag and its implicit damping, which records kv h alpha_a more than it applies, cancel): measured
+    139.8 N m of a 2827 N m peak (MuJoCo), 28.1 (reference); bound 10 % of the peak (2x)."""
     sc = load_scene("coupler/double_phibc90").replace(
         effects={"link_inertia": "massless"},
         params={"massless_factor": 0.05, "solref_timeconst": 1e-3, "i_shaft_c": 90.0, "m_shaft_b": 120.0,
-                "i_shaft_b_axial": 30.0, "i_shaft_b_trans": 60.0},
+                "i_shaft_b_axial": 30.0, "i_shaft_b_trans": 60.0, "kv_drive": 1e5},
         input={"omega": 3 * math.pi, "load_torque": 1500.0}, solver={"duration": 1.0})
     rm, rr = mbsuite.run(sc), mbsuite.run(sc, engine="reference")
     w = rm.t >= 0.5
@@ -135,7 +136,7 @@ def test_shaft_inertias_on_both_paths():
     base = load_scene("coupler/double_lateral").replace(
         effects={"link_inertia": "massless", "gravity": False}, params={"massless_factor": 0.05,
                                                                         "solref_timeconst": 1e-3},
-        solver={"duration": 0.3, "t_settle": 0.25})
+        input={"t_ramp": 0.2}, solver={"duration": 0.3, "t_settle": 0.25})
     runs = {(eng, ia): mbsuite.run(base.replace(params={"i_shaft_a": ia}), engine=eng)
             for eng in ("mujoco", "reference") for ia in (10.0, 40.0)}
     t = runs["mujoco", 10.0].t

@@ -137,6 +137,10 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
         b.inertia = [it, it, ia]
         j = spec.joint(f"link{k + 1}_ball")
         j.frictionloss = p.joint_friction if effects["friction"] else 0.0
+        # MuJoCo's friction is a soft constraint: below a slip speed set by solreffriction (default 20 ms) it acts as
+        # a viscous drag, and the S joints' swing rates (~0.3 rad/s) stay below it; at the stiffest time constant
+        # MuJoCo allows (2 timesteps) the S joints dissipate the dry-friction power (tests/coupler/test_dissipation.py)
+        j.solref_friction = [2.0 * timestep, 1.0]
     # shaft c: only y_c (base y) and phi_c remain; its body sits at the imposed misalignment
     for name in ("x_c", "z_c", "alpha_cz", "alpha_cx"):
         spec.delete(spec.joint(name))
@@ -147,6 +151,7 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
     bc.quat = [w, (Rc[2, 1] - Rc[1, 2]) / (4 * w), (Rc[0, 2] - Rc[2, 0]) / (4 * w), (Rc[1, 0] - Rc[0, 1]) / (4 * w)]
     spec.joint("y_c").axis = Rc.T @ np.array([0.0, 1.0, 0.0])
     spec.joint("phi_c").frictionloss = p.joint_friction if effects["friction"] else 0.0
+    spec.joint("phi_c").solref_friction = [2.0 * timestep, 1.0]
     spec.option.gravity = [0.0, 0.0, -9.81] if effects["gravity"] else [0.0, 0.0, 0.0]
     act = spec.add_actuator()
     act.name = "drive"

@@ -5,6 +5,7 @@ from mutations.mutation import Mutation
 _K = "tests/coupler/test_kinematics.py"
 _C = "tests/coupler/test_criteria_independent.py"
 _D = "tests/coupler/test_dynamics.py"
+_L = "tests/coupler/test_dissipation.py"
 
 MUTATIONS: tuple[Mutation, ...] = (
     Mutation("coupler_jacobian_row_swapped", "mbsuite/models/coupler/jacobian.py",
@@ -45,6 +46,11 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    u = lhat @ R_P.T",
              "the link direction turned into the platform frame by the inverse rotation: wrong beta angles, c3 and "
              "c4", _C),
+    Mutation("coupler_periodic_mean_counts_closing_sample", "mbsuite/models/coupler/criteria.py",
+             "    return float(v[:-1].mean())",
+             "    return float(v.mean())",
+             "the mean over a revolution counts the closing sample twice (off by one): c1 and c5 measured about a "
+             "biased mean", _C),
     Mutation("coupler_c5_sampled_not_refined", "mbsuite/models/coupler/criteria.py",
              "return {\"c5\": fl[\"c\"],",
              "return {\"c5\": fl[\"c_sampled\"],",
@@ -70,4 +76,27 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    energy = shaft_b_energy_batch(p, U, rates) + 0.5 * p.i_shaft_c * rates[:, 0] ** 2",
              "    energy = shaft_b_energy_batch(p, U, rates)",
              "the reference path's kinetic energy without the output shaft (I_c omega_c^2/2 dropped)", _D),
+    Mutation("coupler_s_joint_damping_ignored", "mbsuite/models/coupler/mujoco.py",
+             "spec.joint(f\"{name}_ball\").damping = [p.joint_damping, 0.0, 0.0]",
+             "spec.joint(f\"{name}_ball\").damping = [0.0, 0.0, 0.0]",
+             "the S joints' viscous damping joint_damping never written into the MuJoCo model (its dissipation "
+             "missing)", _L),
+    Mutation("coupler_s_joint_friction_dropped", "mbsuite/models/coupler/mujoco.py",
+             "        j.frictionloss = p.joint_friction if effects[\"friction\"] else 0.0",
+             "        j.frictionloss = 0.0",
+             "the S joints' dry friction left out of the MuJoCo coupler (only the output bearing dissipates)", _L),
+    Mutation("coupler_s_joint_friction_default_regularisation", "mbsuite/models/coupler/mujoco.py",
+             "        j.solref_friction = [2.0 * timestep, 1.0]",
+             "        j.solref_friction = [0.02, 1.0]",
+             "the S joints' friction at MuJoCo's default 20 ms regularisation: a viscous drag below the slip speed, "
+             "dissipating a third of the dry-friction power", _L),
+    Mutation("coupler_closure_dampratio_ignored", "mbsuite/models/coupler/mujoco.py",
+             "        m.eq_solref[e] = [p.solref_timeconst, p.solref_dampratio]",
+             "        m.eq_solref[e] = [p.solref_timeconst, 1.0]",
+             "the closures' damping ratio solref_dampratio ignored (closure stiffness and wind-up as at zeta = 1)",
+             _L),
+    Mutation("coupler_mujoco_ramp_ignores_t_ramp", "mbsuite/models/coupler/mujoco.py",
+             "    s = ramp(np.arange(nstep) * timestep, inp[\"t_ramp\"])",
+             "    s = ramp(np.arange(nstep) * timestep, 0.25)",
+             "the MuJoCo path's start-up ramp of speed and load at the default 0.25 s whatever t_ramp says", _D),
 )

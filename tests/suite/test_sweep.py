@@ -88,15 +88,28 @@ def test_pantograph_frequency_sweep_threads_and_rollout_identical_to_one_thread(
 
 
 def test_dask_localcluster_identical_to_local(tmp_path):
+    """The cluster's results equal the local pool's; with a store the cluster's workers (other processes) compute
+    each point once, counted in a file each computation appends to, and a resumed sweep computes none."""
     distributed = pytest.importorskip("distributed")
     jobs = _jobs()
     local = run_sweep(scene_point, jobs, workers=2)
+    calls, freqs = tmp_path / "calls.txt", sorted(job[1]["input"]["frequency"] for job in jobs)
+    path = str(calls)
+
+    def logged(job):
+        """`_logged_scene_point` as a closure naming nothing of this module: Dask ships it by value (cloudpickle),
+        as the workers cannot import the tests."""
+        with open(path, "a") as fh:
+            fh.write(f"{job[1]['input']['frequency']}\n")
+        return scene_point(job)
+
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                                   local_directory=str(tmp_path)) as cluster:
         store = tmp_path / "dask.jsonl"  # a store works with the cluster too: claims, results, resume
-        via_addr = run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address, store=store)
-        assert run_sweep(scene_point, jobs, executor="dask", scheduler=cluster.scheduler_address,
-                         store=store) == via_addr
+        via_addr = run_sweep(logged, jobs, executor="dask", scheduler=cluster.scheduler_address, store=store)
+        assert _computed(calls) == freqs  # each point computed once, by the workers
+        assert run_sweep(logged, jobs, executor="dask", scheduler=cluster.scheduler_address, store=store) == via_addr
+        assert _computed(calls) == freqs  # the resumed sweep: every result from the store
         cli_options = SweepOptions(executor="dask", scheduler=cluster.scheduler_address)
         via_default = run_sweep(scene_point, jobs, options=cli_options)  # how the CLI's --executor dask reaches hooks
     assert via_addr == local

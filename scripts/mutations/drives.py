@@ -98,7 +98,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation("drives_ground_damper_replaces_bearing", "mbsuite/models/drives/mujoco.py",
              "                m.dof_damping[self.dof[s.a]] += s.D",
              "                m.dof_damping[self.dof[s.a]] = s.D",
-             "MuJoCo: the spring-to-ground damper D overwrites the spring system's viscous bearing B_s (dropped at D = 0)",
+             "MuJoCo: the spring-to-ground damper D overwrites the spring system's viscous bearing B_s (lost at D = 0)",
              "tests/drives/test_non_default.py"),
     Mutation("drives_damper_torque_sign", "mbsuite/models/drives/rotor_system.py",
              "                f[s.a] -= s.K * d + s.D * d_w", "                f[s.a] -= s.K * d - s.D * d_w",

@@ -40,8 +40,8 @@ def test_leading_pantograph_is_the_single_one_when_the_trailing_waves_cannot_rea
     tr = simulate_train(P5, 250.0, 2e-4, ["reference2mass", "reference2mass"], [100.0])
     for k in STATS:
         assert tr.stats[0][k] == pytest.approx(single.stats[k], abs=3e-11), k
-    # and so is the uplift charged to it at each arm of the window (measured 3.2e-13 mm; bound 3e-11 mm)
-    assert tr.stats[0]["uplift_at_supports_mm"] == pytest.approx(single.stats["uplift_at_supports_mm"], abs=3e-11)
+    # and so is the uplift charged to it at each arm of the window (measured 3.2e-13 mm; bound 3e-12 mm, 9x)
+    assert tr.stats[0]["uplift_at_supports_mm"] == pytest.approx(single.stats["uplift_at_supports_mm"], abs=3e-12)
     assert np.max(np.abs(tr.results[0].force - single.result.force)) < 4.5e-10
     assert single.stats["loss_pct"] == 0.0 and single.stats["stat_min"] > 0.0
     assert tr.stats[1]["loss_pct"] > 0.0 and tr.stats[1]["stat_min"] < 0.0

@@ -29,7 +29,7 @@ def test_nan_parameter_is_reported_as_that_parameter(field):
         PantographParams(**{field: math.nan})
 
 
-@pytest.mark.parametrize("field,value", [("alpha", 4.0), ("r_laminar", 0.5), ("r_laminar", 1.0), ("gamma", 1.0),
+@pytest.mark.parametrize("field,value", [("alpha", 4.0), ("r_laminar", 0.4), ("r_laminar", 1.0), ("gamma", 1.0),
                                          ("xf", math.inf)])
 def test_out_of_range_parameter_is_named_with_its_range(field, value):
     with pytest.raises(ParameterError, match=rf"{field} = .* is invalid; valid: [\[(]"):
@@ -44,6 +44,21 @@ def test_cross_field_checks_remain():
     # the laminar band must lie in subsonic flow: above the critical ratio (2/2.1)^11 = 0.584679 of gamma = 1.1
     with pytest.raises(ParameterError, match=r"r_laminar = 0.56 must exceed the critical pressure ratio 0.584679 of"):
         PantographParams(gamma=1.1, r_laminar=0.56)
+
+
+def test_r_laminar_bound_is_the_critical_ratio_of_its_own_gamma():
+    """gamma = 1.67 (monatomic gas): critical ratio (2/2.67)^(1.67/0.67) = 0.486669, below the thesis' 0.528 of air.
+    A band edge between the two, 0.5, lies in subsonic flow and is accepted; 0.47 (inside the declared range, above
+    its infimum 4/9 at gamma -> 2) lies in choked flow and is refused, the message naming both ratios."""
+    g = 1.67
+    assert (2.0 / (g + 1.0)) ** (g / (g - 1.0)) == pytest.approx(0.486669, abs=1e-6)
+    assert PantographParams(gamma=g, r_laminar=0.5).r_laminar == 0.5
+    with pytest.raises(ParameterError, match=r"r_laminar = 0.47 must exceed the critical pressure ratio 0.486669 of "
+                                             r"gamma = 1.67"):
+        PantographParams(gamma=g, r_laminar=0.47)
+    # the declared range alone refuses only below 4/9 = critical_ratio(2), the valid gamma's open upper end
+    with pytest.raises(ParameterError, match=r"r_laminar = 0.44 is invalid; valid: \(0.444444, 1\)"):
+        PantographParams(gamma=1.99, r_laminar=0.44)
 
 
 def test_input_defaults_are_part_of_the_scene():

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from mbsuite import load_scene
+from mbsuite.errors import SceneError
 from mbsuite.models.pantograph import orifice_band
 from mbsuite.models.pantograph.params import PantographParams
 
@@ -32,6 +33,16 @@ HARMONIC_BOUNDS = {
     2.0: (4e-5, 1.1e-5),  # 7.6e-6, 2.2e-6 (5.2x, 5.0x) / 7.9e-5, 1.9e-4
     6.0: (5e-6, 2e-5),    # 1.0e-6, 4.0e-6 (5.0x, 5.0x) / 3.1e-5, 3.4e-5
 }
+
+
+def test_band_width_below_one_minus_the_critical_ratio_of_the_scene_gamma(scene):
+    """The study's band lies in subsonic flow of the scene's own gas: at gamma = 1.67 the critical ratio is
+    (2/2.67)^(1.67/0.67) = 0.486669, so a width 0.5 (edge 0.5, wider than air's 1 - 0.528 allows) is accepted and
+    0.52 refused, the message naming the limit 0.513331."""
+    sc = scene.replace(params={"gamma": 1.67})
+    assert orifice_band._scene_with_band(sc, 0.5).build_params().r_laminar == 0.5
+    with pytest.raises(SceneError, match=r"width 0.52 must be in \(0, 0.513331\)"):
+        orifice_band._scene_with_band(sc, 0.52)
 
 
 def test_default_band_converged_at_hardest_frequencies(scene):

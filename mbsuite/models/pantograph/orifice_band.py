@@ -25,6 +25,7 @@ from ...analysis.harmonic import fundamental
 from ...analysis.sweep import run_sweep
 from ...errors import SceneError
 from ...scenes import Scene, scene_from_dict
+from .params import critical_ratio
 
 SIGNALS = ("F1", "F2", "HD")
 #: convergence criterion: amplitude and phase (rad) change < 0.1 % when the band width is divided by 10
@@ -43,8 +44,9 @@ class BandPoint:
 
 
 def _scene_with_band(scene: Scene, width: float) -> Scene:
-    if not 0.0 < width < 1.0 - 0.5283:
-        raise SceneError(f"laminar band width {width!r} must be in (0, 0.4717)")
+    top = 1.0 - critical_ratio(scene.build_params().gamma)  # the band lies in subsonic flow
+    if not 0.0 < width < top:
+        raise SceneError(f"laminar band width {width!r} must be in (0, {top:.6g}) (1 - the critical pressure ratio)")
     return scene.replace(params={"r_laminar": 1.0 - width}, effects={"cylinder": "nonlinear"},
                          solver={"engine": "reference"})
 

@@ -13,9 +13,6 @@ from dataclasses import dataclass
 from ...errors import ParameterError
 from ...limits import check_fields, param
 
-#: the thesis' critical pressure ratio of Eq 3.17 (air, gamma = 1.4); the declared lower end of r_laminar. The orifice
-#: law chokes at `critical_ratio(gamma)` (0.52828 for gamma = 1.4)
-CHOKED_RATIO = 0.528
 #: default laminar band of the orifice: Pd/Pu > R_LAMINAR (band 1e-5), from the convergence study in the README
 R_LAMINAR = 0.99999
 
@@ -23,6 +20,12 @@ R_LAMINAR = 0.99999
 def critical_ratio(gamma: float) -> float:
     """Critical (choking) pressure ratio Pd/Pu = (2 / (gamma + 1))^(gamma / (gamma - 1)) of an isentropic nozzle."""
     return (2.0 / (gamma + 1.0)) ** (gamma / (gamma - 1.0))
+
+
+#: the declared lower end of r_laminar: the infimum of `critical_ratio` over the valid gamma in (1, 2), approached as
+#: gamma -> 2: (2/3)^2 = 4/9 (the ratio falls with gamma: 0.6065 at gamma -> 1, 0.5283 at 1.4). `__post_init__` holds
+#: the real bound, the critical ratio of the parameters' own gamma
+R_LAMINAR_LO = critical_ratio(2.0)
 
 
 def _pos(default: float, unit: str, doc: str, hi: float | None = None) -> float:
@@ -82,7 +85,7 @@ class PantographParams:
     bc: float = _pos(90000.0, "N s/m", "linear cylinder damper")
     g: float = _nonneg(9.80665, "m/s^2", "gravitational acceleration")
     y_op: float = _pos(1.58, "m", "static operating (wire/ram) height above the base pivot, Chapter 5")
-    r_laminar: float = param(R_LAMINAR, lo=CHOKED_RATIO, hi=1.0, lo_open=True, hi_open=True, unit="-",
+    r_laminar: float = param(R_LAMINAR, lo=R_LAMINAR_LO, hi=1.0, lo_open=True, hi_open=True, unit="-",
                              doc="pressure ratio Pd/Pu above which the orifice flow is linear in dp (laminar band "
                                  "1 - r_laminar, chosen by convergence: README)")
     omega_s: float = _pos(1e-3, "rad/s", "velocity scale of the optional smooth Coulomb law tanh(w/omega_s)")

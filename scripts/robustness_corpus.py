@@ -156,7 +156,6 @@ duty = 0.5
 t_l = 0.2
 [input]
 type = "reference"
-value = 287.0
 [solver]
 engine = "mujoco"
 duration = 1.0
@@ -226,8 +225,8 @@ def scene_attempts() -> Iterator[Attempt]:
                 MODEL_SCENES["drives"].replace('mechanism = "step_up"', 'mechanism = "step_up_down"\n'
                                                'param_set = "design_100w"').replace(
                     'controller = "pwm"', 'controller = "energy_packet"\nclosed_loop = true').replace(
-                    "duty = 0.5\nt_l = 0.2\n", "").replace("value = 287.0",
-                                                           "profile = [[0.0, 300.0], [0.5, 300.0], [1.0, 200.0]]"),
+                    "duty = 0.5\nt_l = 0.2\n", "").replace('type = "reference"\n', 'type = "reference"\n'
+                                                           "profile = [[0.0, 300.0], [0.5, 300.0], [1.0, 200.0]]\n"),
                 "ok", timeout=120)
     for model, text in MODEL_SCENES.items():
         if model not in ("catenary", "pantograph"):
@@ -409,10 +408,16 @@ def input_attempts() -> Iterator[Attempt]:
         yield scene(f"coupler-input-{key}={v.strip(chr(34))}", a, f"coupler constant_speed {key} = {v}", text,
                     culprit=key)
     dr = MODEL_SCENES["drives"]
+    # a reference acts only closed loop (open loop the step-up refuses input.value): the PI on t_k tracks it
+    dr_cl = dr.replace('controller = "pwm"', 'controller = "pwm"\nclosed_loop = true')
+    yield scene("scene-ok-drives-closed-loop", a, "a valid closed-loop step-up scene at 287 rad/s (control)",
+                with_lines(dr_cl, "input", "value = 287.0"), "ok", timeout=120)
+    yield scene("drives-value-open-loop", a, "drives open-loop pwm with input.value = 287 (no reference acts)",
+                with_lines(dr, "input", "value = 287.0"), culprit="value")
     for v, why, cul in (("nan", "NaN reference", "value"), ('"fast"', "a string reference", "value"),
                         ("-1e9", "absurd negative reference", "value"), ("inf", "infinite reference", "value")):
         yield scene(f"drives-value-{why.replace(' ', '_')}", a, f"drives reference value = {v} ({why})",
-                    dr.replace("value = 287.0", f"value = {v}"), culprit=cul)
+                    with_lines(dr_cl, "input", f"value = {v}"), culprit=cul)
     for prof, why in (("[[0.0]]", "rows of one number"), ("[[1.0, 2.0], [0.0, 3.0]]", "times going back"),
                       ('"abc"', "a string"), ("[]", "empty"), ("[[0.0, nan], [1.0, 2.0]]", "NaN value"),
                       ("[[0.0, 1.0, 2.0]]", "rows of three")):
@@ -420,7 +425,7 @@ def input_attempts() -> Iterator[Attempt]:
             'controller = "pwm"', 'controller = "energy_packet"\nclosed_loop = true').replace(
             "duty = 0.5\nt_l = 0.2\n", "")
         yield scene(f"drives-profile-{why.replace(' ', '_')}", a, f"drives step_up_down reference profile = {prof} "
-                    f"({why})", susd.replace("value = 287.0", f"profile = {prof}"), culprit="profile")
+                    f"({why})", with_lines(susd, "input", f"profile = {prof}"), culprit="profile")
     it = MODEL_SCENES["iftomm"]
     for v in ("1000.0", "nan", "-1e3", '"spin"'):
         yield scene(f"iftomm-rate={v.strip(chr(34))}", a, f"iftomm initial rate = {v}",

@@ -91,14 +91,19 @@ def test_resonant_dead_time_with_unequal_delays():
     np.testing.assert_allclose(b_dn[:n] - b_up[:n], 0.3 * 0.16 + D_OFF - D_ON, rtol=0, atol=T_TOL)
 
 
-def test_clutch_matching_engages_at_the_velocity_match():
+@pytest.mark.parametrize(("d_on", "d_off"), [(D_OFF, D_ON), (D_ON, D_OFF)], ids=["d_on>d_off", "d_on<d_off"])
+def test_clutch_matching_engages_at_the_velocity_match(d_on, d_off):
     """Clutch matching (Eq 2.1, Sec. 2.1.3): the loiter time counts from the brake's release, so the controller
     subtracts the clutch's engagement delay minus the brake's release delay. On the run, the clutch must engage
     where the spring end actually reaches the load speed (w_s = w_l after the brake lets go, read off the run at
-    0.1 ms): from one controller sample early (the computed wait is truncated to samples) to on time. Measured
-    -0.9 ... -0.1 ms for either order of the delays (here d_on = 10 ms > d_off = 4 ms); bounds -2.1 / +0.5 ms.
-    Without the compensation the clutch engages 4-6 ms late (up to a cycle late for d_on < d_off)."""
-    d_on, d_off = D_OFF, D_ON
+    0.1 ms): from one controller sample early (the computed wait is truncated to samples) to on time, in either
+    order of the delays. Hand derivation of what the compensation removes: the clutch command issued t_c after the
+    brake's release command acts at t_c + d_on, the spring starts at d_off, so uncompensated the clutch engages
+    d_on - d_off from the match: +6 ms (late) for d_on = 10 ms > d_off = 4 ms, -6 ms (early, against slip) for
+    d_on = 4 ms < d_off = 10 ms. Measured with the compensation: -0.9 ... +0.2 ms (d_on > d_off), -0.9 ... -0.1 ms
+    (d_on < d_off); bounds -2.1 / +0.5 ms. Uncompensated (measured): +4.0 ... +5.3 ms, resp. -3.2 ... -4.8 ms or a
+    cycle late (the slip first closes in a later swing); with the sign reversed +10 ... +11.5 ms, resp. a cycle
+    late."""
     sc = load_scene("drives/step_up_resonant_matched").replace(
         params={"d_on": d_on, "d_off": d_off}, solver={"duration": 1.5, "t_settle": 0.0, "sample_dt": 1e-4})
     res, ctrl, _ = simulate_scene(sc)

@@ -86,10 +86,16 @@ MUTATIONS: tuple[Mutation, ...] = (
              "        j.frictionloss = 0.0",
              "the S joints' dry friction left out of the MuJoCo coupler (only the output bearing dissipates)", _L),
     Mutation("coupler_s_joint_friction_default_regularisation", "mbsuite/models/coupler/mujoco.py",
-             "        j.solref_friction = [2.0 * timestep, 1.0]",
+             "        j.solref_friction = [tf, 1.0]",
              "        j.solref_friction = [0.02, 1.0]",
              "the S joints' friction at MuJoCo's default 20 ms regularisation: a viscous drag below the slip speed, "
              "dissipating a third of the dry-friction power", _L),
+    Mutation("coupler_friction_timeconst_ignored", "mbsuite/models/coupler/mujoco.py",
+             "    tf = 2.0 * timestep if p.solref_friction_timeconst is None else p.solref_friction_timeconst",
+             "    tf = 2.0 * timestep",
+             "a set solref_friction_timeconst ignored: the friction law still follows the timestep, and the "
+             "work-precision study compares a different friction model at every timestep",
+             "tests/coupler/test_workprecision.py"),
     Mutation("coupler_closure_dampratio_ignored", "mbsuite/models/coupler/mujoco.py",
              "        m.eq_solref[e] = [p.solref_timeconst, p.solref_dampratio]",
              "        m.eq_solref[e] = [p.solref_timeconst, 1.0]",

@@ -138,14 +138,17 @@ def test_c5_absolute_against_independent():
     solve of Eqs (4), (6), (7) (8 unknowns, Table 1) with scipy's rotations, the mean over an independent dense grid
     (72 points; exact for the harmonics present) and the extrema by Brent. The oblique offset puts the fluctuation
     near its peak at phi_a = 0 (with z_c alone it is zero there, and a mean that counts the closing sample twice
-    would go unseen). Measured: c5 to 9.8e-13 relative, the mean to 2.2e-16 rad; bounds 2e-11 relative and 1e-12 rad
-    (a mean with the closing sample twice is off by 5.9e-6 rad, c5 by 2.6 %; the sampled maximum reads 1.5 % low)."""
+    would go unseen). The link length is written by hand from Eq (1), l^2 = 2 R^2 (1 - sin 2 gamma) + e_y^2.
+    Measured: c5 to 9.8e-13 relative (bound 2e-11, 20x), the mean (-pi/2) to 2.2e-16 rad, one ulp of pi/2 (bound
+    2e-15 rad, 9x: the floor is the rounding of the two means, sums of 36 and 72 terms near pi/2, each at most a few
+    ulps; the solves agree to ~1e-16 rad). A mean with the closing sample twice is off by 5.9e-6 rad, c5 by 2.6 %;
+    the sampled maximum reads 1.5 % low."""
     p = CouplerParams(phi_bc=math.pi / 2, l_b=3.0)
     xc, zc = 0.036, 0.048
     code = criteria.double_c5(p, zc, x_c=xc, n=37)
     P = _points(p.gamma, p.R)
     Pbc = P @ _rot(0, 0, p.phi_bc).T + np.array([0.0, p.l_b, 0.0])
-    l2 = p.l0**2 + p.e_y**2
+    l2 = 2 * p.R**2 * (1 - math.sin(2 * p.gamma)) + p.e_y**2  # Eq (1) with the axial shift, as in `Single`
 
     def solve(phi_a: float, guess: np.ndarray, scale: float = 1.0) -> np.ndarray:
         def r(u):
@@ -177,5 +180,6 @@ def test_c5_absolute_against_independent():
         return x - solve(x, U[j] + (x - dense[j]) * turn)[0]
 
     c5 = _fluctuation(g, dense, dense - U[:, 0])
+    mean = float(np.mean(dense - U[:, 0]))
     assert code["c5"] == pytest.approx(c5, rel=2e-11)
-    assert code["mean"] == pytest.approx(float(np.mean(dense - U[:, 0])), abs=1e-12)
+    assert code["mean"] == pytest.approx(mean, abs=2e-15)

@@ -252,6 +252,13 @@ class CouplerStudy(Study):
                                   outputs=["phi_a", "phi_c", "phi_c_kin", "phi_c_err", "omega_c", "torque_in",
                                            "closure_residual"])
         self.rest = np.array([self.inp["alpha_cx"], self.inp["alpha_cz"], self.inp["x_c"], self.inp["z_c"]])
+        self.hs = (1e-3, 5e-4) if quick else self.MJ_STEPS
+        # the friction model held fixed: by default its time constant follows the timestep (2 timesteps), which would
+        # compare a different friction law at every timestep; here it is 2x the largest timestep studied throughout
+        self.friction_timeconst = None
+        if scene.effects.get("friction"):
+            self.friction_timeconst = self.p.solref_friction_timeconst or 2.0 * max(self.hs)
+            self.base = self.base.replace(params={"solref_friction_timeconst": self.friction_timeconst})
 
     # ---- FPP over a revolution with a given Gauss-Newton tolerance and number of continuation steps
     def fpp(self, tol: float, n: int) -> np.ndarray:
@@ -294,9 +301,8 @@ class CouplerStudy(Study):
                 out.append(Setting("fpp", "gauss-newton", f"tol {tol:g}, {n} steps",
                                    lambda tol=tol, n=n: ("fpp", n, self.fpp(tol, n))))
         integ = ("implicitfast",) if self.quick else self.MJ_INTEGRATORS
-        hs = (1e-3, 5e-4) if self.quick else self.MJ_STEPS
         for i in integ:
-            for h in hs:
+            for h in self.hs:
                 sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
                 out.append(Setting("mujoco", i, h, lambda sc=sc: ("mujoco", 0, run(sc))))
         return out
@@ -307,8 +313,12 @@ class CouplerStudy(Study):
 
         self._fpp_ref = {n: self.fpp_reference(n) for n in ((19, 37) if self.quick else self.FPP_STEPS)}
         mj_ref = run(self.base.replace(solver={"engine": "mujoco", "integrator": "rk4", "timestep": 1e-4}))
+        model = "same soft-closure model"
+        if self.friction_timeconst is not None:
+            model += (f" and friction time constant {self.friction_timeconst:g} s as every MuJoCo setting, 2x the "
+                      f"largest timestep studied")
         return {"mujoco": mj_ref}, {"reference": "FPP: scipy least_squares (trf) xtol=ftol=gtol=1e-15; "
-                                                 "MuJoCo: rk4 at 1e-4 s (same soft-closure model)"}
+                                                 f"MuJoCo: rk4 at 1e-4 s ({model})"}
 
     def _c5(self, u: np.ndarray, n: int) -> float:
         phis = np.linspace(0.0, 2 * math.pi, n)

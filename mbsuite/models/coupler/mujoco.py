@@ -127,6 +127,17 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
             f"solver.timestep = {timestep:g} s is too large for the soft link closures: MuJoCo needs solref_timeconst "
             f"({p.solref_timeconst:g} s) >= 2 timestep and would silently stiffen it (closure residual 300x larger at "
             f"5 ms); use timestep <= {p.solref_timeconst / 2:g} s or raise params.solref_timeconst")
+    # MuJoCo's friction is a soft constraint: below a slip speed set by its time constant (MuJoCo's default 20 ms) it
+    # acts as a viscous drag, and the S joints' swing rates (~0.3 rad/s) stay below it; at the stiffest time constant
+    # MuJoCo allows (2 timesteps, the default) the S joints dissipate the dry-friction power
+    # (tests/coupler/test_dissipation.py). A set solref_friction_timeconst holds the friction model fixed across
+    # timesteps (the work-precision study)
+    tf = 2.0 * timestep if p.solref_friction_timeconst is None else p.solref_friction_timeconst
+    if effects["friction"] and tf < 2.0 * timestep * (1.0 - 1e-6):
+        raise SceneError(
+            f"solver.timestep = {timestep:g} s is too large for the dry-friction constraints: MuJoCo needs "
+            f"solref_friction_timeconst ({tf:g} s) >= 2 timestep and would silently stiffen it; use timestep <= "
+            f"{tf / 2:g} s, raise params.solref_friction_timeconst or leave it unset (2 timesteps)")
     spec = mjspec_variant(p, "double")
     massless = effects["link_inertia"] == "massless"
     scale = p.massless_factor if massless else 1.0
@@ -137,10 +148,7 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
         b.inertia = [it, it, ia]
         j = spec.joint(f"link{k + 1}_ball")
         j.frictionloss = p.joint_friction if effects["friction"] else 0.0
-        # MuJoCo's friction is a soft constraint: below a slip speed set by solreffriction (default 20 ms) it acts as
-        # a viscous drag, and the S joints' swing rates (~0.3 rad/s) stay below it; at the stiffest time constant
-        # MuJoCo allows (2 timesteps) the S joints dissipate the dry-friction power (tests/coupler/test_dissipation.py)
-        j.solref_friction = [2.0 * timestep, 1.0]
+        j.solref_friction = [tf, 1.0]
     # shaft c: only y_c (base y) and phi_c remain; its body sits at the imposed misalignment
     for name in ("x_c", "z_c", "alpha_cz", "alpha_cx"):
         spec.delete(spec.joint(name))
@@ -151,7 +159,7 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
     bc.quat = [w, (Rc[2, 1] - Rc[1, 2]) / (4 * w), (Rc[0, 2] - Rc[2, 0]) / (4 * w), (Rc[1, 0] - Rc[0, 1]) / (4 * w)]
     spec.joint("y_c").axis = Rc.T @ np.array([0.0, 1.0, 0.0])
     spec.joint("phi_c").frictionloss = p.joint_friction if effects["friction"] else 0.0
-    spec.joint("phi_c").solref_friction = [2.0 * timestep, 1.0]
+    spec.joint("phi_c").solref_friction = [tf, 1.0]
     spec.option.gravity = [0.0, 0.0, -9.81] if effects["gravity"] else [0.0, 0.0, 0.0]
     act = spec.add_actuator()
     act.name = "drive"

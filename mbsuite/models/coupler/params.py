@@ -8,11 +8,13 @@ link k joins A-point k to B-point k+1. Lengths are in metres; the paper's non-di
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
+from ... import perturbation
 from ...errors import ParameterError
-from ...limits import check_fields, param
+from ...limits import param
 
 GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (README, erratum 7)
 GAMMAS_PAPER = (0.11, 0.297, 0.391)  # the paper's Sect. 3.1 and 3.4
@@ -37,6 +39,8 @@ class CouplerParams:
       joint_damping                viscous damping in the S joints [N m s/rad] (regularises the free link spin)
       kv_drive                     velocity-servo gain of the input drive [N m s/rad]
       solref_timeconst, solref_dampratio   soft-constraint parameters of the link closures (see README)
+      solref_friction_timeconst    time constant of MuJoCo's dry-friction constraints [s] (friction effect); None (the
+                                   default): 2 timesteps, the stiffest MuJoCo allows, so it follows the timestep
     """
 
     gamma: float = param(GAMMA_17DEG, lo=0.0, hi=math.pi / 4, lo_open=True, hi_open=True, unit="rad",
@@ -61,9 +65,20 @@ class CouplerParams:
     solref_timeconst: float = param(2.0e-3, lo=0.0, hi=1.0, lo_open=True, unit="s",
                                     doc="time constant of the soft link closures")
     solref_dampratio: float = param(1.0, lo=0.0, hi=100.0, lo_open=True, doc="damping ratio of the link closures")
+    solref_friction_timeconst: float | None = param(
+        None, lo=0.0, hi=1.0, lo_open=True, unit="s",
+        doc="time constant of the dry-friction constraints (S joints, output bearing); None: 2 timesteps")
 
     def __post_init__(self) -> None:
-        check_fields(self, "coupler parameter")
+        # every declared range (as `check_fields`), but None of solref_friction_timeconst (the default: 2 timesteps)
+        for f in dataclasses.fields(self):
+            lim, v = f.metadata.get("limit"), getattr(self, f.name)
+            if lim is None or v is None:
+                continue
+            v2 = lim.check(f"coupler parameter {f.name}", v)
+            if v2 is not v:
+                object.__setattr__(self, f.name, v2)
+        perturbation.fields(self)  # inside the stability check every float is perturbed (None stays None)
         # cross-field checks (each message names the fields involved)
         if self.l_b <= 2.0 * self.link_radius:
             raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for link_radius = "

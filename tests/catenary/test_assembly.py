@@ -152,9 +152,10 @@ def test_static_contact_force_in_closed_form(x_start):
 def test_rayleigh_damping_ratio_at_both_matching_frequencies_and_on_the_wires_only():
     """C = alpha M + beta K0 has the modal damping ratio zeta(w) = alpha/(2w) + beta w/2 (Rayleigh). With non-default
     zeta, f_damp1, f_damp2: zeta(w) equals zeta at both matching frequencies (closed form; measured 1e-16, bound
-    1e-14: a few roundings of two products), and the damping the step matrix S = M + hC + h^2 K carries, (S - M - h^2 (K0 + Kd)) / h, is alpha M +
-    beta K0 with alpha, beta from solving those two conditions here (numpy): the droppers undamped (measured 1.8e-15
-    relative; bound 2e-14, 11x; a Rayleigh term on the droppers' stiffness too is 5e-2 off)."""
+    1e-14: a few roundings of two products), and the damping the step matrix S = M + hC + h^2 K carries,
+    (S - M - h^2 (K0 + Kd)) / h, is alpha M + beta K0 with alpha, beta from solving those two conditions here (numpy):
+    the droppers undamped (measured 1.8e-15 relative; bound 2e-14, 11x; a Rayleigh term on the droppers' stiffness too
+    is 5e-2 off)."""
     p = CatenaryParams(**WIRES, zeta=0.02, f_damp1=2.0, f_damp2=35.0)
     a, b = p.rayleigh()
     for f in (p.f_damp1, p.f_damp2):

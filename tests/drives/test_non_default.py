@@ -22,7 +22,7 @@ from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.models.drives.event_exact import simulate_reference
 from mbsuite.models.drives.mujoco import MujocoRotorSim
 from mbsuite.models.drives.params import DESIGN_100W, TABLE_4_2
-from mbsuite.models.drives.scene_run import setup
+from mbsuite.models.drives.scene_run import setup as run_setup  # a module-level `setup` is pytest's xunit hook
 from mbsuite.paths import mjcf_path
 from mbsuite.scenes import load_scene
 
@@ -246,7 +246,7 @@ def damped_pair():
     sc = load_scene("drives/susd_100w_design").replace(solver={"duration": 0.5, "t_settle": 0.0, "sample_dt": 1e-4})
     out = {}
     for eng in ("reference", "mujoco"):
-        s = setup(sc)
+        s = run_setup(sc)
         s.system.springs[0].D = D_SPRING
         if eng == "reference":
             res = simulate_reference(s.system, s.q0, s.w0, 0.5, controller=s.controller, sample_dt=s.sample_dt,

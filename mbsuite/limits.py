@@ -110,10 +110,11 @@ def limit_of(cls_or_obj: Any, name: str) -> Limit | None:
 
 def check_fields(obj: Any, owner: str, error: type[Exception] = ParameterError) -> None:
     """Check every field of dataclass instance `obj` that declares a `Limit`; coerce ints to floats where the field
-    is a float (frozen dataclasses are updated with `object.__setattr__`). Errors read `<owner> <field> = ...`."""
+    is a float (frozen dataclasses are updated with `object.__setattr__`). Errors read `<owner> <field> = ...`. A field
+    whose default is None may be left None (unset: its owner derives the value)."""
     for f in dataclasses.fields(obj):
         lim = f.metadata.get("limit")
-        if lim is None:
+        if lim is None or (f.default is None and getattr(obj, f.name) is None):
             continue
         v = lim.check(f"{owner} {f.name}", getattr(obj, f.name), error)
         if v is not getattr(obj, f.name):

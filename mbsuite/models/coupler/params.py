@@ -8,13 +8,11 @@ link k joins A-point k to B-point k+1. Lengths are in metres; the paper's non-di
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
-from ... import perturbation
 from ...errors import ParameterError
-from ...limits import param
+from ...limits import check_fields, param
 
 GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (README, erratum 7)
 GAMMAS_PAPER = (0.11, 0.297, 0.391)  # the paper's Sect. 3.1 and 3.4
@@ -70,15 +68,7 @@ class CouplerParams:
         doc="time constant of the dry-friction constraints (S joints, output bearing); None: 2 timesteps")
 
     def __post_init__(self) -> None:
-        # every declared range (as `check_fields`), but None of solref_friction_timeconst (the default: 2 timesteps)
-        for f in dataclasses.fields(self):
-            lim, v = f.metadata.get("limit"), getattr(self, f.name)
-            if lim is None or v is None:
-                continue
-            v2 = lim.check(f"coupler parameter {f.name}", v)
-            if v2 is not v:
-                object.__setattr__(self, f.name, v2)
-        perturbation.fields(self)  # inside the stability check every float is perturbed (None stays None)
+        check_fields(self, "coupler parameter")  # solref_friction_timeconst may stay None (2 timesteps)
         # cross-field checks (each message names the fields involved)
         if self.l_b <= 2.0 * self.link_radius:
             raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for link_radius = "

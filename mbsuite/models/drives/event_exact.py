@@ -491,6 +491,7 @@ class ReferenceSimulator:
         """"running" until the run reached t_end, then "finished" (`mbsuite.stepping.StepObject`; a failing step
         raises SolverError)."""
         return "finished" if self.done else "running"
+
     def _finish(self) -> None:
         if not self.done:
             y = self.y

@@ -513,6 +513,7 @@ class RotorStepper:
         """"running" until every step of the run is made, then "finished" (`mbsuite.stepping.StepObject`; a failing
         step raises SolverError)."""
         return "finished" if self.k >= self.rotor_run.nstep else "running"
+
     def result(self) -> RefResult:
         """The final decision at the end of the run (recorded if on the output grid) and the RefResult."""
         run = self.rotor_run

@@ -26,9 +26,13 @@ from .registry import models as model_specs
 from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
 
 
-def run(scene: Scene | str, engine: str | None = None):
+def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool = False, workers: int = 0):
     """Run a scene's time simulation on its path (`solver.engine`, or `engine`: a key or label of the model's path
-    table, `mbsuite list`), returning a `SimResult` whose health figures are judged here, once."""
+    table, `mbsuite list`), returning a `SimResult` whose health figures are judged here, once.
+
+    `error_estimate=True` also runs the scene refined once and twice (`mbsuite.accuracy`; `workers` local processes,
+    0 = all cores) and attaches `res.error_estimate`: per headline output the estimated error and the observed order;
+    an estimate above its declared tolerance is a health figure like any other."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     spec = scene.spec
@@ -36,7 +40,14 @@ def run(scene: Scene | str, engine: str | None = None):
         raise SceneError(f"model '{spec.name}' has no time simulation")
     if engine is not None:
         scene = scene.replace(solver={"engine": engine})
+    if error_estimate and spec.accuracy is None:
+        raise SceneError(f"model '{spec.name}' declares no headline outputs: no error estimate")
     res = spec.paths[scene.solver.engine].run(scene)
+    if error_estimate:
+        from .analysis.errorestimate import error_estimate as estimate_error
+
+        res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers)
+        res.health.extend(res.error_estimate.figures())
     res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate,
                               what=f"{spec.name} scene {scene.name or scene.source or ''}".strip()))
     return res

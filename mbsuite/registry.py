@@ -73,6 +73,8 @@ class ModelSpec:
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     - `mujoco_model(scene) -> (MjModel, MjData)`: the MuJoCo model of exactly the scene's effects, in its initial state
       (what `mbsuite view` shows; None: the model has no MuJoCo model).
+    - `accuracy`: the model's accuracy declaration (`mbsuite.accuracy.AccuracySpec`: headline outputs with the
+      tolerances the defaults meet, their values from a result, how a run is refined for `--error-estimate`).
     - `file_checks`: model-file stem -> `check(path, engine, model)`, handed to the engines' loaders for a file of
       that name by `mbsuite.load_model_file` (engine "mujoco" with an MjModel, "pinocchio" or "urdf" with a
       pin.Model); raises ModelFileError naming the file, the body and the residual (e.g. a loop that cannot close at
@@ -98,6 +100,7 @@ class ModelSpec:
     under_wire: Callable[..., Any] | None = None
     mujoco_model: Callable[..., Any] | None = None
     file_checks: Mapping[str, Callable[..., None]] = field(default_factory=dict)
+    accuracy: Any = None
 
     def __post_init__(self) -> None:
         labels = [p.label for p in self.paths.values()]

@@ -33,6 +33,7 @@ class SimResult:
     scene: dict[str, Any] = field(default_factory=dict)
     health: list[Any] = field(default_factory=list)  # mbsuite.health.Figure: the run's own accuracy figures
     warnings: list[str] = field(default_factory=list)  # accepted health violations (allow_inaccurate), loud
+    error_estimate: Any = None  # mbsuite.accuracy.ErrorEstimate of the headline outputs (run(..., error_estimate=True))
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]
@@ -50,6 +51,8 @@ class SimResult:
         out["events"] = self.events
         out["stats"] = self.stats
         out["health"] = [f.to_dict() for f in self.health]
+        if self.error_estimate is not None:
+            out["error_estimate"] = self.error_estimate.to_dict()
         if self.warnings:
             out["warnings"] = list(self.warnings)
         return out
@@ -118,8 +121,11 @@ class SimResult:
             table += "\n" + textwrap.fill("health: " + ", ".join(
                 f"{f.name} {f.value:.3g} (bound {f.bound:.3g}{'' if f.ok else ', EXCEEDED'})" for f in self.health),
                 100, subsequent_indent="  ")
+        if self.error_estimate is not None:
+            table += "\n" + self.error_estimate.table()
         for w in self.warnings:
             table += f"\n{w}"
+
         def write(out: Path) -> list[Path]:
             from .plotting import save
 

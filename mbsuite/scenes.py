@@ -19,6 +19,8 @@ engine = "mujoco"    # or "reference" (hand-derived numpy/scipy path)
 integrator = "implicitfast"
 timestep = 5e-4
 duration = 10.0
+[accuracy]           # optional: tolerances of headline outputs (their units), replacing the model's declared ones
+F1_amplitude = 1.0
 ```
 
 `load_scene(x)` accepts a path to a TOML file, a model name (its default scene) or `model/scene` (a shipped scene).
@@ -37,12 +39,13 @@ from pathlib import Path
 from typing import Any
 
 from . import perturbation
+from .accuracy import check_tolerances, declared
 from .errors import SceneError
 from .limits import Limit
 from .registry import ModelSpec, get_model, models
 from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
 
-TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver")
+TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver", "accuracy")
 MAX_SCENE_BYTES = 1_000_000
 
 
@@ -65,6 +68,7 @@ class Scene:
     solver: SolverSettings = field(default_factory=SolverSettings)
     source: str | None = None
     sections: Mapping[str, Any] = field(default_factory=dict)  # the model's own extra sections (ModelSpec.sections)
+    accuracy: Mapping[str, float] = field(default_factory=dict)  # [accuracy]: headline -> tolerance (mbsuite.accuracy)
 
     @property
     def spec(self) -> ModelSpec:
@@ -86,6 +90,7 @@ class Scene:
             "input": dict(self.input),
             "outputs": {"signals": list(self.outputs)},
             "solver": dataclasses.asdict(self.solver),
+            **({"accuracy": dict(self.accuracy)} if self.accuracy else {}),
             **{k: copy.deepcopy(v) for k, v in self.sections.items()},
         }
 
@@ -121,7 +126,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
             raise SceneError(f"{key} = {data[key]!r}{where} must be a string")
-    for key in ("effects", "params", "input", "solver", *spec.sections):
+    for key in ("effects", "params", "input", "solver", "accuracy", *spec.sections):
         if key in data and not isinstance(data[key], Mapping):
             raise SceneError(f"{key} = {data[key]!r}{where} must be a table ([{key}] section with key = value lines)")
     if "outputs" in data and not isinstance(data["outputs"], Mapping | list | tuple):
@@ -219,8 +224,13 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         solver=solver,
         source=source,
         sections=extra,
+        accuracy=check_tolerances(data.get("accuracy") or {}, where),
     )
     scene.build_params()  # parameter dataclasses validate themselves (negative mass etc.)
+    if scene.accuracy:
+        if spec.accuracy is None:
+            raise SceneError(f"[accuracy]{where}: model '{spec.name}' declares no headline outputs")
+        declared(scene)  # every name a headline of this scene
     return scene
 
 

@@ -58,7 +58,7 @@ def cmd_run(args: argparse.Namespace) -> None:
     from .. import run
 
     scene = load(args)
-    emit(run(scene).report(), args, scene.to_dict())
+    emit(run(scene, error_estimate=args.error_estimate).report(), args, scene.to_dict())
 
 
 def cmd_view(args: argparse.Namespace) -> None:

@@ -24,6 +24,15 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
                    help=f"size guard: most steps a run may take (default {DEFAULT_MAX_STEPS:.0e})")
 
 
+def add_error_estimate(p: argparse.ArgumentParser) -> None:
+    """`--error-estimate`: run refined copies and report each headline output's estimated error (mbsuite.accuracy)."""
+    p.add_argument("--error-estimate", action="store_true",
+                   help="also run the scene refined once and twice (the path's step, tolerance or mesh; in parallel "
+                        "on the local cores) and report per headline output the estimated error, the observed order "
+                        "and the declared tolerance; an estimate above its tolerance is an error unless "
+                        "--allow-inaccurate")
+
+
 def load(args: argparse.Namespace) -> Scene:
     """The command's scene with the command-line solver overrides applied (and validated); `--engine` may name a
     path by its key or its label (`mbsuite list`)."""

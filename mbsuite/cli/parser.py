@@ -8,7 +8,7 @@ import importlib
 
 from .. import registry
 from . import commands
-from .options import SCENE_HELP, add_scene_options, add_sweep_options
+from .options import SCENE_HELP, add_error_estimate, add_scene_options, add_sweep_options
 from .output import add_common, emit
 from .sweep import cmd_sweep
 
@@ -53,6 +53,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     add_scene_options(p)
     p.add_argument("--engine", metavar="PATH",
                    help="override the scene's path: a key or label of the model's path table (mbsuite list)")
+    add_error_estimate(p)
     p.set_defaults(func=commands.cmd_run)
 
     p = sub.add_parser("view", help="open MuJoCo's viewer on a scene's model, its effects active")

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...accuracy import AccuracySpec
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import mujoco, pinocchio
+from . import accuracy, mujoco, pinocchio
 from .modelfiles import check_model_file
 from .outputs import OUTPUTS
 from .params import IftommParams
@@ -33,4 +34,5 @@ SPEC = ModelSpec(
                           duration=10.0, sample_dt=1e-2),
     mujoco_model=mujoco.view_model,
     file_checks={"iftomm_fourbar": check_model_file, "iftomm_bricard": check_model_file},
+    accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
 )

@@ -1,0 +1,43 @@
+"""The IFToMM gates' headline outputs, the tolerances their shipped settings meet, and how a run is refined.
+
+Headlines: the input joint's angle at the end of the run (rad), the largest loop-closure residual (m) and the largest
+energy drift (J). The tolerance bounds the discretisation error of the model as posed (on MuJoCo the soft closures
+are part of the model: their own floor against the rigid closed form, 0.175 rad of crank angle in 10 s, is stated in
+docs/accuracy.md and is not a discretisation error). MuJoCo runs are refined by halving the step (RK4: nominal order
+4; the default implicitfast/euler: 1), the Pinocchio path by tightening rtol.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...accuracy import Headline, Refinement, rtol_refinement, timestep_refinement
+
+#: nominal order of each MuJoCo integrator in the step
+ORDER = {"euler": 1.0, "implicit": 1.0, "implicitfast": 1.0, "rk4": 4.0, "discrete": 1.0}
+
+#: declared tolerances at the shipped settings, 6-35x the largest estimate measured on both scenes and both paths
+#: (`mbsuite run iftomm/<scene> [--engine reference] --error-estimate`): final angle 6.6e-5 rad, closure residual
+#: 2.9e-8 m, energy drift 1.5e-4 J (all three largest on the Bricard's Pinocchio path, rtol 1e-8)
+TOL = {"final_angle": 1e-3, "closure_residual_max": 1e-6, "energy_drift_max": 1e-3}
+
+
+def headlines(scene: Any) -> tuple[Headline, ...]:
+    """Final input-joint angle, largest closure residual, largest energy drift."""
+    return (Headline("final_angle", "rad", TOL["final_angle"], "input joint angle at the end of the run"),
+            Headline("closure_residual_max", "m", TOL["closure_residual_max"], "largest loop-closure residual"),
+            Headline("energy_drift_max", "J", TOL["energy_drift_max"], "largest |E(t) - E(0)|"))
+
+
+def values(scene: Any, res: Any) -> dict[str, float]:
+    """The headline values of a run's result."""
+    return {"final_angle": float(res["input_angle"][-1]),
+            "closure_residual_max": float(res.stats["closure_residual_max"]),
+            "energy_drift_max": float(res.stats["energy_drift_max"])}
+
+
+def refinement(scene: Any) -> Refinement:
+    """MuJoCo: halve the step at the integrator's order; Pinocchio: rtol / 10."""
+    if scene.solver.engine == "mujoco":
+        return timestep_refinement(ORDER[scene.solver.integrator])
+    return rtol_refinement()

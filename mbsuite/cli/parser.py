@@ -67,6 +67,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
                         "the grid is the product)")
     p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
     p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
+    add_error_estimate(p)
     add_sweep_options(p)
     add_scene_options(p)
     add_common(p)

@@ -51,9 +51,47 @@ def cmd_sweep(args: argparse.Namespace) -> None:
         points.append((scene.to_dict(), sections))
     # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
     auto = "threads" if engines == {"mujoco"} else "local"
+    estimate = getattr(args, "error_estimate", False)
+    if estimate:
+        if scene.spec.accuracy is None:
+            raise MbsuiteError(f"model '{scene.model}' declares no headline outputs: no --error-estimate")
+        points = [(*pt, level) for pt in points for level in LEVELS]  # every point at levels 0, 1, 2
     results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
                         executor=None if args.executor else auto, options=options)
+    if estimate:
+        results = point_estimates(scene, points, results)
     emit(sweep_report(scene, axes, combos, results, args.signals), args, scene.to_dict())
+    if estimate:
+        judge_points(scene, axes, combos, results)
+
+
+LEVELS = (0, 1, 2)
+
+
+def point_estimates(scene: Scene, points: list[tuple], results: list[dict]) -> list[dict]:
+    """Fold the three levels of every point into the level-0 result with its `error_estimate` (mbsuite.accuracy)."""
+    from ..accuracy import declared, estimate
+
+    out = []
+    n = len(LEVELS)
+    for i in range(0, len(points), n):
+        sc = scene.replace(**points[i][1]) if points[i][1] else scene
+        est = estimate([r["headlines"] for r in results[i:i + n]], declared(sc), sc.spec.accuracy.refinement(sc))
+        r0 = dict(results[i])
+        r0["error_estimate"] = est
+        out.append(r0)
+    return out
+
+
+def judge_points(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict]) -> None:
+    """Every point's estimates against their tolerances: an AccuracyError naming the first point and headline past
+    its tolerance (warnings with solver.allow_inaccurate / --allow-inaccurate)."""
+    from ..health import judge
+
+    for combo, r in zip(combos, results, strict=True):
+        where = ", ".join(f"{s}.{n} = {v}" for (s, n, _), v in zip(axes, combo, strict=True))
+        judge(r["error_estimate"].figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+              what=f"sweep point {where}")
 
 
 def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
@@ -77,6 +115,20 @@ def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[t
                 cols.setdefault(f"{sig}_{k}", []).append(st[k])
     heads = [f"{h} [{units[h]}]" if units[h] else h for h in head]
     table = format_table([*heads, "signal", "unit", "min", "max", "mean"], rows, ".5g")
+    if results and "error_estimate" in results[0]:
+        est_rows = []
+        for combo, r in zip(combos, results, strict=True):
+            for e in r["error_estimate"].rows:
+                est_rows.append([*combo, e.name, e.unit, e.value, e.error, e.tol,
+                                 "-" if e.order is None else f"{e.order:.2f}", "ok" if e.ok else "EXCEEDED"])
+                cols.setdefault(f"{e.name}_value", []).append(e.value)
+                cols.setdefault(f"{e.name}_error", []).append(e.error)
+                sig_units.setdefault(e.name, e.unit)
+        first = results[0]["error_estimate"]
+        est_head = [*heads, "headline", "unit", "value", "est. error", "tol", "observed order", ""]
+        table += (f"\n\nerror estimate per point: {first.setting} refined by {first.factor:g} twice (nominal order "
+                  f"{first.nominal_order:g})\n" + format_table(est_head, est_rows, ".4g"))
+        results = [{**r, "error_estimate": r["error_estimate"].to_dict()} for r in results]
     data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "units": {**units, **sig_units},
             "points": [{"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}
     write = functools.partial(write_sweep, head=head, units=units, combos=combos, results=results, signals=signals,
@@ -89,7 +141,7 @@ def write_sweep(out: Path, *, head: list[str], units: dict, combos: list, result
     """`sweep.csv` (SI units in the header) and `sweep.png` under `out`."""
     from ..plotting import save
 
-    csv_cols = [(k, units[k] if k in units else sig_units[k.rsplit("_", 1)[0]], v) for k, v in cols.items()]
+    csv_cols = [(k, units[k] if k in units else sig_units.get(k.rsplit("_", 1)[0], ""), v) for k, v in cols.items()]
     return [write_csv(Path(out) / "sweep.csv", csv_cols),
             save(plot_sweep(head, units, combos, results, signals, sig_units), Path(out) / "sweep.png")]
 

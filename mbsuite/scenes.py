@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from . import perturbation
 from .accuracy import check_tolerances, declared
 from .errors import SceneError
@@ -104,20 +106,36 @@ class Scene:
             if key not in valid:
                 raise SceneError(f"cannot replace scene section {key!r}; valid sections: {valid}")
             if key == "outputs" and not isinstance(val, Mapping):
-                val = {"signals": list(val)}
+                val = {"signals": [val] if isinstance(val, str) else list(val)}
             if isinstance(val, Mapping):
                 merged = dict(d.get(key) or {})
                 merged.update(val)
                 d[key] = merged
             else:
                 d[key] = val
-        return scene_from_dict(d, source=self.source)
+        changed = ", ".join(f"[{k}]" for k in sections)
+        origin = f"{self.source} (with overrides of {changed})" if self.source else f"the overrides of {changed}"
+        return scene_from_dict(d, source=self.source, origin=origin)
 
 
-def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
-    """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones."""
-    where = f" in {source}" if source else ""
-    data = copy.deepcopy(dict(data))
+def plain(value: Any) -> Any:
+    """`value` with numpy scalars and 0-d arrays as Python numbers (bools, ints, floats), in lists and tables too: what
+    a numpy user passes is taken as the number it holds."""
+    if isinstance(value, np.generic) or (isinstance(value, np.ndarray) and value.ndim == 0):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {k: plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    return value
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origin: str | None = None) -> Scene:
+    """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones, and
+    where the value came from (`origin`, default `source`). Numpy scalars and 0-d arrays count as the numbers they
+    hold."""
+    where = f" in {origin or source}" if (origin or source) else ""
+    data = {k: plain(v) for k, v in copy.deepcopy(dict(data)).items()}
     if "model" not in data:
         raise SceneError(f"scene{where} does not name a model; valid models: {sorted(models())}")
     if not isinstance(data["model"], str):

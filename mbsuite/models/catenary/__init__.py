@@ -7,10 +7,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...accuracy import AccuracySpec
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import mujoco, reference
+from . import accuracy, mujoco, reference
 from .config import validate_train_section
 from .pantographs import PANTOGRAPHS, validate_section
 from .params import CatenaryParams
@@ -48,4 +49,5 @@ SPEC = ModelSpec(
     solver=SolverSettings(engine="reference", timestep=1e-4, duration=6.1),
     sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train_section},
     cases="mbsuite.models.catenary.cases",
+    accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
 )

@@ -1,15 +1,20 @@
 """The catenary's suite declarations: its hard cases (one pantograph near the wave speed; two pantographs: the
 trailing one near the warning limit, contact loss on both, slack droppers under both, a steady-arm start) and the
 random admissible inputs of the random-input test (collected by `mbsuite.hardcases` and the suite's tests through
-`SPEC.cases`). The catenary declares no work-precision study: its accuracy evidence is the mesh/time-step convergence
-of the EN 50318 statistics (README, slow tests)."""
+`SPEC.cases`), and the work-precision study (`workprecision_study`, `CatenaryStudy`: element length x time step
+against the EN 50318 statistics' errors and CPU, `docs/accuracy.md`)."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 import warnings
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from ...analysis.workprecision import Setting, Study
 from ...errors import ParameterError
 from ...hardcases import Checker, HardCase
 from ...scenes import Scene
@@ -187,3 +192,127 @@ def random_input(scene: Scene, rng: np.random.Generator) -> dict:
     if scene.effects["pantograph"] not in PANTOGRAPH_MODELS:
         out["solver"]["engine"] = "reference"
     return out
+
+
+# ================================================================================================ work-precision
+def passage_stats(scene: Scene, element_length: float, dt: float, speeds: tuple[float, ...]) -> dict[str, list]:
+    """The statistics (`accuracy.STATS`) of every pantograph of the scene's passage (its `[train]`, on its path) at
+    each speed with this element length and time step: {"250": [{stat: value} per pantograph], ...}. The size guards
+    grow with the resolution (the study asks for it); a run past the wave-resolution bound is kept."""
+    from .accuracy import STATS
+    from .analysis import scene_config
+    from .config import CriticalSpeedWarning
+    from .train import run_passage
+
+    p = scene.build_params()
+    sc = scene.replace(params={"element_length": element_length, "max_element_steps": max(
+        p.max_element_steps, 1e12)}, solver={"timestep": dt, "max_steps": 1e9, "allow_inaccurate": True})
+    out = {}
+    for v in speeds:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CriticalSpeedWarning)
+            run = run_passage(scene_config(sc, sc.solver.engine, speed_kmh=v))
+        out[f"{v:g}"] = [{k: float(st[k]) for k in STATS} for st in run.stats]
+    return out
+
+
+def _source_digest() -> str:
+    """A digest of the catenary's code (every .py and .c file of the model): a cached reference is only reused by the
+    code that computed it."""
+    h = hashlib.sha256()
+    root = Path(__file__).parent
+    for f in sorted([*root.glob("*.py"), *root.glob("native/*.c"), *root.glob("native/*.h")]):
+        h.update(f.name.encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+class CatenaryStudy(Study):
+    """Work-precision study of a catenary scene: element length x time step (every pantograph of the scene's passage,
+    both EN 50318 speeds; one setting's CPU is both passages') against a reference at 0.0625 m / 2.5e-5 s, whose
+    own accuracy is shown against 0.125 m / 5e-5 s. Errors are those of the eight statistics (`accuracy.py`)."""
+
+    ELEMENTS = (1.0, 0.5, 0.25, 0.125)
+    STEPS = (4e-4, 2e-4, 1e-4, 5e-5)
+    SPEEDS = (250.0, 300.0)
+    REFERENCE = (0.0625, 2.5e-5)
+    CHECK = (0.125, 5e-5)
+    #: where references are cached (None: computed every time); keyed by the scene, resolution, speeds and the code
+    reference_cache: Path | None = None
+    state_doc = ("max |statistic - ref| over the six force statistics (Fm, sigma, Fm +/- 3 sigma, actual max and "
+                 "min of the 20 Hz filtered force), every pantograph and both speeds (N)")
+    physics_doc = ("max |statistic - ref| / declared tolerance over the eight statistics (1 N on the forces, 0.5 mm "
+                   "on the uplift, 0.02 % on the contact loss), every pantograph and both speeds (1 = the tolerance)")
+
+    def __init__(self, scene: Scene, quick: bool = False):
+        super().__init__(scene, quick)
+        if quick:  # one speed, two coarse settings against the shipped-scene resolution
+            self.elements, self.steps, self.speeds = (2.0, 1.0), (8e-4, 4e-4), (float(scene.input["speed"]),)
+            self.ref_res, self.check_res = (0.5, 2e-4), (1.0, 4e-4)
+        else:
+            self.elements, self.steps, self.speeds = self.ELEMENTS, self.STEPS, self.SPEEDS
+            self.ref_res, self.check_res = self.REFERENCE, self.CHECK
+
+    def _stats(self, h: float, dt: float) -> dict[str, list]:
+        return passage_stats(self.scene, h, dt, self.speeds)
+
+    def settings(self) -> list[Setting]:
+        """Element length x time step, trapezoidal rule."""
+        return [Setting("fe", "trapezoidal", f"h {h:g} m, dt {dt:g} s", lambda h=h, dt=dt: self._stats(h, dt))
+                for h in self.elements for dt in self.steps]
+
+    def _cached(self, h: float, dt: float) -> dict[str, list]:
+        if self.reference_cache is None:
+            return self._stats(h, dt)
+        key = hashlib.sha256(json.dumps([self.scene.to_dict(), h, dt, self.speeds, _source_digest()],
+                                        sort_keys=True, default=str).encode()).hexdigest()[:20]
+        f = Path(self.reference_cache) / f"catenary_reference_{key}.json"
+        if f.exists():
+            return json.loads(f.read_text())
+        out = self._stats(h, dt)
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_text(json.dumps(out))
+        return out
+
+    def reference(self):
+        """The reference statistics (finest resolution) and their check against the next coarser one."""
+        ref = self._cached(*self.ref_res)
+        chk = self._cached(*self.check_res)
+        err, det = self.physics_error(chk, ref)
+        return ref, {"reference": f"element length {self.ref_res[0]:g} m, dt {self.ref_res[1]:g} s (speeds "
+                                  f"{', '.join(f'{v:g}' for v in self.speeds)} km/h)",
+                     "check": f"{self.check_res[0]:g} m, {self.check_res[1]:g} s",
+                     "check_state_error": self.state_error(chk, ref), "check_physics_error": err,
+                     "check_details": det, "reference_values": ref}
+
+    @staticmethod
+    def _errors(res: dict[str, list], ref: dict[str, list]) -> dict[str, float]:
+        """Per speed and pantograph: the largest force-statistic error (N), the uplift error (mm), the loss error
+        (%)."""
+        from .accuracy import STATS, UNITS
+
+        out: dict[str, float] = {}
+        for v, pans in ref.items():
+            for k, (a, b) in enumerate(zip(res[v], pans, strict=True)):
+                tag = f"{v}kmh_p{k + 1}"
+                out[f"{tag}_force_N"] = max(abs(a[s] - b[s]) for s in STATS if UNITS[s] == "N")
+                out[f"{tag}_uplift_mm"] = abs(a["uplift_mm"] - b["uplift_mm"])
+                out[f"{tag}_loss_pct"] = abs(a["loss_pct"] - b["loss_pct"])
+        return out
+
+    def state_error(self, res: Any, ref: Any) -> float:
+        """The class's `state_doc`."""
+        return max(e for k, e in self._errors(res, ref).items() if k.endswith("_force_N"))
+
+    def physics_error(self, res: Any, ref: Any) -> tuple[float, dict]:
+        """The class's `physics_doc`, and the errors per speed and pantograph."""
+        from .accuracy import TOL
+
+        det = self._errors(res, ref)
+        scale = {"force_N": TOL["Fm"], "uplift_mm": TOL["uplift_mm"], "loss_pct": TOL["loss_pct"]}
+        return max(e / scale[k.split("_", 2)[2]] for k, e in det.items()), det
+
+
+def workprecision_study(scene: Scene, quick: bool = False) -> Study:
+    """The `workprecision_study` hook: the catenary study of this scene."""
+    return CatenaryStudy(scene, quick=quick)

@@ -1,12 +1,14 @@
-"""`mbsuite catenary SCENE --speed KMH [--engine E] [--with-linear] [--quality [--system S]] [--json] [--out DIR]`:
-EN 50318 statistics and the current-collection quality report."""
+"""`mbsuite catenary SCENE --speed KMH [--engine E] [--with-linear] [--quality [--system S]] [--error-estimate]
+[--allow-inaccurate] [--json] [--out DIR]`: EN 50318 statistics, the current-collection quality report and the
+statistics' estimated errors (`accuracy.py`)."""
 
 from __future__ import annotations
 
 import argparse
 
+from ...cli.options import add_error_estimate, add_scene_options, check_workers
 from ...errors import SceneError
-from ...results import Progress
+from ...results import Progress, Report
 from ...scenes import Scene, load_scene
 
 COMMAND = "catenary"
@@ -33,6 +35,10 @@ def register(sub, add_common, emit) -> str:
                         "else AC)")
     p.add_argument("--spacings", type=float, nargs="+", default=None,
                    help="distances (m) between consecutive pantographs of a [train] scene (overrides the scene)")
+    p.add_argument("--workers", type=int, default=0,
+                   help="local processes for the refined passages of --error-estimate (0 = all cores)")
+    add_error_estimate(p)
+    add_scene_options(p)
     add_common(p)
     p.set_defaults(func=cmd_catenary, emit=emit)
     return COMMAND
@@ -65,8 +71,14 @@ def _scene(args: argparse.Namespace) -> Scene:
         scene = scene.replace(params={"element_length": args.element_length})
     if args.speed is not None:
         scene = scene.replace(input={"speed": args.speed})
-    if args.spacings is not None and "train" not in scene.sections:
-        raise SceneError("--spacings needs a scene with a [train] section (e.g. catenary/en50318_two_pantographs)")
+    if getattr(args, "allow_inaccurate", False):
+        scene = scene.replace(solver={"allow_inaccurate": True})
+    if getattr(args, "max_steps", None) is not None:
+        scene = scene.replace(solver={"max_steps": args.max_steps})
+    if args.spacings is not None:
+        if "train" not in scene.sections:
+            raise SceneError("--spacings needs a scene with a [train] section (e.g. catenary/en50318_two_pantographs)")
+        scene = scene.replace(train={"spacings": list(args.spacings)})
     return scene
 
 
@@ -84,10 +96,14 @@ def cmd_catenary(args: argparse.Namespace) -> None:
         if args.system is not None:
             sec["system"] = args.system
         criteria = criteria_from(sec)
+    workers = check_workers(args.workers)
     if "train" in scene.sections:
         with Progress(100, desc="catenary train") as bar:
-            run = run_train_scene(scene, progress=_Percent(bar), spacings=args.spacings)
-        args.emit(train_report(run, quality=criteria), args, scene.to_dict())
+            run = run_train_scene(scene, progress=_Percent(bar))
+        rep = train_report(run, quality=criteria)
+        if args.error_estimate:
+            add_estimate(rep, scene, run.stats, workers)
+        args.emit(rep, args, scene.to_dict())
         return
     variants = [scene]
     if args.with_linear and scene.effects["droppers"] != "linear":
@@ -96,4 +112,24 @@ def cmd_catenary(args: argparse.Namespace) -> None:
     for sc in variants:
         with Progress(100, desc=f"catenary {sc.effects['droppers']}") as bar:
             runs.append(run_scene(sc, progress=_Percent(bar)))
-    args.emit(report(runs[0], scene.to_dict(), runs[1:], quality=criteria), args, scene.to_dict())
+    rep = report(runs[0], scene.to_dict(), runs[1:], quality=criteria)
+    if args.error_estimate:
+        add_estimate(rep, scene, [runs[0].stats], workers)
+    args.emit(rep, args, scene.to_dict())
+
+
+def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0) -> None:
+    """Estimate the error of every pantograph's statistics of the passage `stats` (the scene's own run, leading
+    pantograph first) from the scene refined once and twice (`accuracy.refine`, run in parallel), judge each estimate
+    against its tolerance (`AccuracyError` naming the statistic and the setting to refine, unless the scene allows
+    inaccurate results: then a warning) and add the table, `error_estimate` and the warnings to the report."""
+    from ...analysis.errorestimate import error_estimate
+    from ...health import judge
+    from .accuracy import passage_values, stats_values
+
+    est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers)
+    warned = judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                   what=f"catenary scene {scene.name or scene.source or ''}".strip())
+    rep.data["error_estimate"] = est.to_dict()
+    rep.data["warnings"] = list(rep.data.get("warnings", [])) + warned
+    rep.table = "\n".join([rep.table, est.table(), *warned])

@@ -1,0 +1,206 @@
+"""The catenary's declared accuracy (`mbsuite/models/catenary/accuracy.py`): the headline names of one and two
+pantographs, their values against the EN 50318 statistics computed here from the run's signals, the refinement, the
+`mbsuite catenary --error-estimate` command, the work-precision study's error measure; slow: every shipped scene's
+statistics within their tolerances of a 4x finer run, and the error estimate bracketing the true error."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.signal import butter, filtfilt
+
+import mbsuite
+from mbsuite.accuracy import declared
+from mbsuite.analysis.errorestimate import error_estimate
+from mbsuite.errors import SceneError
+from mbsuite.health import InaccurateResultWarning
+from mbsuite.models.catenary import accuracy
+from mbsuite.models.catenary.cases import CatenaryStudy
+
+STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
+SCENES = ("en50318", "en50318_linear", "en50318_two_pantographs", "en50318_eppinger", "eppinger_lab")
+
+#: a two-span line (120 m) passed at 150 km/h, window over the middle support, its edges between samples (spacing
+#: V dt = 8.3 mm): a passage of well under a second
+SHORT = {"n_spans": 2, "x_end": 110.0, "window_start": 25.004, "window_end": 95.004}
+
+
+def _short(**params) -> mbsuite.Scene:
+    return mbsuite.load_scene("catenary").replace(params={**SHORT, **params}, input={"speed": 150.0})
+
+
+def test_headlines_of_one_and_two_pantographs():
+    one = declared(mbsuite.load_scene("catenary/en50318"))
+    assert [h.name for h in one] == list(STATS)
+    assert {h.name: (h.unit, h.tol) for h in one} == {
+        **{s: ("N", 1.0) for s in STATS[:6]}, "uplift_mm": ("mm", 0.5), "loss_pct": ("%", accuracy.LOSS_TOL)}
+    two = mbsuite.load_scene("catenary/en50318_two_pantographs")
+    assert [h.name for h in declared(two)] == [f"p{k}_{s}" for k in (1, 2) for s in STATS]
+    # a scene's [accuracy] section names a pantograph's statistic; a single pantograph's name is not one of a train's
+    assert {h.name: h.tol for h in declared(two.replace(accuracy={"p2_max": 3.0}))}["p2_max"] == 3.0
+    with pytest.raises(SceneError, match=r"unknown headline\(s\) \['max'\]"):
+        two.replace(accuracy={"max": 3.0})
+
+
+def _independent_stats(t, x, force, p, uplift_cols: dict[float, np.ndarray] | None) -> dict[str, float]:
+    """The EN 50318 statistics from the signals, written here: 4th-order Butterworth at 20 Hz in transfer-function form
+    run forwards and backwards (scipy filtfilt, the same odd padding of 15 samples), window by position, population
+    sigma; uplift the largest steady-arm displacement inside the window (mm); loss = share of window samples with
+    force <= 0 (%)."""
+    dt = float(t[1] - t[0])
+    b, a = butter(4, 20.0, fs=1.0 / dt)
+    ff = filtfilt(b, a, force, padlen=15)
+    w = (x >= p.window_start) & (x <= p.window_end)
+    fw = ff[w]
+    out = {"Fm": fw.mean(), "sigma": fw.std(), "max": fw.max(), "min": fw.min(),
+           "loss_pct": 100.0 * np.mean(force[w] <= 0.0)}
+    out.update(stat_max=out["Fm"] + 3 * out["sigma"], stat_min=out["Fm"] - 3 * out["sigma"])
+    if uplift_cols is not None:
+        out["uplift_mm"] = 1000 * max(float(u.max()) for xs, u in uplift_cols.items()
+                                      if p.window_start <= xs <= p.window_end)
+    return out
+
+
+def test_values_against_statistics_computed_from_the_signals():
+    """One pantograph on the two-span line, contact lost (F0 = 30 N at 150 km/h, so the loss is a real number): the
+    headline values against the statistics computed here from the SimResult's force, position and uplift signals.
+    Measured: forces 8.4e-8 N (the rounding of the transfer-function form of the filter at f_c / f_s = 0.004), uplift
+    and loss exact; bound 1e-6 N (12x; a sample-variance sigma would be off by 1e-3 N)."""
+    sc = _short(F0=30.0)
+    res = mbsuite.run(sc)
+    vals = accuracy.values(sc, res)
+    p = sc.build_params()
+    ups = {float(k[len("uplift_"):-1]): res[k] for k in res.signals if k.startswith("uplift_")}
+    ref = _independent_stats(res.t, res["position"], res["contact_force"], p, ups)
+    assert ref["loss_pct"] > 0.1 and ref["uplift_mm"] > 1.0  # a real loss, a real uplift
+    for s in STATS:
+        assert vals[s] == pytest.approx(ref[s], abs=1e-6), s
+
+
+def test_train_values_against_statistics_computed_from_the_signals():
+    """Two pantographs 30 m apart on the two-span line: each one's force statistics from its own record
+    (`contact_force_p<k>`, `position_p<k>`) against `p<k>_...`. Measured 3.6e-7 N (the filter's transfer-function
+    form, as above), loss exact; bound 3e-6 N (8x)."""
+    sc = _short().replace(train={"pantographs": ["reference2mass", "reference2mass"], "spacings": [30.0]},
+                          params={"n_spans": 3, "x_end": 110.0})
+    res = mbsuite.run(sc)
+    vals = accuracy.values(sc, res)
+    assert len(vals) == 16
+    p = sc.build_params()
+    for k in (1, 2):
+        ref = _independent_stats(res.t, res[f"position_p{k}"], res[f"contact_force_p{k}"], p, None)
+        for s in STATS[:6] + ("loss_pct",):
+            assert vals[f"p{k}_{s}"] == pytest.approx(ref[s], abs=3e-6), (k, s)
+    assert vals["p1_sigma"] != vals["p2_sigma"]  # two records, not one read twice
+
+
+def test_refinement_halves_element_length_and_timestep_together():
+    sc = mbsuite.load_scene("catenary/en50318")
+    ref = accuracy.refinement(sc)
+    assert (ref.factor, ref.order) == (2.0, accuracy.ORDER)
+    assert ref.refine(sc, 0) is sc
+    p, s = sc.build_params(), sc.solver
+    two = ref.refine(sc, 2)
+    p2, s2 = two.build_params(), two.solver
+    assert (p2.element_length, s2.timestep) == (p.element_length / 4, s.timestep / 4)
+    # the size guards grow with the work: elements x steps by 16, steps by 4
+    assert (p2.max_element_steps, s2.max_steps) == (16 * p.max_element_steps, 4 * s.max_steps)
+    # the wave Courant number c dt / h of the run is held
+    assert s2.timestep / p2.element_length == pytest.approx(s.timestep / p.element_length, rel=1e-15)
+
+
+def _cli_scene(tmp_path, extra: str = "") -> str:
+    f = tmp_path / "short.toml"
+    f.write_text('model = "catenary"\n[params]\nelement_length = 1.0\nn_spans = 2\nx_end = 110.0\n'
+                 'window_start = 25.0\nwindow_end = 95.0\n[input]\ntype = "passage"\nspeed = 150.0\n'
+                 f'[solver]\ntimestep = 4e-4\n{extra}')
+    return str(f)
+
+
+def test_cli_error_estimate_judges_every_statistic(tmp_path, capsys):
+    """`mbsuite catenary SCENE --error-estimate` on a two-span line at 1 m / 4e-4 s: a tolerance the estimate
+    exceeds is an error (exit 2) naming the statistic and the setting to refine; with --allow-inaccurate the run is
+    kept: every statistic's row (value = the run's statistic, the two refined values = passages at 0.5 m / 2e-4 s
+    and 0.25 m / 1e-4 s) in the JSON, in summary.json and, past its tolerance, in the warnings."""
+    from mbsuite.cli import main
+
+    scene = _cli_scene(tmp_path, "[accuracy]\nsigma = 1e-9\n")
+    assert main(["catenary", scene, "--error-estimate", "--workers", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "error_estimate[sigma]" in err and "refine params.element_length + solver.timestep" in err
+    out = tmp_path / "out"
+    with pytest.warns(InaccurateResultWarning):
+        assert main(["catenary", scene, "--error-estimate", "--workers", "2", "--allow-inaccurate", "--json",
+                     "--out", str(out)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    est = data["error_estimate"]
+    assert est["levels"] == ["params.element_length = 1, solver.timestep = 0.0004",
+                             "params.element_length = 0.5, solver.timestep = 0.0002",
+                             "params.element_length = 0.25, solver.timestep = 0.0001"]
+    rows = {r["name"]: r for r in est["rows"]}
+    assert list(rows) == list(STATS)
+    stats = data["runs"]["slack"]["statistics"]
+    assert all(rows[s]["value"] == stats[s] for s in STATS)
+    fine = mbsuite.run(mbsuite.load_scene(scene).replace(params={"element_length": 0.25},
+                                                          solver={"timestep": 1e-4}))
+    assert all(rows[s]["refined"][1] == fine.stats[s] for s in STATS)
+    assert not rows["sigma"]["ok"]
+    over = sorted(r["name"] for r in rows.values() if not r["ok"])
+    assert sorted(w.split("error_estimate[")[1].split("]")[0] for w in data["warnings"]
+                  if "error_estimate[" in w) == over
+    assert json.loads((out / "summary.json").read_text())["results"]["error_estimate"]["rows"] == est["rows"]
+
+
+def test_study_error_is_the_largest_statistic_error_over_its_tolerance():
+    """Hand values: force errors 0.3 N (speed 250) and 0.1 N, uplift 0.4 mm (0.8 of 0.5 mm), loss 0.01 %."""
+    ref = {"250": [{s: 10.0 for s in STATS}], "300": [{s: 20.0 for s in STATS}]}
+    res = {"250": [{**{s: 10.0 for s in STATS}, "max": 10.3, "uplift_mm": 10.4}],
+           "300": [{**{s: 20.0 for s in STATS}, "Fm": 19.9, "loss_pct": 20.0 + accuracy.LOSS_TOL / 2}]}
+    st = CatenaryStudy(mbsuite.load_scene("catenary/en50318"))
+    assert st.state_error(res, ref) == pytest.approx(0.3)
+    err, det = st.physics_error(res, ref)
+    assert err == pytest.approx(0.8)
+    assert det["300kmh_p1_loss_pct"] == pytest.approx(accuracy.LOSS_TOL / 2)
+
+
+# ----------------------------------------------------------------------------------------------------- slow proofs
+def _fine(scene: mbsuite.Scene, factor: int) -> mbsuite.Scene:
+    p, s = scene.build_params(), scene.solver
+    return scene.replace(params={"element_length": p.element_length / factor, "max_element_steps": 1e12},
+                         solver={"timestep": s.timestep / factor, "max_steps": 1e9})
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SCENES)
+def test_shipped_scene_meets_its_tolerances_against_a_4x_finer_run(name):
+    """Every headline of every shipped scene at its defaults within its declared tolerance of the same scene with
+    element length and time step divided by 4 (16x the work)."""
+    sc = mbsuite.load_scene(f"catenary/{name}")
+    base = accuracy.values(sc, mbsuite.run(sc))
+    fine = accuracy.values(sc, mbsuite.run(_fine(sc, 4)))
+    for h in declared(sc):
+        assert abs(base[h.name] - fine[h.name]) <= h.tol, (h.name, base[h.name], fine[h.name])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("speed", [250.0, 300.0])
+def test_error_estimate_brackets_the_true_error_on_en50318(speed):
+    """en50318 at its defaults: the estimate (levels 1x, 2x, 4x finer) against the true error, the distance to a run
+    8x finer (0.0625 m / 2.5e-5 s at the shipped 0.5 m / 2e-4 s), for every statistic whose true error is above the
+    finest run's own (a quarter of the 4x-finer level's distance to it): estimate >= true error and <= 10x it."""
+    sc = mbsuite.load_scene("catenary/en50318").replace(input={"speed": speed})
+    est = error_estimate(sc, workers=2)
+    ref = accuracy.values(sc, mbsuite.run(_fine(sc, 8)))
+    checked = 0
+    for r in est.rows:
+        true = abs(r.value - ref[r.name])
+        floor = abs(r.refined[1] - ref[r.name]) / 4
+        if true <= max(floor, 1e-6):
+            continue
+        checked += 1
+        assert true <= r.error <= 10.0 * true, (r.name, r.error, true)
+    assert checked >= 4
+    assert all(math.isfinite(r.error) and r.ok for r in est.rows)

@@ -95,7 +95,13 @@ def design_grid(scene, speeds: Sequence[float], vary: Mapping[str, Sequence[floa
     results = run_sweep(evaluate, points, workers=workers, progress=progress, desc="catenary design grid",
                         **sweep_kw)
     return {"speeds": [float(v) for v in speeds], "vary": {n: [float(x) for x in vary[n]] for n in names},
-            "points": results}
+            "points": results, "resolution": resolution(scene)}
+
+
+def resolution(scene) -> dict[str, float]:
+    """The element length (m) and time step (s) every point of the scene's grid runs at: the statistics' accuracy
+    follows from them (`accuracy.py`; `mbsuite catenary SCENE --error-estimate` estimates it for one point)."""
+    return {"element_length": float(scene.build_params().element_length), "timestep": float(scene.solver.timestep)}
 
 
 def plot_grid(grid: dict[str, Any], out: str | Path) -> list[Path]:
@@ -142,6 +148,10 @@ def grid_figure(grid: dict[str, Any]) -> MplFigure:
             sub = ", ".join(f"{n} = {v:g} {_unit(n)}".rstrip() for n, v in zip(rest, rc, strict=True))
             ax.set_title(f"{title}{'; ' + sub if sub else ''}\n(red numbers fail)", fontsize=9)
             fig.colorbar(im, ax=ax)
+    res = grid.get("resolution")
+    if res:
+        fig.suptitle(f"every point at element length {res['element_length']:g} m, time step {res['timestep']:g} s",
+                     fontsize=9)
     return fig
 
 

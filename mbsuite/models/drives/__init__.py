@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...accuracy import AccuracySpec
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import equations, mujoco
+from . import accuracy, equations, mujoco
 from .params import PARAM_SETS, DriveParams
 from .scene_run import SIGNALS
 
@@ -61,5 +62,6 @@ SPEC = ModelSpec(
                           what="MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
     },
     cases="mbsuite.models.drives.cases",
+    accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),
 )

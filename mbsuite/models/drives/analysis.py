@@ -10,14 +10,14 @@ from typing import Any
 
 import numpy as np
 
+from ...analysis.errorestimate import run_values
 from ...errors import SceneError
-from ...paths import mjcf_path
+from ...health import judge
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
 from . import coupled_clutches as cc
 from . import design as D
 from . import drive, equations, mujoco
-from .event_exact import simulate_reference
 from .rotor_system import RefResult, RotorSystem
 
 #: each path's simulation of a scene, returning (result, controller, rotor system) for the analyses: the runs behind
@@ -37,7 +37,11 @@ def steady_window(scene: Scene) -> float:
 
 def efficiency_point(scene: Scene) -> dict[str, Any]:
     """One open-loop run: averages over t >= t_settle of speeds, input/output power, losses (W), efficiency."""
-    res, ctrl, system = simulate_scene(scene)
+    return _efficiency_point(scene, *simulate_scene(scene))
+
+
+def _efficiency_point(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> dict[str, Any]:
+    """`efficiency_point` of a run already made."""
     t0 = steady_window(scene)
     i0 = int(np.searchsorted(res.t, t0))
     T = res.t[-1] - res.t[i0]
@@ -69,20 +73,75 @@ EFF_COLUMNS = (("tau_l", "tau_l", "N m", "tau_l [N m]", 1.0), ("load_speed", "w_
                ("balance_relative", "balance_residual", "1", "balance [-]", 1.0))
 
 
-def efficiency(scene: Scene, loads: list[float], engine: str | None = None) -> Report:
+#: the headlines (`accuracy.py`) of an efficiency curve's point: its count of events, cycle-mean speeds, efficiency
+EFFICIENCY_HEADLINES = ("n_events", "mean_load_speed", "mean_motor_speed", "efficiency")
+
+
+def efficiency_values(scene_d: dict) -> dict[str, float]:
+    """The efficiency-curve headlines of one run of the scene `scene_d` (a `Scene.to_dict()`; module-level: the
+    refined copies of `efficiency(..., error_estimate=True)` run it in worker processes)."""
+    from ...scenes import scene_from_dict
+
+    sc = scene_from_dict(scene_d)
+    return _headlines_of(sc, *simulate_scene(sc), EFFICIENCY_HEADLINES)
+
+
+def _headlines_of(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem,
+                  names: tuple[str, ...] | None = None) -> dict[str, float]:
+    """The scene's headline values (`accuracy.values`) of a run already made, all or only `names`."""
+    from .accuracy import values
+    from .scene_run import sim_result
+
+    v = values(scene, sim_result(scene, res, ctrl, system))
+    return {k: x for k, x in v.items() if names is None or k in names}
+
+
+def estimate_points(scenes: list[Scene], bases: list[dict[str, float]], evaluate, names: tuple[str, ...] | None,
+                    workers: int = 0) -> list[Any]:
+    """The error estimate (`mbsuite.accuracy`) of several runs at once: every run's two refined copies in one
+    parallel batch (`workers` local processes, 0 = all cores); `bases` are the runs' own headline values and
+    `evaluate(scene_dict)` computes one refined copy's (module-level). Headlines restricted to `names` (None: all)."""
+    from ...accuracy import declared, estimate
+    from ...analysis.errorestimate import level_settings
+    from ...analysis.sweep import run_sweep
+
+    refs = [sc.spec.accuracy.refinement(sc) for sc in scenes]
+    levels = [[r.refine(sc, k) for k in (0, 1, 2)] for sc, r in zip(scenes, refs, strict=True)]
+    jobs = [lv[k].to_dict() for lv in levels for k in (2, 1)]  # the most refined first: the longest runs start first
+    out = run_sweep(evaluate, jobs, workers=workers, desc="error estimate", executor="local")
+    ests = []
+    for i, (sc, ref, lv, base) in enumerate(zip(scenes, refs, levels, bases, strict=True)):
+        heads = tuple(h for h in declared(sc) if names is None or h.name in names)
+        ests.append(estimate([dict(base), dict(out[2 * i + 1]), dict(out[2 * i])], heads, ref,
+                             settings=level_settings(sc, lv)))
+    return ests
+
+
+def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, error_estimate: bool = False,
+               workers: int = 0) -> Report:
     """Open-loop efficiency sweep over load torques (one `efficiency_point` per load): a table of the operating
     points and one of the mean loss powers; `--out` writes efficiency.csv (SI units in the header) and efficiency.png
-    (`plots.efficiency_figure`: the curve ordered by load speed, non-switching points apart, losses as sorted bars)."""
+    (`plots.efficiency_figure`: the curve ordered by load speed, non-switching points apart, losses as sorted bars).
+
+    `error_estimate`: every point also runs refined once and twice (`mbsuite.accuracy`; all points' copies in one
+    parallel batch) and its efficiency-curve headlines (`EFFICIENCY_HEADLINES`) get an estimated error: a table per
+    point and `data["points"][i]["error_estimate"]`; an estimate past its tolerance is an `AccuracyError` naming the
+    point (a warning in `data["warnings"]` when the scene allows inaccurate results)."""
     if scene.effects["mechanism"] == "coupled_clutches":
         raise SceneError("efficiency needs a drive scene (mechanism step_up or step_up_down)")
     if scene.effects.get("closed_loop"):
         raise SceneError("efficiency curves are open-loop runs: use a scene with closed_loop = false")
-    pts = []
+    pts, scenes, bases = [], [], []
     for tl in loads:
         if tl < 0:
             raise SceneError(f"load torque must be >= 0, got {tl}")
         sc = scene.replace(params={"tau_l": float(tl)}, solver={"engine": engine} if engine else {})
-        pts.append(efficiency_point(sc))
+        run = simulate_scene(sc)
+        pts.append(_efficiency_point(sc, *run))
+        if error_estimate:
+            scenes.append(sc)
+            bases.append(_headlines_of(sc, *run, EFFICIENCY_HEADLINES))
+    ests = estimate_points(scenes, bases, efficiency_values, EFFICIENCY_HEADLINES, workers) if error_estimate else []
     labels = sorted({k for p in pts for k in p["losses_W"]}, key=lambda k: list(LOSS_SHORT).index(k)
                     if k in LOSS_SHORT else len(LOSS_SHORT))
 
@@ -99,6 +158,9 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None) -> R
     from .plots import loss_label
 
     table += "\n" + textwrap.fill("; ".join(f"{LOSS_SHORT.get(k, k)} = {loss_label(k)}" for k in labels), 100)
+    for p, est in zip(pts, ests, strict=True):
+        p["error_estimate"] = est.to_dict()
+        table += f"\n\ntau_l = {p['tau_l']:g} N m: " + est.table()
 
     def write(out: Path) -> list[Path]:
         from ...plotting import save
@@ -109,7 +171,15 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None) -> R
         fig = efficiency_figure(pts, scene.name)
         return [write_csv(out / "efficiency.csv", cols), save(fig, out / "efficiency.png")]
 
-    return Report({"scene": scene.name, "points": pts}, table, write)
+    data: dict[str, Any] = {"scene": scene.name, "points": pts}
+    warned = []
+    for p, est in zip(pts, ests, strict=True):  # an estimate past its tolerance: AccuracyError naming the point
+        warned += judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                        what=f"drives efficiency {scene.name} at tau_l = {p['tau_l']:g} N m")
+    if warned:
+        data["warnings"] = warned
+        table += "\n\n" + "\n".join(warned)
+    return Report(data, table, write)
 
 
 def _tidy(v: float, scale: float) -> float:
@@ -175,22 +245,30 @@ def design_tables() -> Report:
     return Report(data, table + "\n'ours' and 'thesis' are in the unit of the row.", write)
 
 
-def coupled_clutches_table(timestep: float = 1e-4) -> dict[str, Any]:
-    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s (MuJoCo at
-    `timestep`)."""
+def coupled_clutches_table(timestep: float = 1e-4, *, error_estimate: bool = False, workers: int = 0,
+                           scene: Scene | None = None) -> dict[str, Any]:
+    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s. The runs are
+    the scene `drives/coupled_clutches` (or `scene`) on each path, MuJoCo at `timestep`: the settings of
+    `mbsuite run drives/coupled_clutches [--engine mujoco]`. `error_estimate`: each path's headlines (`accuracy.py`)
+    also get their estimated error from the scene refined once and twice (`out[path]["error_estimate"]`, an
+    `ErrorEstimate`)."""
+    from ...scenes import load_scene
+
+    base = scene if scene is not None else load_scene("drives/coupled_clutches")
     ref = cc.load_reference()
     rev = cc.reference_events(ref)
     out: dict[str, Any] = {"reference_events": rev}
-    system = cc.build_system()
     grid = np.round(np.arange(0.0, cc.T_END + 1e-9, 0.1), 10)
     j_ref = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
     out["grid"] = grid.tolist()
     out["w_ref"] = ref["w"][:, j_ref].T.tolist()
-    runs = {"reference": lambda: simulate_reference(system, cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3),
-            "mujoco": lambda: mujoco.MujocoRotorSim(system, mjcf_path("coupled_clutches"), timestep=timestep).run(
-                cc.Q0, cc.W0, cc.T_END, sample_dt=1e-3)}
-    for eng, simulate in runs.items():
-        res = simulate()
+    scenes = {"reference": base.replace(solver={"engine": "reference"}),
+              "mujoco": base.replace(solver={"engine": "mujoco", "timestep": timestep})}
+    bases = {}
+    for eng, sc in scenes.items():
+        run = simulate_scene(sc)
+        res = run[0]
+        bases[eng] = _headlines_of(sc, *run)
         ev = cc.events_as_codes(res.events)
         rows = cc.match_events(ev, rev)
         idx = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
@@ -200,4 +278,8 @@ def coupled_clutches_table(timestep: float = 1e-4) -> dict[str, Any]:
                     "same_sequence": all(r["t"] is not None and r["t_ref"] is not None for r in rows),
                     "max_event_dt": float(max(abs(x) for x in dts)) if dts else math.nan,
                     "max_w_err": float(np.max(np.abs(w - np.asarray(out["w_ref"]))))}
+    if error_estimate:
+        ests = estimate_points(list(scenes.values()), list(bases.values()), run_values, None, workers)
+        for eng, est in zip(scenes, ests, strict=True):
+            out[eng]["error_estimate"] = est
     return out

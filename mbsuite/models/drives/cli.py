@@ -10,11 +10,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ...analysis.errorestimate import error_estimate
+from ...cli.options import add_error_estimate, add_scene_options
 from ...errors import MbsuiteError, SceneError
+from ...health import judge
 from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene
+from . import accuracy
 from . import coupled_clutches as cc
 from . import design as D
 from .analysis import coupled_clutches_table, design_tables, efficiency, simulate_scene
@@ -25,7 +29,8 @@ from .scene_run import sim_result
 CYCLE_QUANTITIES = {"n_cycles": ("energy cycles in the window t >= t_settle", ""),
                     "switching_rate": ("switching rate Sr (energy cycles per second)", "1/s"),
                     "mean_load_speed": ("mean load speed", "rad/s"), "mean_motor_speed": ("mean motor speed", "rad/s"),
-                    "max_extension": ("largest spring twist", "rad")}
+                    "max_extension": ("largest spring twist", "rad"),
+                    "efficiency": ("efficiency E_out / E_in over t >= t_settle", "1")}
 
 #: most time steps of `drive coupled-clutches` (scene runs are guarded by the scene's solver.max_steps)
 MAX_STEPS = DEFAULT_MAX_STEPS
@@ -187,6 +192,8 @@ def register(sub, add_common, emit) -> str:
     q.add_argument("scene", help="scene TOML, or drives/<scene>")
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
+    add_scene_options(q)
+    add_error_estimate(q)
     add_common(q)
     q.set_defaults(func=partial(run_cmd, emit))
 
@@ -195,11 +202,15 @@ def register(sub, add_common, emit) -> str:
     q.add_argument("--loads", type=_floats("--loads"), default=None, help="comma list of load torques (N m)")
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
+    add_scene_options(q)
+    add_error_estimate(q)
     add_common(q)
     q.set_defaults(func=partial(efficiency_cmd, emit))
 
     q = dsub.add_parser("coupled-clutches", help="Modelica CoupledClutches: both paths vs the Dymola reference")
-    q.add_argument("--timestep", type=float, default=1e-4)
+    q.add_argument("--timestep", type=float, default=1e-4, help="MuJoCo step (s; the scene's default)")
+    add_scene_options(q)
+    add_error_estimate(q)
     add_common(q)
     q.set_defaults(func=partial(coupled_clutches_cmd, emit))
     return "drive"
@@ -285,9 +296,15 @@ def gains_cmd(emit, a: argparse.Namespace) -> None:
 
 
 def run_cmd(emit, a: argparse.Namespace) -> None:
-    """`drive run`: a scene on its path with cycle statistics, energy balance and lock events."""
+    """`drive run`: a scene on its path with cycle statistics, energy balance and lock events; health figures judged
+    as by `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
     sc = _scene(a)
     res = sim_result(sc, *simulate_scene(sc))
+    if a.error_estimate:
+        res.error_estimate = error_estimate(sc, base=accuracy.values(sc, res))
+        res.health.extend(res.error_estimate.figures())
+    res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate,
+                              what=f"drives scene {sc.name or sc.source or ''}".strip()))
     eb = res.stats["energy_balance"]
     cyc = res.stats.get("cycles", {})
     rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
@@ -298,9 +315,13 @@ def run_cmd(emit, a: argparse.Namespace) -> None:
              ["stored", "change of stored energy", eb["stored"], "J"],
              ["balance", "energy residual / turnover", eb["relative"], "1"]]
     rows += [[f"loss_{k}", loss_label(k), v, "J"] for k, v in eb["losses"].items()]
-    rep = Report({"summary": res.summary(), "stats": res.stats}, _quantity_table(
-        [(k, m, float(v) if isinstance(v, float | np.floating) else str(v), u) for k, m, v, u in rows]),
-        partial(_write_run, res))
+    table = _quantity_table([(k, m, float(v) if isinstance(v, float | np.floating) else str(v), u)
+                             for k, m, v, u in rows])
+    if res.error_estimate is not None:
+        table += "\n\n" + res.error_estimate.table()
+    if res.warnings:
+        table += "\n\n" + "\n".join(res.warnings)
+    rep = Report({"summary": res.summary(), "stats": res.stats}, table, partial(_write_run, res))
     emit(rep, a, sc.to_dict())
 
 
@@ -314,14 +335,24 @@ def efficiency_cmd(emit, a: argparse.Namespace) -> None:
     _check_options(a, "--loads")
     sc = _scene(a)
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
-    emit(efficiency(sc, loads, engine=a.engine), a, sc.to_dict())
+    emit(efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate), a, sc.to_dict())
 
 
 def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
     """`drive coupled-clutches`: both paths against the Dymola reference (`analysis.coupled_clutches_table`)."""
     _check_options(a, "--timestep")
     _check_steps("--timestep", cc.T_END, a.timestep)
-    d = coupled_clutches_table(timestep=a.timestep)
+    scene = _solver_options(load_scene("drives/coupled_clutches"), a)
+    d = coupled_clutches_table(timestep=a.timestep, error_estimate=a.error_estimate, scene=scene)
+    estimates = ""
+    for eng in ("reference", "mujoco"):  # each path's estimate against its tolerances (AccuracyError naming it)
+        est = d[eng].pop("error_estimate", None)
+        if est is None:
+            continue
+        d[eng]["error_estimate"] = est.to_dict()
+        warned = judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                       what=f"drives coupled-clutches, path {eng}")
+        estimates += f"\n\n{eng} path: " + est.table() + "".join("\n" + w for w in warned)
     mode = {v: k for k, v in cc.MODE_CODE.items()}
     rows = []
     for i, r in enumerate(d["reference"]["events"]):
@@ -346,7 +377,7 @@ def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
                                         (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
     ref = cc.load_reference()
     write = partial(_write_coupled_clutches, d, ref["t"], ref["w"], ev_cols, w_cols)
-    emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2, write), a, None)
+    emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2 + estimates, write), a, None)
 
 
 def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,
@@ -380,4 +411,14 @@ def _scene(a: argparse.Namespace):
         if sc.solver.t_settle >= a.duration:
             upd["t_settle"] = 0.5 * a.duration
     # the scene's solver checks duration / timestep against solver.max_steps (the size guard)
+    return _solver_options(sc.replace(solver=upd) if upd else sc, a)
+
+
+def _solver_options(sc, a: argparse.Namespace):
+    """The scene with `--allow-inaccurate` and `--max-steps` applied (`mbsuite.cli.options.add_scene_options`)."""
+    upd: dict = {}
+    if getattr(a, "allow_inaccurate", False):
+        upd["allow_inaccurate"] = True
+    if getattr(a, "max_steps", None) is not None:
+        upd["max_steps"] = a.max_steps
     return sc.replace(solver=upd) if upd else sc

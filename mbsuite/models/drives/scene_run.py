@@ -17,6 +17,7 @@ from ...results import SimResult, assemble
 from ...scenes import Scene
 from . import coupled_clutches as cc
 from . import drive, msl
+from .accuracy import window_efficiency
 from .commands import Controller
 from .rotor_system import RefResult, RotorSystem
 
@@ -156,6 +157,8 @@ def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> 
     if ctrl is not None:
         cs = drive.cycle_stats(res, ctrl, t0=scene.solver.t_settle)
         cs.pop("packets", None)
+        if outputs:  # a load torque: the efficiency over the same window (Eq 3.22 corrected)
+            cs["efficiency"] = window_efficiency(res.t, sig["E_in"], sig["E_out"], scene.solver.t_settle)
         stats["cycles"] = cs
     # the scene's outputs in its order (an output of the other mechanisms is not computed, so not kept)
     ordered = {k: sig[k] for k in scene.outputs if k in sig}

@@ -1,0 +1,70 @@
+"""Study (not a test): the drives' declared accuracy measured on every shipped scene and both paths.
+
+For each scene and path: the headline values at the scene's settings (level 0) and refined once and twice (the
+error estimate of `mbsuite.accuracy`: hand path rtol / 10 per level, MuJoCo step / 2 per level), and a much finer
+run for the true error (hand path rtol 1e-12, atol 1e-14; MuJoCo the step / FINE). One Markdown row per headline:
+value, declared tolerance, estimated error, observed order, true error, estimate / true error. The tolerances of
+`mbsuite/models/drives/accuracy.py` are set a stated factor above the largest numbers of this table.
+
+    nice .venv/bin/python scripts/drives_accuracy.py [scene ...] [--engines reference mujoco] [--workers 2] \
+        [--json out/drives_accuracy.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+
+from mbsuite import load_scene
+from mbsuite.accuracy import declared
+from mbsuite.analysis.errorestimate import error_estimate, run_values
+
+#: how much finer than the scene's step the MuJoCo "true" run is
+FINE = 16
+
+
+def fine_scene(sc):
+    """The much finer run of the scene's path (the true error's reference)."""
+    if sc.solver.engine == "mujoco":
+        return sc.replace(solver={"timestep": sc.solver.timestep / FINE, "max_steps": sc.solver.max_steps * FINE})
+    return sc.replace(solver={"rtol": 1e-12, "atol": 1e-14})
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenes", nargs="*")
+    ap.add_argument("--engines", nargs="*", default=["reference", "mujoco"])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--json", default=None, help="also write every row as JSON lines to this file")
+    a = ap.parse_args()
+    names = a.scenes or sorted(load_scene("drives").spec.scene_files())
+    out = open(a.json, "a") if a.json else None  # noqa: SIM115 - appended row by row
+    print("| scene | path | headline | value | tol | est. error | observed order | true error | est / true |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name in names:
+        for eng in a.engines:
+            sc = load_scene(f"drives/{name}").replace(solver={"engine": eng, "allow_inaccurate": True})
+            t0 = time.perf_counter()
+            est = error_estimate(sc, workers=a.workers)
+            t1 = time.perf_counter()
+            fine = run_values(fine_scene(sc).to_dict())
+            t2 = time.perf_counter()
+            tol = {h.name: h.tol for h in declared(sc)}
+            for r in est.rows:
+                true = abs(r.value - fine[r.name])
+                ratio = r.error / true if true > 0 else math.inf
+                order = "-" if r.order is None else f"{r.order:.2f}"
+                print(f"| {name} | {eng} | {r.name} | {r.value:.10g} | {tol[r.name]:.3g} | {r.error:.3g} | {order} | "
+                      f"{true:.3g} | {ratio:.3g} |", flush=True)
+                if out:
+                    out.write(json.dumps({"scene": name, "engine": eng, **r.to_dict(), "fine": fine[r.name],
+                                          "true_error": true, "levels": est.settings}) + "\n")
+                    out.flush()
+            print(f"{name} {eng}: estimate {t1 - t0:.1f} s, fine run {t2 - t1:.1f} s", file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,224 @@
+"""The drives' declared accuracy (`mbsuite/models/drives/accuracy.py`) and their error estimate.
+
+Default suite: the declaration (names per scene, tolerances per path), the lock-up table against the Modelica
+Association's reference results, the headline values against an independent computation from the run's own signals
+and events and (CoupledClutches) against the Dymola result, a refinement that changes the number of events is an
+AccuracyError naming `n_events`, and `--error-estimate` on the `drive` commands that run a scene.
+Slow (`make test-slow`): every shipped scene's headlines at its default settings against a much refined run (hand
+path rtol 1e-12), the estimate bracketing the true error, and the MuJoCo path's branch flip on step_up_closed_loop."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+
+import mbsuite
+from mbsuite.accuracy import declared, estimate
+from mbsuite.analysis.errorestimate import error_estimate, run_values
+from mbsuite.health import AccuracyError
+from mbsuite.models.drives import accuracy as acc
+from mbsuite.models.drives import coupled_clutches as cc
+from mbsuite.models.drives import msl
+from mbsuite.scenes import load_scene
+
+SCENES = sorted(load_scene("drives").spec.scene_files())
+
+
+def _names(sc) -> list[str]:
+    return [h.name for h in declared(sc)]
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_declared_headlines_of_every_shipped_scene(name):
+    """n_events first (a count that changes fails before any time is compared); drives: the cycle-mean speeds, the
+    efficiency where there is a load torque, the first lock-up of each switched element; Modelica examples: every
+    lock-up of the reference's sequence and every inertia's end speed. MuJoCo's tolerances are the looser ones."""
+    sc = load_scene(f"drives/{name}")
+    names = _names(sc)
+    assert names[0] == "n_events" and declared(sc)[0].tol == 0.5
+    mech = sc.effects["mechanism"]
+    if mech in acc.SWITCHED:
+        tau_l = sc.build_params().resolved(sc.effects["param_set"])["tau_l"]
+        expect = ["n_events", "mean_load_speed", "mean_motor_speed"] + (["efficiency"] if tau_l else []) + [
+            f"t_lock_{k}" for k in acc.SWITCHED[mech]]
+    else:
+        expect = ["n_events"] + [f"t_lock_{el}_{k}" for el, n in acc.LOCKUPS[mech].items() for k in range(1, n + 1)]
+        expect += [f"w_end_{b}" for b in acc.INERTIAS[mech]]
+    assert names == expect
+    mj = {h.name: h.tol for h in declared(sc.replace(solver={"engine": "mujoco"}))}
+    for h in declared(sc)[1:]:
+        assert 0 < h.tol < mj[h.name], h.name
+
+
+def test_lockup_counts_are_the_reference_results():
+    """LOCKUPS of CoupledClutches, Friction and OneWayClutch read back from the Modelica Association's results
+    (mode changes to stuck per element; tests/data/msl/). OneWayClutchDisengaged (4) and SimpleGearShift (1) are the
+    closed forms asserted in test_msl.py."""
+    got = {"coupled_clutches": {}}
+    for e in cc.reference_events(cc.load_reference()):
+        if e["to"] == cc.MODE_CODE["stuck"]:
+            got["coupled_clutches"][e["element"]] = got["coupled_clutches"].get(e["element"], 0) + 1
+    for mech in ("msl_friction", "msl_one_way_clutch"):
+        ex = msl.example(mech)
+        got[mech] = {}
+        for e in msl.reference_events(ex, msl.load_reference(ex)):
+            if e["to"] == msl.MODE_CODE["stuck"]:
+                got[mech][e["element"]] = got[mech].get(e["element"], 0) + 1
+    for mech, counts in got.items():
+        assert counts == acc.LOCKUPS[mech], mech
+
+
+def test_drive_values_against_the_runs_signals():
+    """A 0.6 s step-up run with a load torque (0.03 N m, so it has an efficiency): the headline values recomputed
+    from the result's signals and events by their definitions (trapezoidal means over [t_settle, T], energy
+    differences, the first lock-up at t >= t_settle). Same run, other arithmetic: agreement to round-off."""
+    sc = load_scene("drives/step_up_pwm").replace(
+        params={"tau_l": 0.03}, solver={"duration": 0.6, "t_settle": 0.3},
+        outputs=["w_motor", "w_load", "E_in", "E_out"])
+    res = mbsuite.run(sc)
+    v = acc.values(sc, res)
+    m = res.t >= 0.3
+    span = res.t[m][-1] - res.t[m][0]
+    assert v["mean_load_speed"] == pytest.approx(np.trapezoid(res["w_load"][m], res.t[m]) / span, rel=1e-12)
+    assert v["mean_motor_speed"] == pytest.approx(np.trapezoid(res["w_motor"][m], res.t[m]) / span, rel=1e-12)
+    e_in, e_out = res["E_in"][m], res["E_out"][m]
+    assert v["efficiency"] == pytest.approx((e_out[-1] - e_out[0]) / (e_in[-1] - e_in[0]), rel=1e-12)
+    assert 0 < v["efficiency"] < 1
+    for k, el in (("brake", "spring_ground"), ("clutch", "clutch")):
+        assert v[f"t_lock_{k}"] == min(e["t"] for e in res.events if e["element"] == el and e["to"] == "stuck"
+                                       and e["t"] >= 0.3)
+    assert v["n_events"] == len(res.events) > 0
+
+
+def test_coupled_clutches_values_against_dymola():
+    """CoupledClutches' headline values against the Modelica Association's Dymola result (an independent solver):
+    lock-up times within 1e-5 s (measured 4.1e-6 s: the reference's own event accuracy at DASSL tol 1e-6), end
+    speeds within 1e-4 rad/s (measured 4.7e-5, the reference's accuracy)."""
+    sc = load_scene("drives/coupled_clutches")
+    v = acc.values(sc, mbsuite.run(sc))
+    ref = cc.load_reference()
+    stuck = [e for e in cc.reference_events(ref) if e["to"] == cc.MODE_CODE["stuck"]]
+    for el in ("clutch1", "clutch2", "clutch3"):
+        for k, e in enumerate([e for e in stuck if e["element"] == el], start=1):
+            assert abs(v[f"t_lock_{el}_{k}"] - e["t"]) <= 1e-5, (el, k)
+    for i in range(4):
+        assert abs(v[f"w_end_J{i + 1}"] - ref["w"][i, -1]) <= 1e-4
+
+
+def test_a_changed_event_count_is_an_accuracy_error_naming_n_events():
+    """CoupledClutches at rtol 1e-4 misses clutch 1's release and re-lock at 0.83 / 0.91 s (7 events; 9 at rtol 1e-5
+    and 1e-6): the count differs between the levels, so the estimate fails on n_events, the first headline, and the
+    message names it and the setting to refine; lock-up lists of different lengths are not passed as accurate. (At
+    rtol 1e-4 the energy residual, 9.7e-5, fails too: kept with allow_inaccurate to read every message.)"""
+    sc = load_scene("drives/coupled_clutches").replace(solver={"rtol": 1e-4, "atol": 1e-6, "allow_inaccurate": True})
+    with pytest.warns(UserWarning):
+        res = mbsuite.run(sc, error_estimate=True, workers=2)
+    assert res.error_estimate["n_events"].value == 7 and res.error_estimate["n_events"].refined == (9, 9)
+    assert any(re.search(r"error_estimate\[n_events\] = 2 .*refine solver\.rtol", w) for w in res.warnings)
+    with pytest.raises(AccuracyError):
+        mbsuite.run(sc.replace(solver={"allow_inaccurate": False}), error_estimate=True, workers=2)
+    # the estimator on the counts alone: any difference is >= 1 > 0.5
+    heads = tuple(h for h in declared(sc) if h.name == "n_events")
+    for counts in ((7, 9, 9), (9, 9, 10), (9, 10, 9)):
+        est = estimate([{"n_events": c} for c in counts], heads, acc.refinement(sc))
+        assert est["n_events"].error >= 1 and not est["n_events"].ok
+
+
+def test_drive_run_error_estimate_cli(capsys):
+    """`drive run --error-estimate`: the estimate of every headline in the JSON summary, on the hand path's rtol
+    levels; its level 0 is the run `mbsuite run` makes of the scene (one default per question)."""
+    from mbsuite.cli import main
+
+    assert main(["drive", "run", "drives/coupled_clutches", "--error-estimate", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)["summary"]["error_estimate"]
+    assert d["levels"] == ["solver.rtol = 1e-09", "solver.rtol = 1e-10", "solver.rtol = 1e-11"]
+    assert [r["name"] for r in d["rows"]] == _names(load_scene("drives/coupled_clutches"))
+    assert all(r["ok"] for r in d["rows"])
+    api = run_values(load_scene("drives/coupled_clutches").to_dict())
+    assert {r["name"]: r["value"] for r in d["rows"]} == api
+
+
+def test_coupled_clutches_command_estimates_both_paths(capsys):
+    """`drive coupled-clutches --error-estimate`: each path's estimate (hand path rtol / 10, MuJoCo step / 2 from
+    --timestep), level 0 being `mbsuite run drives/coupled_clutches [--engine mujoco --timestep]`'s run. (That the
+    MuJoCo estimate brackets the true error is the slow test below.)"""
+    from mbsuite.cli import main
+
+    assert main(["drive", "coupled-clutches", "--timestep", "2e-4", "--error-estimate", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["mujoco"]["error_estimate"]["levels"] == ["solver.timestep = 0.0002", "solver.timestep = 0.0001",
+                                                       "solver.timestep = 5e-05"]
+    assert d["reference"]["error_estimate"]["levels"][0] == "solver.rtol = 1e-09"
+    sc = load_scene("drives/coupled_clutches")
+    for eng, scene in (("reference", sc), ("mujoco", sc.replace(solver={"engine": "mujoco", "timestep": 2e-4}))):
+        rows = d[eng]["error_estimate"]["rows"]
+        assert {r["name"]: r["value"] for r in rows} == run_values(scene.to_dict()), eng
+        assert all(r["ok"] for r in rows), eng
+
+
+def test_efficiency_command_estimates_every_point(capsys):
+    """`drive efficiency --error-estimate`: each load point's efficiency-curve headlines with their estimate."""
+    from mbsuite.cli import main
+
+    assert main(["drive", "efficiency", "drives/step_up_efficiency", "--loads", "0.1", "--duration", "0.6",
+                 "--error-estimate", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    (pt,) = d["points"]
+    rows = {r["name"]: r for r in pt["error_estimate"]["rows"]}
+    assert list(rows) == ["n_events", "mean_load_speed", "mean_motor_speed", "efficiency"]
+    assert rows["efficiency"]["value"] == pytest.approx(pt["efficiency"], rel=1e-12)
+    assert all(r["ok"] for r in rows.values())
+
+
+# ---------------------------------------------------------------------------------------------------- slow proofs
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SCENES)
+def test_declared_tolerances_hold_against_a_refined_run(name):
+    """Every headline at the scene's defaults (hand path, rtol 1e-9) within its declared tolerance of the same
+    scene at rtol 1e-12, atol 1e-14 (1000x tighter), with the same number of events."""
+    sc = load_scene(f"drives/{name}")
+    assert sc.solver.engine == "reference"
+    v0 = run_values(sc.to_dict())
+    vf = run_values(sc.replace(solver={"rtol": 1e-12, "atol": 1e-14}).to_dict())
+    assert v0["n_events"] == vf["n_events"]
+    for h in declared(sc):
+        assert math.isfinite(v0[h.name]), h.name
+        assert abs(v0[h.name] - vf[h.name]) <= h.tol, (h.name, v0[h.name], vf[h.name], h.tol)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,engine,heads", [
+    ("coupled_clutches", "reference", ("w_end_J1", "w_end_J2")),
+    ("coupled_clutches", "mujoco", ("t_lock_clutch1_2", "t_lock_clutch3_1", "w_end_J1", "w_end_J2")),
+    ("step_up_pwm", "reference", ("mean_load_speed", "mean_motor_speed")),
+    ("msl_friction", "mujoco", ("t_lock_clutch_3", "w_end_inertia2")),
+])
+def test_estimate_brackets_the_true_error(name, engine, heads):
+    """The estimate against the true error (hand path: rtol 1e-12; MuJoCo: 1/16 of the step) on headlines whose
+    error is well above round-off: true <= estimate <= 10 x true. Measured ratios (scripts/drives_accuracy.py):
+    CoupledClutches hand 1.36 (w_end), MuJoCo 1.27-1.44; step_up_pwm hand 3.0 / 1.33; msl_friction MuJoCo 1.92 /
+    2.04."""
+    sc = load_scene(f"drives/{name}").replace(solver={"engine": engine})
+    est = error_estimate(sc, workers=2)
+    fine_sc = (sc.replace(solver={"timestep": sc.solver.timestep / 16, "max_steps": sc.solver.max_steps * 16})
+               if engine == "mujoco" else sc.replace(solver={"rtol": 1e-12, "atol": 1e-14}))
+    fine = run_values(fine_sc.to_dict())
+    for h in heads:
+        r = est[h]
+        true = abs(r.value - fine[h])
+        assert true <= r.error <= 10 * true, (h, r.error, true)
+
+
+@pytest.mark.slow
+def test_mujoco_closed_loop_step_up_flips_a_lock_trial_under_refinement():
+    """step_up_closed_loop on MuJoCo: at t = 4.32 s the brake's lock trial on the stopping spring end is a near tie
+    (the hand path locks and breaks loose 61 ms later); MuJoCo passes through at 1e-4 s, locks at 5e-5 s: 311 vs 310
+    events. The estimate says so by n_events instead of comparing lock-ups of different lists (README, Declared
+    accuracy)."""
+    sc = load_scene("drives/step_up_closed_loop").replace(solver={"engine": "mujoco"})
+    with pytest.raises(AccuracyError, match=r"error_estimate\[n_events\]"):
+        mbsuite.run(sc, error_estimate=True, workers=2)

@@ -2,9 +2,13 @@
 the compiled step core side by side (median of --repeats, alternating), with the cost per step, the banded solve
 alone (LAPACK dpbtrs and the core's block sweeps), and the catenary alone against the catenary with the 2-mass
 pantograph in the core (same steps, no contact point vs one); with --eppinger also one passage of the Eppinger
-pantograph on each engine path (0.5 m, dt 1e-4 s). Run it on one core: `taskset -c 0`.
+pantograph on each engine path (0.5 m, dt 1e-4 s). `--compare` instead times the shipped method (the point-load
+correction, `fe.PointCorrection`, at the shipped defaults) against the method before it (the plain Hermite wires at
+the same 0.5 m and dt 2e-4 s): one single-pantograph EN 50318 passage each, assembly included, alternating, medians
+and their ratio. Run it on one core: `taskset -c 0`.
 
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
+    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --compare [--repeats 7]
 """
 
 from __future__ import annotations
@@ -15,13 +19,14 @@ import time
 
 import numpy as np
 
-from mbsuite.models.catenary.analysis import simulate
+from mbsuite.models.catenary.analysis import run_scene, simulate
 from mbsuite.models.catenary.fe import assemble
 from mbsuite.models.catenary.native_core import NativeCore
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.sim import CHECK_EVERY, CoupledSimulation
 from mbsuite.results import format_table
+from mbsuite.scenes import load_scene
 
 STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
 
@@ -52,6 +57,36 @@ def core_loop_cpu(p: CatenaryParams, speed_kmh: float, dt: float, with_pantograp
     return cpu
 
 
+def compare(speeds: list[float], repeats: int) -> None:
+    """The shipped method at the shipped defaults (`run_scene` of `catenary/en50318`: the parameters' element length,
+    the scene's time step, assembly with the point-load correction) against the plain Hermite wires at 0.5 m and
+    dt 2e-4 s, alternating within each repeat; CPU seconds of the whole passage (assembly, start, stepping,
+    statistics), medians and their ratio, and how far the two sets of statistics are apart."""
+    scene = load_scene("catenary/en50318")
+    p_old = CatenaryParams(element_length=0.5)
+    rows = []
+    for v in speeds:
+        cpu = {"plain": [], "shipped": []}
+        stats = {}
+        for r in range(repeats):
+            for label in (("plain", "shipped") if r % 2 == 0 else ("shipped", "plain")):
+                c0 = time.process_time()
+                if label == "shipped":
+                    run = run_scene(scene, speed_kmh=v)
+                else:
+                    run = simulate(p_old, v, 2e-4, fe=assemble(p_old, point_correction=False))
+                cpu[label].append(time.process_time() - c0)
+                stats[label] = (run.stats, run.params.element_length, run.dt, run.timing["steps"])
+        old, new = statistics.median(cpu["plain"]), statistics.median(cpu["shipped"])
+        d = max(abs(stats["shipped"][0][k] - stats["plain"][0][k]) for k in STATS if k != "loss_pct")
+        _, h, dt, steps = stats["shipped"]
+        rows.append([v, f"{h:g} m, {dt:g} s", steps, f"{old:.3f} ({min(cpu['plain']):.3f}-{max(cpu['plain']):.3f})",
+                     f"{new:.3f} ({min(cpu['shipped']):.3f}-{max(cpu['shipped']):.3f})", f"{new / old:.3f}",
+                     f"{d:.2f}"])
+    print(format_table(["km/h", "shipped setting", "steps", "plain Hermite 0.5 m, 2e-4 s: CPU s (min-max)",
+                        "shipped: CPU s (min-max)", "ratio shipped / plain", "max |stat diff| (N, mm)"], rows))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
@@ -59,7 +94,11 @@ def main() -> None:
     ap.add_argument("--element-length", type=float, default=0.5)
     ap.add_argument("--timestep", type=float, default=2e-4)
     ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
+    ap.add_argument("--compare", action="store_true", help="the shipped method against the plain Hermite wires")
     a = ap.parse_args()
+    if a.compare:
+        compare(a.speeds, a.repeats)
+        return
     p = CatenaryParams(element_length=a.element_length)
     dt = a.timestep
     fe = assemble(p)

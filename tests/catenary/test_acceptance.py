@@ -23,10 +23,11 @@ def _assert_inside(stats, speed):
 
 @pytest.mark.parametrize("speed", [250, 300])
 def test_en50318_reference_scene_inside_ranges(speed):
-    """The shipped scene (0.5 m elements, dt 2e-4 s: within 0.2 N / 0.1 mm of the finest level of the README's
-    convergence table) with every parameter of the specification: all eight statistics inside the ranges."""
+    """The shipped scene (0.5 m elements with the point-load correction, dt 2e-4 s: within 1 N / 0.5 mm of the
+    refined solution, `test_convergence.py`) with every parameter of the specification: all eight statistics inside
+    the ranges."""
     run = run_scene(load_scene("catenary"), speed_kmh=speed)
-    assert run.params == CatenaryParams(element_length=run.params.element_length)  # nothing but the mesh chosen
+    assert run.params == CatenaryParams()  # nothing changed: the mesh is the parameters' default
     _assert_inside(run.stats, speed)
     assert run.stats["loss_events"] == []
 
@@ -49,6 +50,18 @@ def test_linear_droppers_give_sigma_far_above_the_range(speed):
     """catenary.md: 'with linear (bilateral) droppers the same model gives a sigma far above the range'."""
     run = run_scene(load_scene("catenary/en50318_linear"), speed_kmh=speed)
     assert run.stats["sigma"] > ACCEPTED_RANGES[speed]["sigma"][1] + 5.0
+
+
+def test_one_element_length_for_python_and_every_shipped_scene():
+    """One default per question: the element length a Python run takes (`CatenaryParams()`) is the one every shipped
+    catenary scene resolves to (a scene that states it states the same), 0.5 m."""
+    from mbsuite.scenes import shipped_scenes
+
+    names = shipped_scenes()["catenary"]
+    assert len(names) == 5
+    for name in names:
+        assert load_scene(f"catenary/{name}").build_params().element_length == CatenaryParams().element_length, name
+    assert CatenaryParams().element_length == 0.5
 
 
 def test_shipped_scenes_validate_and_unknown_effect_is_an_error(tmp_path):

@@ -12,6 +12,17 @@ Both wires share the same nodes (supports and dropper positions are always nodes
 two ends; those DOFs are removed. Droppers (CW node to MW node), steady arms (CW to ground) and messenger supports
 (MW to ground) are springs. The dynamic model is written for the displacement w from the static state.
 
+Point springs on a wire (`PointCorrection`): a point force on a tensioned beam bends it in a boundary layer of width
+sqrt(EI/T) (0.1 m for the contact wire) that a cubic element of 0.5 m cannot represent: the Hermite wire is locally
+too stiff under a point load, by a compliance d(x) (0.5 m elements: 3.0e-7 m/N at a node of the contact wire,
+5.9e-7 m/N mid-element, 4.2e-7 m/N at a node of the messenger wire; at a node of the contact wire 4.3e-8 and
+3.8e-9 m/N at 0.25 and 0.125 m). In series with a dropper (1e-5 m/N) that makes the droppers 7 % too stiff. Every point
+spring on a wire (droppers, steady arms, messenger supports, the contact spring) therefore gets the wire's defect at
+its point in series: k_eff = 1 / (1/k + d_cw + d_mw) for a dropper, 1 / (1/k + d) for a support spring, and the
+contact spring 1 / (1/k_c + d_cw(x)) wherever the contact point is. d is the exact static compliance of the continuous
+tensioned beam minus the Hermite elements' (`tensioned_beam_compliance`, `PointCorrection`), on a pinned reference
+beam of the local mesh (8 elements each side; the defect is local: it changes by < 1e-6 relative beyond 8).
+
 Static state (catenary.md, "Choices mbsuite fixes"): no pre-sag; the CW is held level (w = 0) at every dropper and
 support and sags under its own weight between them. The constraint reactions at the droppers are the droppers' static
 tensions; those at the supports are the steady arms' static pre-loads (constant, they cancel in the dynamics).
@@ -31,6 +42,8 @@ from .params import CatenaryParams
 
 NDOF_NODE = 4  # w_cw, theta_cw, w_mw, theta_mw
 CW_W, CW_T, MW_W, MW_T = range(4)
+#: elements of the local mesh on each side of an element in the reference beam of `PointCorrection`
+REF_ELEMENTS = 8
 
 
 def beam_stiffness(EI: float, T: float, h: float) -> np.ndarray:
@@ -57,6 +70,128 @@ def hermite(xi: float, h: float) -> np.ndarray:
     """Hermite shape functions at local coordinate xi in [0, 1] on an element of length h: w = N . [w1, t1, w2, t2]."""
     x2, x3 = xi * xi, xi * xi * xi
     return np.array([1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)])
+
+
+def tensioned_beam_compliance(a: float, L: float, T: float, EI: float) -> float:
+    """Static deflection at x = a under a unit point force at x = a of a pinned-pinned tensioned Euler-Bernoulli beam
+    of length L (EI w'''' - T w'' = delta(x - a), w = w'' = 0 at both ends), in closed form:
+
+        w(a) = [a (L - a) / L - sinh(lam a) sinh(lam (L - a)) / (lam sinh(lam L))] / T,      lam = sqrt(T / EI),
+
+    the string's deflection less the bending boundary layer's; EI = 0 is the string. Written with expm1 so that it
+    holds for lam L >> 1: the sinh quotient is (1 - e^(-2 lam a)) (1 - e^(-2 lam (L - a))) / (2 lam (1 - e^(-2 lam L))).
+    """
+    s = a * (L - a) / L
+    if EI > 0.0:
+        lam = math.sqrt(T / EI)
+        s -= (-math.expm1(-2 * lam * a)) * (-math.expm1(-2 * lam * (L - a))) / (2 * lam * (-math.expm1(-2 * lam * L)))
+    return s / T
+
+
+@dataclass
+class PointCorrection:
+    """The point-load compliance defect of one wire's Hermite mesh (module docstring): at local coordinate xi of
+    element e, d = tensioned_beam_compliance(a0 + xi h, L) - N(xi) . Q N(xi) on the element's reference beam (the
+    wire's own elements up to REF_ELEMENTS on each side, pinned at its ends; at the line's ends, the line's pins), Q
+    the Hermite elements' static compliance of the element's four DOFs (w, theta at both nodes) on that beam. Elements
+    with the same reference beam (lengths equal to 1e-9 m, same place in it) share one entry of the tables."""
+
+    T: float
+    EI: float
+    sig: np.ndarray  # (n_elements,) int: each element's entry in Q and ref
+    Q: np.ndarray  # (n_entries, 4, 4)
+    ref: np.ndarray  # (n_entries, 3): a0 (the element's left node on the reference beam), L, h (element length)
+
+    @classmethod
+    def build(cls, x: np.ndarray, T: float, EI: float) -> PointCorrection:
+        """The tables of a wire through the nodes `x` (m), pinned (w = 0) at the first and the last node."""
+        h = np.diff(x)
+        ne, m = h.size, REF_ELEMENTS
+        hr = np.round(h, 9)
+        sig = np.empty(ne, dtype=int)
+        Qs, refs = [], []
+        ke: dict[float, np.ndarray] = {}
+
+        def entry(lo: int, hi: int, e: int) -> int:
+            Q, a0, L = _reference_beam(h[lo:hi], e - lo, T, EI, ke)
+            Qs.append(Q)
+            refs.append((a0, L, h[e]))
+            return len(Qs) - 1
+
+        inner = np.arange(m, ne - m)
+        if inner.size:  # a full reference beam: elements with equal windows of lengths share an entry
+            codes = np.unique(hr, return_inverse=True)[1].astype(np.int64)
+            windows = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(codes, 2 * m + 1))
+            rows = windows.view(np.dtype((np.void, windows.shape[1] * windows.itemsize))).ravel()
+            _, first, inverse = np.unique(rows, return_index=True, return_inverse=True)
+            ks = np.array([entry(i, i + 2 * m + 1, i + m) for i in first])
+            sig[inner] = ks[inverse.ravel()]
+        keys: dict[tuple, int] = {}
+        for e in np.setdiff1d(np.arange(ne), inner):  # next to the line's ends: the beam ends at the line's pin
+            lo, hi = max(0, e - m), min(ne, e + m + 1)
+            key = (hr[lo:hi].tobytes(), e - lo)
+            if key not in keys:
+                keys[key] = entry(lo, hi, e)
+            sig[e] = keys[key]
+        return cls(T=float(T), EI=float(EI), sig=sig, Q=np.array(Qs).reshape(-1, 4, 4),
+                   ref=np.array(refs, dtype=float).reshape(-1, 3))
+
+    @classmethod
+    def none(cls, n_elements: int, T: float) -> PointCorrection:
+        """No correction (the plain Hermite wire): d = 0 everywhere."""
+        return cls(T=float(T), EI=0.0, sig=np.zeros(n_elements, dtype=int), Q=np.zeros((1, 4, 4)),
+                   ref=np.zeros((1, 3)))
+
+    @property
+    def active(self) -> bool:
+        """Whether the tables hold a correction (False: `none`)."""
+        return bool(self.ref[0, 1] > 0.0)
+
+    def defect(self, e: int, xi: float) -> float:
+        """The defect d (m/N) at local coordinate xi of element e (0 without a correction)."""
+        k = self.sig[e]
+        a0, L, h = self.ref[k]
+        if L == 0.0:
+            return 0.0
+        N = hermite(xi, h)
+        Q = self.Q[k]
+        q = 0.0
+        for r in range(4):  # the compiled core's order (native/catenary.c, point_defect)
+            q += N[r] * (((Q[r, 0] * N[0] + Q[r, 1] * N[1]) + Q[r, 2] * N[2]) + Q[r, 3] * N[3])
+        return tensioned_beam_compliance(a0 + xi * h, L, self.T, self.EI) - q
+
+    def nodal(self) -> np.ndarray:
+        """The defect at every node (m/N), `defect(e, 0)` at the left node of each element and `defect(e, 1)` at the
+        last node (N = e_1 or e_3 there); 0 at the pinned ends."""
+        if not self.active:
+            return np.zeros(self.sig.size + 1)
+        left = np.array([tensioned_beam_compliance(a0, L, self.T, self.EI) for a0, L, _ in self.ref]) - self.Q[:, 0, 0]
+        k = self.sig[-1]
+        a0, L, h = self.ref[k]
+        last = tensioned_beam_compliance(a0 + h, L, self.T, self.EI) - self.Q[k, 2, 2]
+        return np.append(left[self.sig], last)
+
+
+def _reference_beam(h: np.ndarray, e: int, T: float, EI: float,
+                    ke: dict[float, np.ndarray]) -> tuple[np.ndarray, float, float]:
+    """Hermite elements of lengths `h` of a wire (T, EI), pinned at both ends: the static compliance Q (4 x 4) of the
+    DOFs of element e, the position a0 of its left node and the beam's length. `ke` caches element stiffnesses by
+    length."""
+    ne = h.size
+    n = 2 * (ne + 1)
+    for hi in set(h.tolist()) - set(ke):
+        ke[hi] = beam_stiffness(EI, T, hi)
+    K = np.zeros((n, n))
+    d = 2 * np.arange(ne)[:, None] + np.arange(4)
+    np.add.at(K, (d[:, :, None], d[:, None, :]), np.array([ke[hi] for hi in h.tolist()]))
+    K[[0, n - 2], :] = 0.0  # pinned: w = 0 at both ends (identity rows and columns)
+    K[:, [0, n - 2]] = 0.0
+    K[0, 0] = K[n - 2, n - 2] = 1.0
+    rhs = np.zeros((n, 4))
+    rhs[2 * e:2 * e + 4] = np.eye(4)
+    rhs[[0, n - 2]] = 0.0
+    Q = np.linalg.solve(K, rhs)[2 * e:2 * e + 4]
+    return Q, float(np.sum(h[:e])), float(np.sum(h))
 
 
 def build_nodes(p: CatenaryParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -91,9 +226,11 @@ class CatenaryFE:
 
     `M`, `K0` (beams + steady arms + messenger supports), `Kd` (droppers as linear springs) are CSR on free DOFs.
     `B` (n_free x n_droppers) maps DOFs to dropper elongations delta = B^T u (MW up minus CW up); a dropper's tension
-    T0 + k delta pulls the CW node up and the MW node down. `w0` is the static CW shape (full DOF vector, w and theta
-    of both wires; the MW static shape does not enter the dynamics and is left at 0), `T0` the droppers' static
-    tensions.
+    T0 + k delta pulls the CW node up and the MW node down, k = `k_drop` (the dropper with both wires' point-load
+    defects in series, `PointCorrection`; the ground springs in K0 carry their wire's defect likewise), and `contact`
+    gives the contact wire's defect under the contact point (`contact_defect`). `w0` is the static CW shape (full DOF
+    vector, w and theta of both wires; the MW static shape does not enter the dynamics and is left at 0), `T0` the
+    droppers' static tensions.
     """
 
     params: CatenaryParams
@@ -111,6 +248,8 @@ class CatenaryFE:
     w0_full: np.ndarray  # static CW shape on the full DOF vector
     T0: np.ndarray  # static dropper tensions (N)
     support_preload: np.ndarray  # static steady-arm forces (N), at every support node (ends: pin reactions)
+    k_drop: np.ndarray  # dropper stiffnesses with both wires' point-load defects in series (N/m)
+    contact: PointCorrection  # the contact wire's point-load defect under the contact point
 
     @property
     def n(self) -> int:
@@ -120,6 +259,10 @@ class CatenaryFE:
     def cw_dofs_of_node(self, i: int) -> tuple[int, int]:
         """Free indices (w, theta) of the CW at node i (-1 if pinned)."""
         return int(self.full_to_free[NDOF_NODE * i + CW_W]), int(self.full_to_free[NDOF_NODE * i + CW_T])
+
+    def contact_defect(self, e: int, xi: float) -> float:
+        """The contact wire's point-load defect (m/N) at local coordinate xi of element e (`PointCorrection`)."""
+        return self.contact.defect(e, xi)
 
     def element_at(self, xp: float) -> tuple[int, float, float]:
         """Element index e (nodes e, e+1), local coordinate xi in [0, 1] and element length at position xp."""
@@ -132,10 +275,22 @@ class CatenaryFE:
         return e, (xp - x[e]) / h, h
 
 
-def assemble(p: CatenaryParams) -> CatenaryFE:
-    """Mesh, assemble and solve the static state of the catenary described by `p`."""
+def series(k: float | np.ndarray, d: float | np.ndarray) -> float | np.ndarray:
+    """A spring k (N/m) in series with a compliance d (m/N): k / (1 + k d) (k = 0 stays 0; d = 0 leaves k as it is)."""
+    return k / (1.0 + k * d)
+
+
+def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
+    """Mesh, assemble and solve the static state of the catenary described by `p`. `point_correction`: every point
+    spring gets its wires' point-load defect in series (module docstring); False gives the plain Hermite wires."""
     x, supports, droppers = build_nodes(p)
     nn = x.size
+    if point_correction:
+        pc_cw = PointCorrection.build(x, p.cw_tension, p.cw_EI)
+        d_cw, d_mw = pc_cw.nodal(), PointCorrection.build(x, p.mw_tension, p.mw_EI).nodal()
+    else:
+        pc_cw = PointCorrection.none(nn - 1, p.cw_tension)
+        d_cw = d_mw = np.zeros(nn)
     nfull = NDOF_NODE * nn
     h = np.diff(x)
     groups, inverse = np.unique(np.round(h, 9), return_inverse=True)
@@ -161,16 +316,17 @@ def assemble(p: CatenaryParams) -> CatenaryFE:
     Kbeam_cw = Kf.copy()  # for the static CW problem (MW rows are decoupled)
     # ground springs at the supports
     ground = np.zeros(nfull)
-    ground[NDOF_NODE * supports + CW_W] += p.k_steady_arm
-    ground[NDOF_NODE * supports + MW_W] += p.k_messenger_support
+    ground[NDOF_NODE * supports + CW_W] += series(p.k_steady_arm, d_cw[supports])
+    ground[NDOF_NODE * supports + MW_W] += series(p.k_messenger_support, d_mw[supports])
     Kf = (Kf + sp.diags(ground)).tocsr()
-    # droppers: k (e_mw - e_cw)(e_mw - e_cw)^T
+    # droppers: k_j (e_mw - e_cw)(e_mw - e_cw)^T
     nd = droppers.size
+    k_drop = np.asarray(series(p.k_dropper, d_cw[droppers] + d_mw[droppers]), dtype=float)
     bfull = sp.coo_matrix(
         (np.concatenate([np.ones(nd), -np.ones(nd)]),
          (np.concatenate([NDOF_NODE * droppers + MW_W, NDOF_NODE * droppers + CW_W]), np.tile(np.arange(nd), 2))),
         shape=(nfull, nd)).tocsc()
-    Kdf = (p.k_dropper * (bfull @ bfull.T)).tocsr()
+    Kdf = (bfull @ sp.diags(k_drop) @ bfull.T).tocsr()
     # pinned ends: w of both wires at the first and last node
     pinned = np.array([CW_W, MW_W, NDOF_NODE * (nn - 1) + CW_W, NDOF_NODE * (nn - 1) + MW_W])
     mask = np.ones(nfull, bool)
@@ -187,7 +343,7 @@ def assemble(p: CatenaryParams) -> CatenaryFE:
     return CatenaryFE(params=p, x=x, supports=supports, droppers=droppers, free=free, full_to_free=full_to_free,
                       M=M, K0=K0, Kd=Kd, B=B, dropper_cw=full_to_free[NDOF_NODE * droppers + CW_W],
                       dropper_mw=full_to_free[NDOF_NODE * droppers + MW_W], w0_full=w0_full, T0=T0,
-                      support_preload=preload)
+                      support_preload=preload, k_drop=k_drop, contact=pc_cw)
 
 
 def _static_cw(p: CatenaryParams, x: np.ndarray, supports: np.ndarray, droppers: np.ndarray,
@@ -200,16 +356,15 @@ def _static_cw(p: CatenaryParams, x: np.ndarray, supports: np.ndarray, droppers:
     cw = np.arange(nn) * NDOF_NODE
     idx = np.concatenate([cw + CW_W, cw + CW_T])
     idx.sort()
-    K = Kbeam[idx][:, idx].tocsr()
-    loc = {int(d): i for i, d in enumerate(idx)}
-    f = np.zeros(idx.size)
+    K = Kbeam[idx][:, idx].tocsr()  # CW DOFs of node i at 2i (w) and 2i + 1 (theta)
     h = np.diff(x)
     q = -p.cw_mass * p.g
-    for e in range(nn - 1):
-        fe = beam_load(q, h[e])
-        for a, d in enumerate((cw[e] + CW_W, cw[e] + CW_T, cw[e + 1] + CW_W, cw[e + 1] + CW_T)):
-            f[loc[int(d)]] += fe[a]
-    held = np.array([loc[int(NDOF_NODE * i + CW_W)] for i in np.concatenate([supports, droppers])])
+    f = np.zeros(idx.size)  # beam_load(q, h_e) of every element, in its order of terms
+    f[0:-2:2] += q * (h / 2)
+    f[1:-2:2] += q * (h * h / 12)
+    f[2::2] += q * (h / 2)
+    f[3::2] += q * (-h * h / 12)
+    held = 2 * np.concatenate([supports, droppers])
     mask = np.ones(idx.size, bool)
     mask[held] = False
     w = np.zeros(idx.size)
@@ -218,6 +373,4 @@ def _static_cw(p: CatenaryParams, x: np.ndarray, supports: np.ndarray, droppers:
     r = K @ w - f
     w_full = np.zeros(NDOF_NODE * nn)
     w_full[idx] = w
-    T0 = np.array([r[loc[int(NDOF_NODE * i + CW_W)]] for i in droppers])
-    preload = np.array([r[loc[int(NDOF_NODE * i + CW_W)]] for i in supports])
-    return w_full, T0, preload
+    return w_full, r[2 * droppers], r[2 * supports]

@@ -25,7 +25,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 1
+ABI = 2
 
 
 class _Job(ctypes.Structure):
@@ -33,13 +33,15 @@ class _Job(ctypes.Structure):
         ("n", _I), ("bw", _I), ("nd", _I), ("nsup", _I), ("ncon", _I), ("nnode", _I), ("nnz", _I),
         ("slack", _I), ("unilateral", _I), ("max_iter", _I),
         ("h", _D), ("hh2", _D), ("c_ab", _D), ("inv_1ha", _D), ("c_kd", _D), ("two_hh", _D), ("kc", _D),
-        ("kd", _D), ("V", _D), ("dt", _D), ("max_disp", _D),
+        ("V", _D), ("dt", _D), ("max_disp", _D), ("cw_T", _D), ("cw_EI", _D),
         ("L", _P), ("invd", _P), ("Kp", _P), ("Ki", _P), ("Kx", _P), ("mw", _P), ("cw", _P), ("T0", _P),
-        ("Zg", _P), ("D", _P), ("xnode", _P), ("cwdof", _P), ("w0cw", _P), ("supidx", _P),
+        ("kdj", _P), ("Zg", _P), ("D", _P), ("xnode", _P), ("cwdof", _P), ("w0cw", _P), ("supidx", _P),
+        ("esig", _P), ("pq", _P), ("pref", _P),
         ("u", _P), ("q", _P), ("p", _P), ("R", _P), ("vbs", _P), ("vb", _P),
         ("slk", _P), ("nslack", _I), ("sS", _P),
         ("present", _P), ("active", _P), ("elem", _P), ("xc", _P), ("xs", _P), ("xend", _P), ("Nl", _P),
-        ("dofs", _P), ("w0d", _P), ("cols", _P), ("f", _P), ("gv", _P), ("a", _P), ("Cm", _P), ("bz", _P),
+        ("dofs", _P), ("w0d", _P), ("cols", _P), ("f", _P), ("kce", _P), ("cbc", _P), ("gv", _P), ("a", _P),
+        ("Cm", _P), ("bz", _P),
         ("dstar", _P), ("P", _P), ("gp", _P), ("head", _P), ("work", _P), ("iwork", _P), ("pm", _P),
         ("rec_t", _P), ("rec_x", _P), ("rec_f", _P), ("rec_head", _P), ("rec_wire", _P), ("rec_frame", _P),
         ("rec_up", _P), ("rec_ns", _P),
@@ -103,8 +105,10 @@ class NativeCore:
         c_ab = h * sim.beta + h * h
         inv_1ha = 1.0 / (1 + h * sim.alpha)
         j.h, j.hh2, j.c_ab, j.inv_1ha = h, 0.5 * h, c_ab, inv_1ha
-        j.c_kd, j.two_hh, j.kc, j.kd = (c_ab - h * h) * inv_1ha, 2 * h * h, p.k_contact, sim.kd
+        j.c_kd, j.two_hh, j.kc = (c_ab - h * h) * inv_1ha, 2 * h * h, p.k_contact
         j.V, j.dt, j.max_disp = sim.V, sim.dt, sim.max_displacement
+        pc = fe.contact
+        j.cw_T, j.cw_EI = pc.T, pc.EI
         cwdof = np.stack([fe.full_to_free[4 * np.arange(fe.x.size)], fe.full_to_free[4 * np.arange(fe.x.size) + 1]],
                          axis=1)
         w0cw = np.stack([fe.w0_full[4 * np.arange(fe.x.size)], fe.w0_full[4 * np.arange(fe.x.size) + 1]], axis=1)
@@ -115,14 +119,17 @@ class NativeCore:
         arrays = {
             "L": L, "invd": np.zeros(n), "Kp": K.indptr.astype(np.int32), "Ki": K.indices.astype(np.int32),
             "Kx": K.data.astype(float), "mw": fe.dropper_mw.astype(np.int32), "cw": fe.dropper_cw.astype(np.int32),
-            "T0": fe.T0.astype(float), "Zg": zg, "D": dd, "xnode": fe.x.astype(float),
-            "cwdof": cwdof.astype(np.int32), "w0cw": w0cw.astype(float), "supidx": sup.astype(np.int32),
+            "T0": fe.T0.astype(float), "kdj": np.asarray(sim.kd, float) if nd else np.zeros(1), "Zg": zg, "D": dd,
+            "xnode": fe.x.astype(float), "cwdof": cwdof.astype(np.int32), "w0cw": w0cw.astype(float),
+            "supidx": sup.astype(np.int32), "esig": pc.sig.astype(np.int32), "pq": pc.Q.reshape(-1).astype(float),
+            "pref": pc.ref.reshape(-1).astype(float),
             "u": np.zeros(n), "q": np.zeros(n), "p": np.zeros(n), "R": np.zeros(n), "vbs": np.zeros(n),
             "vb": np.zeros(n), "slk": np.zeros(max(nd, 1), np.int32), "sS": np.zeros(max(nd, 1)),
             "present": np.zeros(nc, np.int32), "active": np.zeros(nc, np.int32), "elem": -np.ones(nc, np.int32),
             "xc": np.zeros(nc), "xs": np.asarray(x_start, float).copy(), "xend": np.asarray(x_end, float).copy(),
             "Nl": np.zeros(4 * nc), "dofs": np.zeros(4 * nc, np.int32), "w0d": np.zeros(4 * nc),
-            "cols": np.zeros((nc, 4, n)), "f": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
+            "cols": np.zeros((nc, 4, n)), "f": np.zeros(nc), "kce": np.full(nc, float(p.k_contact)),
+            "cbc": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
             "Cm": np.zeros(nc * nc), "bz": np.zeros(max(nc * nd, 1)), "dstar": np.zeros(max(nd, 1)),
             "P": np.zeros(nc), "gp": np.zeros(nc), "head": np.zeros(nc),
             "work": np.zeros(m * (m + 1) + m + 1), "iwork": np.zeros(2 * m + 2, np.int32),
@@ -146,11 +153,13 @@ class NativeCore:
         return int(self.job.nslack)
 
     def place(self, k: int, x: float) -> None:
-        """Place contact k at position x (m): its element and Hermite shape functions N(x)."""
+        """Place contact k at position x (m): its element, Hermite shape functions N(x), the contact wire's
+        point-load defect there (`cbc`) and the contact spring in series with it (`kce`)."""
         self.lib.mbs_cat_place(ctypes.byref(self.job), k, float(x))
 
     def wire(self, k: int) -> float:
-        """Contact-wire height (m, from the undisturbed level) at contact k, from the predicted state."""
+        """Contact-wire height (m, from the undisturbed level) at contact k, from the current state (the nodes';
+        without the defect's deflection under a force)."""
         return float(self.lib.mbs_cat_wire(ctypes.byref(self.job), k))
 
     def set_force(self, k: int, f: float) -> None:

@@ -13,7 +13,7 @@ from ...errors import ParameterError
 from ...limits import check_fields, param
 
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
-#: dt 2e-4 s, 250 km/h: 7.3e7; the finest convergence level, 0.125 m at 5e-5 s: 1.2e9)
+#: dt 2e-4 s, 250 km/h: 7.3e7; 0.125 m at 5e-5 s: 1.2e9)
 MAX_ELEMENT_STEPS = 5e9
 
 #: EN 50318 reference dropper positions from the span's first support (m), catenary.md "Model data"
@@ -44,7 +44,9 @@ class CatenaryParams:
     f_damp1: float = param(1.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz", doc="first Rayleigh matching frequency")
     f_damp2: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz", doc="second Rayleigh matching frequency")
     g: float = param(9.81, lo=0.0, hi=100.0, unit="m/s^2", doc="gravitational acceleration for the static state")
-    element_length: float = param(0.25, lo=0.0, lo_open=True, hi=1000.0, unit="m",
+    #: the shipped default (every catenary scene): with the point-load correction (`fe.PointCorrection`) 0.5 m is
+    #: within 1 N / 0.5 mm of the converged statistics (model README, "Convergence")
+    element_length: float = param(0.5, lo=0.0, lo_open=True, hi=1000.0, unit="m",
                                   doc="target FE element length; key points (supports, droppers) are always nodes")
     # --- reference pantograph (two lumped masses on a fixed base) ----------------------------------------------------
     m1: float = param(7.2, lo=0.0, lo_open=True, hi=1e4, unit="kg", doc="head mass")

@@ -85,12 +85,11 @@ class Passage(Stepping):
     # --- the start: coupled static equilibrium ----------------------------------------------------------------
     def _static(self, x_start: float) -> None:
         """Catenary and pantograph at rest, pressing on each other: the pantograph's static state on a spring of the
-        contact stiffness in series with the wire's static compliance at x_start, the wire's static response to that
-        force."""
+        contact stiffness in series with the wire's static compliance at x_start (its point-load defect included,
+        `sim.contact_stiffness`), the wire's static response to that force."""
         sim, panto = self.sim, self.panto
         fe, h = sim.fe, sim.h
         n = fe.n
-        kc = fe.params.k_contact
         u = np.zeros(n)
         q = np.zeros(n)
         pv = np.zeros(n)
@@ -99,7 +98,7 @@ class Passage(Stepping):
         Nl, dofs, valid = self.Nl, self._dofs, self._valid
         w0 = float(Nl @ self._w0d)
         c_static = sim.static_compliance(Nl, dofs)
-        f = panto.static(w0, 1.0 / (1.0 / kc + c_static))
+        f = panto.static(w0, 1.0 / (1.0 / self.kce + c_static))
         if sim.unilateral and f < 0:
             f = panto.static(w0, 0.0)
         if f != 0.0 and c_static > 0:
@@ -120,10 +119,12 @@ class Passage(Stepping):
         self.head = panto.head()
 
     def _set_contactelement(self, e: int, dx: float) -> None:
-        """The contact point at distance dx into CW element e: its element data and shape functions."""
+        """The contact point at distance dx into CW element e: its element data, shape functions, the contact wire's
+        point-load defect there (`cb`) and the contact spring in series with it (`kce`)."""
         x_e, he, dofs, valid, w0d, cols = self.sim.element(e)
         self.e, self._dofs, self._valid, self._w0d, self._cols = e, dofs, valid, w0d, cols
         self.Nl = self.sim.shape(dx / he, he, valid)
+        self.cb, self.kce = self.sim.contact_stiffness(e, dx / he)
 
     # --- one step ---------------------------------------------------------------------------------------------
     def _one_step(self) -> None:
@@ -182,7 +183,7 @@ class Passage(Stepping):
         """An affine pantograph: its exact head map P - g f1 into the local problem, one trial to advance it."""
         sim, panto, f_prev = self.sim, self.panto, self.force
         P, gp = panto.affine_map(sim.dt, f_prev)
-        f, S, sS, active = sim.solve_local(P, gp, a, c, bz, dstar, self.in_contact, self.slack)
+        f, S, sS, active = sim.solve_local(P, gp, a, c, bz, dstar, self.in_contact, self.slack, self.kce)
         yh = panto.trial(t, sim.dt, f_prev, f)
         self.n_local += 1
         return f, S, sS, active, yh
@@ -200,7 +201,7 @@ class Passage(Stepping):
         P = y0 + gp * f_prev
         fa, ya = f_prev, y0
         for _it in range(30):
-            f, S, sS, active = sim.solve_local(P, gp, a, c, bz, dstar, active, S)
+            f, S, sS, active = sim.solve_local(P, gp, a, c, bz, dstar, active, S, self.kce)
             if f == fa:
                 yh = ya
                 panto.trial(t, dt, f_prev, f)
@@ -267,9 +268,10 @@ class Passage(Stepping):
 
     # --- what the state shows ---------------------------------------------------------------------------------
     def wire_height(self) -> float:
-        """CW height at the contact point, static sag included (m)."""
+        """CW height at the contact point, static sag and the point-load defect's deflection d f included (m): the
+        height the contact spring meets, f = k_c max(head - wire, 0)."""
         Nl = self.Nl
-        return float(Nl @ self._w0d) + float(Nl @ self.u[self._dofs])
+        return float(Nl @ self._w0d) + float(Nl @ self.u[self._dofs]) + self.cb * self.force
 
     def dropper_tension(self) -> np.ndarray:
         """Elastic dropper tensions T0 + k delta (N); negative on a slack dropper."""
@@ -282,9 +284,10 @@ class Passage(Stepping):
 
     def energy_terms(self) -> dict[str, float]:
         """The catenary energy relative to the static state (kinetic + wires + support springs + droppers with their
-        exact law), the pantograph's energy (if it offers `energy()`, else NaN), the contact spring energy and the
-        power -f V dw/dx that the imposed horizontal motion feeds in through the sloping wire (its time integral
-        closes the balance of an undamped system)."""
+        exact law), the pantograph's energy (if it offers `energy()`, else NaN), the contact spring energy (the
+        wire's point-load defect under it included: f^2 (1/k_c + d) / 2) and the power -f V dw/dx that the imposed
+        horizontal motion feeds in through the sloping wire (its time integral closes the balance of an undamped
+        system)."""
         sim, fe, u, f = self.sim, self.sim.fe, self.u, self.force
         v = self.velocity()
         delta = u[sim.mw] - u[sim.cw]
@@ -305,7 +308,7 @@ class Passage(Stepping):
         dN = np.where(valid, dN, 0.0)
         slope = float(dN @ (u[dofs] + w0d))
         return {"catenary": E_c, "pantograph": en() if en is not None else np.nan,
-                "contact": f * f / (2 * fe.params.k_contact), "drive_power": -f * sim.V * slope}
+                "contact": 0.5 * f * f * (1.0 / fe.params.k_contact + self.cb), "drive_power": -f * sim.V * slope}
 
 
 class Recorder:

@@ -10,7 +10,9 @@ so one step costs one banded solve (S is symmetric positive definite with half-b
 ordering: LAPACK banded Cholesky dpbtrf once, dpbtrs per step) and one sparse mat-vec. C = alpha M + beta K0
 (Rayleigh on the wires and support springs; droppers are massless undamped springs). K = K0 + Kd holds the
 droppers as linear springs; g are the local forces: the contact force f N(x) (Hermite shape functions at the
-contact point) and, for slack droppers, a correction -s B_i that cancels the dropper's tension.
+contact point) and, for slack droppers, a correction -s B_i that cancels the dropper's tension. Every point spring
+carries its wires' point-load defect in series (`fe.PointCorrection`): the droppers and support springs in K, the
+contact spring through its effective stiffness k_c,eff = 1 / (1/k_c + d(x)) at the contact point x.
 
 Consistency (no lag): with G = h^2 S^-1, the end-of-step displacement is affine in the unknown local forces,
 u_{n+1} = u* + f G N - G B s, where u* comes from the single solve and G B (all droppers) is precomputed; G N is
@@ -93,7 +95,7 @@ class CoupledSimulation:
         self.lu = BandedSPD(S)
         self.max_displacement = MAX_DISPLACEMENT
         self.mw, self.cw = fe.dropper_mw, fe.dropper_cw
-        self.kd = p.k_dropper
+        self.kd = fe.k_drop  # per dropper (the wires' point-load defects in series)
         nd = fe.T0.size
         if self.slack:
             # G B with G = h^2 S^-1: response of u_{n+1} to unit slack corrections; D = B^T G B
@@ -140,6 +142,13 @@ class CoupledSimulation:
             self._elem[e] = d
         return d
 
+    def contact_stiffness(self, e: int, xi: float) -> tuple[float, float]:
+        """The contact wire's point-load defect d (m/N) at local coordinate xi of element e and the contact spring in
+        series with it, k_c,eff = 1 / (1/k_c + d) (k_c itself where d = 0)."""
+        d = self.fe.contact_defect(e, xi)
+        kc = self.fe.params.k_contact
+        return d, (kc / (1.0 + kc * d) if d != 0.0 else kc)
+
     @staticmethod
     def shape(xi: float, he: float, valid: np.ndarray) -> np.ndarray:
         """Hermite shape functions of a beam element at local coordinate `xi` (length `he`); 0 where not `valid`."""
@@ -149,13 +158,14 @@ class CoupledSimulation:
         return np.where(valid, N, 0.0)
 
     # --- the local nonlinear problem of one step ---------------------------------------------------------------
-    def solve_local(self, P, gp, a, c, bz, dstar, active, S):
+    def solve_local(self, P, gp, a, c, bz, dstar, active, S, kc):
         """Contact force f and slack corrections s (on the set S) for the pantograph map y_h = P - gp f and the wire
-        map y_w = a + c f - bz_S . s_S, dropper elongations delta = dstar + bz f - D[:, S] s_S.
+        map y_w = a + c f - bz_S . s_S, dropper elongations delta = dstar + bz f - D[:, S] s_S, contact stiffness kc
+        (the effective one at the contact point, `contact_stiffness`).
 
         Returns f, S, s_S, active. Semi-smooth Newton (primal-dual active set) on the piecewise-linear conditions
         f = k_c max(y_h - y_w, 0) and T0 + k delta + s = 0 with s >= 0 on slack droppers."""
-        kc, kd, T0 = self.fe.params.k_contact, self.kd, self.fe.T0
+        kd, T0 = self.kd, self.fe.T0
         if not S:  # fast path: no slack dropper
             f = kc * (P - a) / (1 + kc * (gp + c))
             if self.unilateral and f < 0:
@@ -176,11 +186,11 @@ class CoupledSimulation:
                     r[0] = kc * (P - a)
                     if m:
                         A[0, 1:] = -kc * bz[S]
-                        A[1:, 0] = kd * bz[S]
+                        A[1:, 0] = kd[S] * bz[S]
                     o = 1
                 if m:
-                    A[o:, o:] = np.eye(m) - kd * self.D[np.ix_(S, S)]
-                    r[o:] = -T0[S] - kd * dstar[S]
+                    A[o:, o:] = np.eye(m) - kd[S][:, None] * self.D[np.ix_(S, S)]
+                    r[o:] = -T0[S] - kd[S] * dstar[S]
                 sol = np.linalg.solve(A, r)
                 f = float(sol[0]) if active else 0.0
                 sS = sol[o:]

@@ -124,13 +124,14 @@ class TrainPassage(Stepping):
             self._finish()
 
     def _enter(self, k: int, n: int) -> None:
-        """Pantograph k enters at step n: placed where it stands, at its static equilibrium against the wire."""
+        """Pantograph k enters at step n: placed where it stands, at its static equilibrium against the wire (through
+        the contact spring in series with the contact wire's point-load defect there)."""
         sim, core, pan = self.sim, self.core, self.pans[k]
         core.place(k, float(self.xs[k] + self.V * n * self.dt))
         if k == 0:
             f, head = self.lead.force, self.lead.head
         else:
-            f = pan.static(core.wire(k), sim.fe.params.k_contact)
+            f = pan.static(core.wire(k), float(core.kce[k]))
             if sim.unilateral and f < 0:
                 f = pan.static(core.wire(k), 0.0)
             head = pan.head()
@@ -310,7 +311,7 @@ def _record_row(core: NativeCore, n: int, t: float, T, X, F, H, W, U, NS, pans, 
         if core.present[k]:
             F[n, k] = core.f[k]
             H[n, k] = core.head[k]
-            W[n, k] = core.wire(k)
+            W[n, k] = core.wire(k) + core.cbc[k] * core.f[k]  # the height the contact spring meets
             for key, v in pans[k].signals().items():
                 arr = psig[k].get(key)
                 if arr is None:
@@ -389,7 +390,8 @@ class _Secant:
 
 def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, float]:
     """Energy terms of the coupled train (as `Passage.energy_terms`): catenary (kinetic + wires and supports +
-    droppers with their exact law, relative to the static state), every pantograph, every contact spring, and the
+    droppers with their exact law, relative to the static state), every pantograph, every contact spring (with the
+    wire's point-load defect under it), and the
     power the imposed horizontal motion feeds in through the sloping wire, summed over the contacts."""
     fe = sim.fe
     u = core.u
@@ -407,7 +409,7 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
             continue
         E_p += pan.energy()
         f = float(core.f[k])
-        E_k += f * f / (2 * fe.params.k_contact)
+        E_k += 0.5 * f * f * (1.0 / fe.params.k_contact + float(core.cbc[k]))
         e = int(core.elem[k])
         he = fe.x[e + 1] - fe.x[e]
         xi = (core.xc[k] - fe.x[e]) / he

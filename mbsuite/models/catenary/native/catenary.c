@@ -5,8 +5,9 @@
  *   predict:  R = q_n + h/2 g_n,  vb* = S^-1 R  (one banded Cholesky solve, S factorised once here);
  *   contacts: per contact k its element, Hermite shape functions N_k, the wire height a_k without new local forces,
  *             the compliances C_kl = N_k . G N_l, the influence bz_kj of contact k on dropper j, the elongations
- *             dstar_j of the droppers;
- *   local:    the contact forces f_k = k_c max(y_head,k - y_wire,k, 0) (unilateral) and the slack droppers' tension-
+ *             dstar_j of the droppers, and the contact spring in series with the contact wire's point-load defect
+ *             d_k there, k_c,k = 1 / (1/k_c + d_k) (fe.PointCorrection; the droppers' own defects are in kdj);
+ *   local:    the contact forces f_k = k_c,k max(y_head,k - y_wire,k, 0) (unilateral) and the slack droppers' tension-
  *             cancelling corrections s_j >= 0, solved exactly by a primal-dual active-set iteration on this
  *             piecewise-linear problem, with each pantograph's head map y_head,k = P_k - gp_k f_k;
  *   advance:  vb = vb* + (sum_k f_k G N_k - sum_j s_j G B_j) / (2h), u += 2h vb, and the momentum recursions
@@ -17,14 +18,15 @@
 #include <math.h>
 #include <string.h>
 
-#define CAT_ABI 1
+#define CAT_ABI 2
 
 typedef struct {
   /* sizes and switches */
   int n, bw, nd, nsup, ncon, nnode, nnz;
   int slack, unilateral, max_iter;
   /* scalars of the scheme */
-  double h, hh2, c_ab, inv_1ha, c_kd, two_hh, kc, kd, V, dt, max_disp;
+  double h, hh2, c_ab, inv_1ha, c_kd, two_hh, kc, V, dt, max_disp;
+  double cw_T, cw_EI; /* contact wire tension and bending stiffness (its point-load defect) */
   /* matrices (caller's arrays) */
   double *L;     /* n*(bw+1): on entry the lower band of S (L[i*(bw+1)+k] = S[i][i-k]), factorised in place */
   double *invd;  /* n: 1 / diagonal of the Cholesky factor */
@@ -32,12 +34,16 @@ typedef struct {
   double *Kx;
   int *mw, *cw;  /* nd: free index of the MW / CW w DOF of each dropper */
   double *T0;    /* nd static dropper tensions */
+  double *kdj;   /* nd dropper stiffnesses (the wires' point-load defects in series) */
   double *Zg;    /* nd*n: row j = G B_j */
   double *D;     /* nd*nd: B^T G B */
   double *xnode; /* nnode node positions */
   int *cwdof;    /* 2*nnode: free index of the CW (w, theta) of each node, -1 when pinned */
   double *w0cw;  /* 2*nnode: static CW (w, theta) of each node */
   int *supidx;   /* nsup: free index of the CW w at each support, -1 when pinned */
+  int *esig;     /* nnode-1: each CW element's entry in pq, pref (fe.PointCorrection) */
+  double *pq;    /* 16 per entry: the Hermite compliance Q of the element's DOFs on its reference beam */
+  double *pref;  /* 3 per entry: a0, L (reference beam; L = 0: no correction), h */
   /* catenary state and work */
   double *u, *q, *p, *R, *vbs, *vb; /* n each */
   int *slk;      /* nd: the slack set (sorted) */
@@ -55,6 +61,8 @@ typedef struct {
   double *w0d;   /* 4*ncon static CW DOFs of the element */
   double *cols;  /* ncon*4*n: G e_d for the element's 4 CW DOFs (0 for a pinned DOF) */
   double *f;     /* ncon contact forces at the end of the last step */
+  double *kce;   /* ncon contact stiffness in series with the contact wire's point-load defect there */
+  double *cbc;   /* ncon the defect d_k (m/N) */
   double *gv;    /* 4*ncon: N_k f_k of the last step (the local force g_n) */
   double *a, *Cm, *bz, *dstar; /* ncon, ncon*ncon, ncon*nd, nd */
   double *P, *gp; /* ncon head maps */
@@ -299,7 +307,31 @@ static int locate(const cat_job* J, double xp, int e) {
   return e;
 }
 
-/* element, shape functions and geometry of contact k at position xp */
+/* the static deflection at a of a pinned-pinned tensioned beam of length L under a unit force at a (closed form,
+ * fe.tensioned_beam_compliance) */
+static double beam_compliance(double a, double L, double T, double EI) {
+  double s = a * (L - a) / L;
+  if (EI > 0.0) {
+    const double lam = sqrt(T / EI);
+    s -= (-expm1(-2 * lam * a)) * (-expm1(-2 * lam * (L - a))) / (2 * lam * (-expm1(-2 * lam * L)));
+  }
+  return s / T;
+}
+
+/* the contact wire's point-load defect at xi of element e (fe.PointCorrection.defect, same order of operations) */
+static double point_defect(const cat_job* J, int e, double xi) {
+  const int k = J->esig[e];
+  const double a0 = J->pref[3 * k], L = J->pref[3 * k + 1], h = J->pref[3 * k + 2];
+  if (L == 0.0) return 0.0;
+  const double x2 = xi * xi, x3 = x2 * xi;
+  const double N[4] = {1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)};
+  const double* Q = J->pq + 16 * k;
+  double q = 0.0;
+  for (int r = 0; r < 4; r++) q += N[r] * (((Q[4 * r] * N[0] + Q[4 * r + 1] * N[1]) + Q[4 * r + 2] * N[2]) + Q[4 * r + 3] * N[3]);
+  return beam_compliance(a0 + xi * h, L, J->cw_T, J->cw_EI) - q;
+}
+
+/* element, shape functions and geometry of contact k at position xp; its contact stiffness with the defect */
 void mbs_cat_place(cat_job* J, int k, double xp) {
   const int e = locate(J, xp, J->elem[k]);
   set_element(J, k, e);
@@ -309,6 +341,9 @@ void mbs_cat_place(cat_job* J, int k, double xp) {
   const double N[4] = {1 - 3 * x2 + 2 * x3, he * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, he * (x3 - x2)};
   for (int m = 0; m < 4; m++) J->Nl[4 * k + m] = J->cwdof[2 * e + m] >= 0 ? N[m] : 0.0;
   J->xc[k] = xp;
+  const double d = point_defect(J, e, xi);
+  J->cbc[k] = d;
+  J->kce[k] = d != 0.0 ? J->kc / (1.0 + J->kc * d) : J->kc;
 }
 
 /* CW height at contact k from the current u (static sag included) */
@@ -431,7 +466,6 @@ static int dense_solve(double* A, double* r, int m) {
  * maps P - gp f of the pantographs (active-set iteration, see the file's comment and sim.Passage.solve_local) */
 int mbs_cat_local(cat_job* J) {
   const int nc = J->ncon, nd = J->nd;
-  const double kc = J->kc, kd = J->kd;
   int* act_idx = J->iwork;        /* active contacts */
   int* in_s = J->iwork + nc + nd; /* membership of the slack set (nd) */
   double* f = J->f;
@@ -447,6 +481,7 @@ int mbs_cat_local(cat_job* J) {
     double* r = J->work + (long)m * m;
     for (int i = 0; i < na; i++) {
       const int k = act_idx[i];
+      const double kc = J->kce[k];
       for (int j = 0; j < na; j++) A[i * m + j] = kc * J->Cm[k * nc + act_idx[j]];
       A[i * m + i] += 1.0 + kc * J->gp[k];
       for (int b = 0; b < ms; b++) A[i * m + na + b] = -kc * J->bz[k * nd + S[b]];
@@ -454,6 +489,7 @@ int mbs_cat_local(cat_job* J) {
     }
     for (int b = 0; b < ms; b++) {
       const int j = S[b], row = na + b;
+      const double kd = J->kdj[j];
       for (int i = 0; i < na; i++) A[row * m + i] = kd * J->bz[act_idx[i] * nd + j];
       for (int c = 0; c < ms; c++) A[row * m + na + c] = (b == c ? 1.0 : 0.0) - kd * J->D[j * nd + S[c]];
       r[row] = -J->T0[j] - kd * J->dstar[j];
@@ -499,7 +535,7 @@ int mbs_cat_local(cat_job* J) {
         double d = J->dstar[j];
         for (int k = 0; k < nc; k++) d += J->bz[k * nd + j] * f[k];
         for (int b = 0; b < ms; b++) d -= J->D[j * nd + S[b]] * s[b];
-        const double tension = J->T0[j] + kd * d;
+        const double tension = J->T0[j] + J->kdj[j] * d;
         int was = 0;
         for (int b = 0; b < ms; b++) was |= (S[b] == j);
         if (tension < 0 && !was) {
@@ -566,10 +602,9 @@ void mbs_cat_advance(cat_job* J) {
     p[i] = A2 + B2 - q[i];
     q[i] = qn;
   }
-  const double ckd = 2.0 * J->kd * J->c_kd;
   for (int j = 0; j < nd; j++) {
     const int im = J->mw[j], ic = J->cw[j];
-    const double dv = ckd * (vb[im] - vb[ic]);
+    const double dv = 2.0 * J->kdj[j] * J->c_kd * (vb[im] - vb[ic]);
     q[im] += dv;
     p[im] += dv;
     q[ic] -= dv;
@@ -643,7 +678,7 @@ static void record(cat_job* J, long row, double t) {
     if (J->rec_x) J->rec_x[row * nc + k] = J->xc[k];
     if (J->rec_f) J->rec_f[row * nc + k] = J->present[k] ? J->f[k] : 0.0;
     if (J->rec_head) J->rec_head[row * nc + k] = J->head[k];
-    if (J->rec_wire) J->rec_wire[row * nc + k] = J->present[k] ? mbs_cat_wire(J, k) : 0.0;
+    if (J->rec_wire) J->rec_wire[row * nc + k] = J->present[k] ? mbs_cat_wire(J, k) + J->cbc[k] * J->f[k] : 0.0;
     if (J->rec_frame) J->rec_frame[row * nc + k] = J->pm ? J->pm[16 * k + 1] : 0.0;
   }
   if (J->rec_up) {

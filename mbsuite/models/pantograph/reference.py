@@ -46,8 +46,10 @@ class EventExactIntegrator(Stepping):
 
     def __init__(self, ode: PantographODE, y_w: Callable[[float], float], t_end: float, x0: np.ndarray, *,
                  method: str = "LSODA", rtol: float = 1e-8, atol: float = 1e-10, max_step: float = 0.0,
-                 t_eval: np.ndarray | None = None, max_events: int = 200_000, max_nfev: int = 50_000_000):
+                 t_eval: np.ndarray | None = None, max_events: int = 200_000, max_nfev: int = 50_000_000,
+                 breaks: tuple[float, ...] = ()):
         self.ode, self.y_w, self.t_end, self.t_eval = ode, y_w, t_end, t_eval
+        self.breaks = tuple(sorted(float(b) for b in breaks if 0.0 < b < t_end))
         self.method, self.max_events, self.max_nfev = method, max_events, max_nfev
         self.x = np.asarray(x0, dtype=float).copy()
         self.t = 0.0
@@ -76,25 +78,35 @@ class EventExactIntegrator(Stepping):
         if self.nsegments > self.max_events:
             raise SolverError(f"more than {self.max_events} friction/contact events before t = {t0:.6g} s (mode "
                               "chattering)")
+        # a discontinuity of the input (a step) ends the segment: integrate to it on the input's left limit
+        brk = next((b for b in self.breaks if b > t0), None)
+        t_stop = t_end if brk is None else brk
+        u = y_w if brk is None else _left_limit(y_w, brk)
         evs, kinds = [], []
         if self.exact:
             for j in range(3):
                 if ode.c[j] == 0:
                     continue
                 if modes.stuck[j]:
-                    evs.append(_stuck_event(ode, y_w, modes, j))
+                    evs.append(_stuck_event(ode, u, modes, j))
                     kinds.append(("release", j))
                 else:
                     evs.append(_slide_event(ode, modes, j))
                     kinds.append(("zero_rate", j))
         if self.unilateral:
-            evs.append(_contact_event(ode, y_w, self.in_contact))
+            evs.append(_contact_event(ode, u, self.in_contact))
             kinds.append(("contact", -1))
         t_eval = self.t_eval
-        te = None if t_eval is None else t_eval[(t_eval >= t0) & (t_eval <= t_end)]
+        te = None if t_eval is None else t_eval[(t_eval >= t0) & (t_eval <= t_stop)]
+        if brk is not None and te is not None:  # the break's own sample belongs to the next segment
+            te = np.append(te[te < brk], brk)
         seg_modes = modes if self.exact else None
-        sol = solve_ivp(lambda t, x, m=seg_modes: ode.rhs(t, x, y_w(t), m), (t0, t_end), self.x,
-                        t_eval=te, events=evs or None, **self._kw)
+        try:
+            sol = solve_ivp(lambda t, x, m=seg_modes: ode.rhs(t, x, u(t), m), (t0, t_stop), self.x,
+                            t_eval=te, events=evs or None, **self._kw)
+        except ValueError as exc:  # solve_ivp's event root finder on a bracket its interpolant does not keep
+            raise SolverError(f"reference integrator {self.method} failed to locate a friction/contact event after "
+                              f"t = {t0:.6g} s ({exc}); tighten solver.rtol or choose another solver.method") from None
         self.nfev += sol.nfev
         self.nsteps += max(len(sol.t) - 1, 0) if t_eval is None else 0
         if sol.status == -1:
@@ -102,9 +114,18 @@ class EventExactIntegrator(Stepping):
         if self.nfev > self.max_nfev:
             raise SolverError(f"reference integrator exceeded {self.max_nfev} RHS evaluations (step-size collapse)")
         st = np.asarray(sol.t, dtype=float)
+        sy = np.asarray(sol.y, dtype=float).reshape(ode.n, st.size)
+        at_break = brk is not None and sol.status == 0
+        if at_break and te is not None:  # keep the state at the break, leave its sample to the next segment
+            x_brk, st, sy = sy[:, -1].copy(), st[:-1], sy[:, :-1]
+        elif at_break:
+            x_brk = sy[:, -1].copy()
         if st.size:
             self._t_out.append(st)
-            self._x_out.append(np.asarray(sol.y, dtype=float).reshape(ode.n, st.size))
+            self._x_out.append(sy)
+        if at_break:
+            self._cross_break(brk, x_brk)
+            return
         if sol.status == 0:
             self.t, self.status = t_end, "finished"
             return
@@ -143,6 +164,28 @@ class EventExactIntegrator(Stepping):
         if self.t >= t_end:
             self.status = "finished"
 
+    def _cross_break(self, t0: float, x: np.ndarray) -> None:
+        """At a jump of the input: re-decide the friction modes (a stuck joint whose holding torque jumped past c
+        breaks loose now) and the contact (the wire may jump away from the head or onto it)."""
+        ode, y_w = self.ode, self.y_w
+        if self.exact:
+            old = self.modes.stuck.copy()
+            self.modes = _decide_modes(ode, x, y_w(t0), self.modes)
+            x = _project_stuck(ode, x, self.modes)
+            for jj in np.flatnonzero(old != self.modes.stuck):
+                self.events.append({"kind": "stick" if self.modes.stuck[jj] else "slip", "joint": JOINT_NAMES[jj],
+                                    "t": t0})
+        if self.unilateral:
+            touching = ode.contact_height(x) >= y_w(t0)
+            if touching and not self.in_contact:
+                self.events.append({"kind": "contact_loss", "t_start": self._loss_start,
+                                    "duration": t0 - self._loss_start})
+                self._loss_start = None
+            elif self.in_contact and not touching:
+                self._loss_start = t0
+            self.in_contact = touching
+        self.t, self.x = t0, x
+
     def solution(self) -> RefSolution:
         """The samples so far (t_eval's, or every solver step without t_eval), the events (a contact loss still
         open at the end has duration None) and the cost. Raises SolverError on a non-finite state."""
@@ -179,13 +222,20 @@ def run_reference(scene: Scene) -> SimResult:
     dt_out = s.sample_dt or s.timestep
     t_eval = np.arange(0.0, s.duration + 0.5 * dt_out, dt_out)
     max_step = s.max_step or (1.0 / (16.0 * u.frequency) if u.kind == "sine" else 0.0)
+    breaks = (u.t_step,) if u.kind == "step" else ()  # the ram's jump ends a smooth segment
     sol = simulate(ode, u, s.duration, start.x0, method=s.method, rtol=s.rtol, atol=s.atol, max_step=max_step,
-                   t_eval=t_eval)
+                   t_eval=t_eval, breaks=breaks)
     th = np.array([ode.theta(sol.x[: ode.nq, k]) for k in range(sol.t.size)])
     P = sol.x[-1] if ode.has_P else None
     return assemble(scene, sol.t, signals(ode, th, u(sol.t), P), engine="reference", events=sol.events,
                     stats={"nfev": sol.nfev, "segments": sol.nsegments, "method": s.method, "rtol": s.rtol},
                     health=[excursion(th, start.theta0)])
+
+
+def _left_limit(y_w: Callable[[float], float], b: float) -> Callable[[float], float]:
+    """The input up to the jump at `b`, held at its left limit from `b` on (a segment ending at `b` sees no jump)."""
+    left = y_w(float(np.nextafter(b, -np.inf)))
+    return lambda t: y_w(t) if t < b else left
 
 
 def _slide_event(ode: PantographODE, modes: FrictionModes, j: int):

@@ -65,8 +65,8 @@ def _per_speed(rows: list[Row], d: dict) -> list[str]:
         return " | ".join(f"{det[k + '_force_N']:.2g} / {det[k + '_uplift_mm']:.2g} / {det[k + '_loss_pct']:.2g}"
                           for k in keys)
 
-    if "check_details" in d:
-        out.append(f"| check {d['check']} (against the reference) | – | {cells(d['check_details'])} |")
+    for c in d.get("checks", []):
+        out.append(f"| check: {c['check']} (against the reference) | – | {cells(c['details'])} |")
     for r in ok:
         out.append(f"| {_s(r.setting)} | {r.time_s:.3g} | {cells(r.details)} |")
     return [*out, ""]

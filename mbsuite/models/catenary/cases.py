@@ -195,23 +195,32 @@ def random_input(scene: Scene, rng: np.random.Generator) -> dict:
 
 
 # ================================================================================================ work-precision
-def passage_stats(scene: Scene, element_length: float, dt: float, speeds: tuple[float, ...]) -> dict[str, list]:
+#: the FE method options the study compares: the point-load correction of the wires (`fe.PointCorrection`, the
+#: default) and the plain Hermite wires
+METHODS = {"corrected": True, "plain": False}
+
+
+def passage_stats(scene: Scene, element_length: float, dt: float, speeds: tuple[float, ...],
+                  correction: bool = True) -> dict[str, list]:
     """The statistics (`accuracy.STATS`) of every pantograph of the scene's passage (its `[train]`, on its path) at
-    each speed with this element length and time step: {"250": [{stat: value} per pantograph], ...}. The size guards
-    grow with the resolution (the study asks for it); a run past the wave-resolution bound is kept."""
+    each speed with this element length, time step and FE method (`correction`: the wires' point-load correction):
+    {"250": [{stat: value} per pantograph], ...}. The size guards grow with the resolution (the study asks for it);
+    a run past the wave-resolution bound is kept."""
     from .accuracy import STATS
     from .analysis import scene_config
     from .config import CriticalSpeedWarning
+    from .fe import assemble
     from .train import run_passage
 
     p = scene.build_params()
     sc = scene.replace(params={"element_length": element_length, "max_element_steps": max(
-        p.max_element_steps, 1e12)}, solver={"timestep": dt, "max_steps": 1e9, "allow_inaccurate": True})
+        p.max_element_steps, 1e13)}, solver={"timestep": dt, "max_steps": 1e9, "allow_inaccurate": True})
     out = {}
     for v in speeds:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", CriticalSpeedWarning)
-            run = run_passage(scene_config(sc, sc.solver.engine, speed_kmh=v))
+            cfg = scene_config(sc, sc.solver.engine, speed_kmh=v)
+            run = run_passage(cfg, fe=assemble(cfg.params, point_correction=correction))
         out[f"{v:g}"] = [{k: float(st[k]) for k in STATS} for st in run.stats]
     return out
 
@@ -228,15 +237,17 @@ def _source_digest() -> str:
 
 
 class CatenaryStudy(Study):
-    """Work-precision study of a catenary scene: element length x time step (every pantograph of the scene's passage,
-    both EN 50318 speeds; one setting's CPU is both passages') against a reference at 0.0625 m / 2.5e-5 s, whose
-    own accuracy is shown against 0.125 m / 5e-5 s. Errors are those of the eight statistics (`accuracy.py`)."""
+    """Work-precision study of a catenary scene: FE method (the wires' point-load correction, or the plain Hermite
+    wires) x element length x time step, every pantograph of the scene's passage at both EN 50318 speeds (one
+    setting's time is both passages'), against a reference of the plain Hermite wires at 0.0625 m / 5e-5 s whose own
+    accuracy is shown by two checks, 0.125 m / 5e-5 s (the mesh) and 0.0625 m / 1e-4 s (the step). Errors are those
+    of the eight statistics (`accuracy.py`)."""
 
     ELEMENTS = (1.0, 0.5, 0.25, 0.125)
     STEPS = (4e-4, 2e-4, 1e-4, 5e-5)
     SPEEDS = (250.0, 300.0)
-    REFERENCE = (0.0625, 2.5e-5)
-    CHECK = (0.125, 5e-5)
+    REFERENCE = ("plain", 0.0625, 5e-5)
+    CHECKS = (("plain", 0.125, 5e-5), ("plain", 0.0625, 1e-4))
     #: where references are cached (None: computed every time); keyed by the scene, resolution, speeds and the code
     reference_cache: Path | None = None
     state_doc = ("max |statistic - ref| over the six force statistics (Fm, sigma, Fm +/- 3 sigma, actual max and "
@@ -246,44 +257,52 @@ class CatenaryStudy(Study):
 
     def __init__(self, scene: Scene, quick: bool = False):
         super().__init__(scene, quick)
-        if quick:  # one speed, two coarse settings against the shipped-scene resolution
-            self.elements, self.steps, self.speeds = (2.0, 1.0), (8e-4, 4e-4), (float(scene.input["speed"]),)
-            self.ref_res, self.check_res = (0.5, 2e-4), (1.0, 4e-4)
+        if quick:  # one speed, the corrected method at two coarse settings against the shipped resolution
+            self.methods, self.elements, self.steps = ("corrected",), (2.0, 1.0), (8e-4, 4e-4)
+            self.speeds = (float(scene.input["speed"]),)
+            self.ref_res, self.checks = ("corrected", 0.5, 2e-4), (("corrected", 1.0, 4e-4),)
         else:
-            self.elements, self.steps, self.speeds = self.ELEMENTS, self.STEPS, self.SPEEDS
-            self.ref_res, self.check_res = self.REFERENCE, self.CHECK
+            self.methods, self.elements, self.steps = tuple(METHODS), self.ELEMENTS, self.STEPS
+            self.speeds, self.ref_res, self.checks = self.SPEEDS, self.REFERENCE, self.CHECKS
 
-    def _stats(self, h: float, dt: float) -> dict[str, list]:
-        return passage_stats(self.scene, h, dt, self.speeds)
+    def _stats(self, method: str, h: float, dt: float) -> dict[str, list]:
+        return passage_stats(self.scene, h, dt, self.speeds, METHODS[method])
 
     def settings(self) -> list[Setting]:
-        """Element length x time step, trapezoidal rule."""
-        return [Setting("fe", "trapezoidal", f"h {h:g} m, dt {dt:g} s", lambda h=h, dt=dt: self._stats(h, dt))
-                for h in self.elements for dt in self.steps]
+        """FE method x element length x time step, trapezoidal rule."""
+        return [Setting("fe", f"trapezoidal, {m} Hermite", f"h {h:g} m, dt {dt:g} s",
+                        lambda m=m, h=h, dt=dt: self._stats(m, h, dt))
+                for m in self.methods for h in self.elements for dt in self.steps]
 
-    def _cached(self, h: float, dt: float) -> dict[str, list]:
+    def _cached(self, method: str, h: float, dt: float) -> dict[str, list]:
         if self.reference_cache is None:
-            return self._stats(h, dt)
-        key = hashlib.sha256(json.dumps([self.scene.to_dict(), h, dt, self.speeds, _source_digest()],
+            return self._stats(method, h, dt)
+        key = hashlib.sha256(json.dumps([self.scene.to_dict(), method, h, dt, self.speeds, _source_digest()],
                                         sort_keys=True, default=str).encode()).hexdigest()[:20]
         f = Path(self.reference_cache) / f"catenary_reference_{key}.json"
         if f.exists():
             return json.loads(f.read_text())
-        out = self._stats(h, dt)
+        out = self._stats(method, h, dt)
         f.parent.mkdir(parents=True, exist_ok=True)
         f.write_text(json.dumps(out))
         return out
 
     def reference(self):
-        """The reference statistics (finest resolution) and their check against the next coarser one."""
+        """The reference statistics and their checks (the class docstring)."""
         ref = self._cached(*self.ref_res)
-        chk = self._cached(*self.check_res)
-        err, det = self.physics_error(chk, ref)
-        return ref, {"reference": f"element length {self.ref_res[0]:g} m, dt {self.ref_res[1]:g} s (speeds "
+        checks = []
+        for m, h, dt in self.checks:
+            chk = self._cached(m, h, dt)
+            err, det = self.physics_error(chk, ref)
+            checks.append({"check": f"{m} Hermite {h:g} m, {dt:g} s", "state_error": self.state_error(chk, ref),
+                           "physics_error": err, "details": det})
+        m, h, dt = self.ref_res
+        return ref, {"reference": f"{m} Hermite wires, element length {h:g} m, dt {dt:g} s (speeds "
                                   f"{', '.join(f'{v:g}' for v in self.speeds)} km/h)",
-                     "check": f"{self.check_res[0]:g} m, {self.check_res[1]:g} s",
-                     "check_state_error": self.state_error(chk, ref), "check_physics_error": err,
-                     "check_details": det, "reference_values": ref}
+                     "check": "; ".join(c["check"] for c in checks),
+                     "check_state_error": max(c["state_error"] for c in checks),
+                     "check_physics_error": max(c["physics_error"] for c in checks), "checks": checks,
+                     "reference_values": ref}
 
     @staticmethod
     def _errors(res: dict[str, list], ref: dict[str, list]) -> dict[str, float]:

@@ -4,29 +4,35 @@ alone (LAPACK dpbtrs and the core's block sweeps), and the catenary alone agains
 pantograph in the core (same steps, no contact point vs one); with --eppinger also one passage of the Eppinger
 pantograph on each engine path (0.5 m, dt 1e-4 s). `--compare` instead times the shipped method (the point-load
 correction, `fe.PointCorrection`, at the shipped defaults) against the method before it (the plain Hermite wires at
-the same 0.5 m and dt 2e-4 s): one single-pantograph EN 50318 passage each, assembly included, alternating, medians
-and their ratio. Run it on one core: `taskset -c 0`.
+the same 0.5 m and dt 2e-4 s; with --baseline REV in the code of git revision REV): one single-pantograph EN 50318
+passage each, in fresh interpreters, assembly included, alternating, medians and their ratio. Run it on one core:
+`taskset -c 0`.
 
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
-    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --compare [--repeats 7]
+    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --compare [--repeats 7] [--baseline REV]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
-from mbsuite.models.catenary.analysis import run_scene, simulate
+from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.fe import assemble
 from mbsuite.models.catenary.native_core import NativeCore
 from mbsuite.models.catenary.pantographs import TwoMassPantograph
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.sim import CHECK_EVERY, CoupledSimulation
 from mbsuite.results import format_table
-from mbsuite.scenes import load_scene
 
 STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
 
@@ -57,34 +63,69 @@ def core_loop_cpu(p: CatenaryParams, speed_kmh: float, dt: float, with_pantograp
     return cpu
 
 
-def compare(speeds: list[float], repeats: int) -> None:
+#: one passage in a fresh interpreter: CPU seconds (assembly, start, stepping, statistics) and the statistics
+PASSAGE = {
+    "shipped": ("from mbsuite.models.catenary.analysis import run_scene\n"
+                "from mbsuite.scenes import load_scene\n"
+                "go = lambda v: run_scene(load_scene('catenary/en50318'), speed_kmh=v)\n"),
+    "plain": ("from mbsuite.models.catenary.analysis import simulate\n"
+              "from mbsuite.models.catenary.params import CatenaryParams\n"
+              "try:\n"
+              "    from mbsuite.models.catenary.fe import PointCorrection\n"
+              "    from mbsuite.models.catenary.fe import assemble\n"
+              "    p = CatenaryParams(element_length=0.5)\n"
+              "    go = lambda v: simulate(p, v, 2e-4, fe=assemble(p, point_correction=False))\n"
+              "except ImportError:  # code from before the point-load correction: its method\n"
+              "    go = lambda v: simulate(CatenaryParams(element_length=0.5), v, 2e-4)\n"),
+}
+TIMED = ("import json, sys, time\n{setup}"
+         "go({speed})\n"  # warm-up: the native layer built and loaded, caches filled
+         "c0 = time.process_time()\nrun = go({speed})\ncpu = time.process_time() - c0\n"
+         "print(json.dumps({{'cpu': cpu, 'h': run.params.element_length, 'dt': run.dt, 'steps': run.timing['steps'],"
+         " 'stats': {{k: run.stats[k] for k in {keys!r}}}}}))\n")
+
+
+def _passage(kind: str, speed: float, src: Path) -> dict:
+    """One timed passage of `kind` ("shipped" or "plain") run by the code under `src` in a fresh interpreter."""
+    code = TIMED.format(setup=PASSAGE[kind], speed=speed, keys=STATS)
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=src, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def compare(speeds: list[float], repeats: int, baseline: str | None) -> None:
     """The shipped method at the shipped defaults (`run_scene` of `catenary/en50318`: the parameters' element length,
-    the scene's time step, assembly with the point-load correction) against the plain Hermite wires at 0.5 m and
-    dt 2e-4 s, alternating within each repeat; CPU seconds of the whole passage (assembly, start, stepping,
-    statistics), medians and their ratio, and how far the two sets of statistics are apart."""
-    scene = load_scene("catenary/en50318")
-    p_old = CatenaryParams(element_length=0.5)
-    rows = []
-    for v in speeds:
-        cpu = {"plain": [], "shipped": []}
-        stats = {}
-        for r in range(repeats):
-            for label in (("plain", "shipped") if r % 2 == 0 else ("shipped", "plain")):
-                c0 = time.process_time()
-                if label == "shipped":
-                    run = run_scene(scene, speed_kmh=v)
-                else:
-                    run = simulate(p_old, v, 2e-4, fe=assemble(p_old, point_correction=False))
-                cpu[label].append(time.process_time() - c0)
-                stats[label] = (run.stats, run.params.element_length, run.dt, run.timing["steps"])
-        old, new = statistics.median(cpu["plain"]), statistics.median(cpu["shipped"])
-        d = max(abs(stats["shipped"][0][k] - stats["plain"][0][k]) for k in STATS if k != "loss_pct")
-        _, h, dt, steps = stats["shipped"]
-        rows.append([v, f"{h:g} m, {dt:g} s", steps, f"{old:.3f} ({min(cpu['plain']):.3f}-{max(cpu['plain']):.3f})",
-                     f"{new:.3f} ({min(cpu['shipped']):.3f}-{max(cpu['shipped']):.3f})", f"{new / old:.3f}",
-                     f"{d:.2f}"])
-    print(format_table(["km/h", "shipped setting", "steps", "plain Hermite 0.5 m, 2e-4 s: CPU s (min-max)",
-                        "shipped: CPU s (min-max)", "ratio shipped / plain", "max |stat diff| (N, mm)"], rows))
+    the scene's time step, the point-load correction) against the plain Hermite wires at 0.5 m and dt 2e-4 s, each
+    passage in its own interpreter (`_passage`), alternating; with `baseline` (a git revision) the plain passage runs
+    that revision's code (`git archive` into a temporary folder: the method and the code as they were). CPU seconds
+    of the whole passage after a warm-up passage in the same interpreter, medians, min-max and their ratio, and how
+    far the two sets of statistics are apart."""
+    root = Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory() as tmp:
+        old_src = root
+        if baseline:
+            old_src = Path(tmp)
+            archive = subprocess.run(["git", "archive", baseline], cwd=root, capture_output=True, check=True).stdout
+            subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+        rows = []
+        for v in speeds:
+            cpu: dict[str, list[float]] = {"plain": [], "shipped": []}
+            last: dict[str, dict] = {}
+            for r in range(repeats):
+                for kind in (("plain", "shipped") if r % 2 == 0 else ("shipped", "plain")):
+                    res = _passage(kind, v, old_src if kind == "plain" else root)
+                    cpu[kind].append(res["cpu"])
+                    last[kind] = res
+            old, new = statistics.median(cpu["plain"]), statistics.median(cpu["shipped"])
+            d = max(abs(last["shipped"]["stats"][k] - last["plain"]["stats"][k]) for k in STATS if k != "loss_pct")
+            sh = last["shipped"]
+            rows.append([v, f"{sh['h']:g} m, {sh['dt']:g} s", sh["steps"],
+                         f"{old:.3f} ({min(cpu['plain']):.3f}-{max(cpu['plain']):.3f})",
+                         f"{new:.3f} ({min(cpu['shipped']):.3f}-{max(cpu['shipped']):.3f})", f"{new / old:.3f}",
+                         f"{d:.2f}"])
+    what = f"plain Hermite 0.5 m, 2e-4 s ({'code of ' + baseline if baseline else 'this code'})"
+    print(format_table(["km/h", "shipped setting", "steps", f"{what}: CPU s (min-max)", "shipped: CPU s (min-max)",
+                        "ratio shipped / plain", "max |stat diff| (N, mm)"], rows))
 
 
 def main() -> None:
@@ -95,9 +136,10 @@ def main() -> None:
     ap.add_argument("--timestep", type=float, default=2e-4)
     ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
     ap.add_argument("--compare", action="store_true", help="the shipped method against the plain Hermite wires")
+    ap.add_argument("--baseline", default=None, help="with --compare: a git revision whose code runs the plain wires")
     a = ap.parse_args()
     if a.compare:
-        compare(a.speeds, a.repeats)
+        compare(a.speeds, a.repeats, a.baseline)
         return
     p = CatenaryParams(element_length=a.element_length)
     dt = a.timestep

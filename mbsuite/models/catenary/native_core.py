@@ -40,8 +40,8 @@ class _Job(ctypes.Structure):
         ("u", _P), ("q", _P), ("p", _P), ("R", _P), ("vbs", _P), ("vb", _P),
         ("slk", _P), ("nslack", _I), ("sS", _P),
         ("present", _P), ("active", _P), ("elem", _P), ("xc", _P), ("xs", _P), ("xend", _P), ("Nl", _P),
-        ("dofs", _P), ("w0d", _P), ("cols", _P), ("f", _P), ("kce", _P), ("cbc", _P), ("gv", _P), ("a", _P),
-        ("Cm", _P), ("bz", _P),
+        ("dofs", _P), ("w0d", _P), ("cols", _P), ("crng", _P), ("zrng", _P), ("f", _P), ("kce", _P), ("cbc", _P),
+        ("gv", _P), ("a", _P), ("Cm", _P), ("bz", _P),
         ("dstar", _P), ("P", _P), ("gp", _P), ("head", _P), ("work", _P), ("iwork", _P), ("pm", _P),
         ("rec_t", _P), ("rec_x", _P), ("rec_f", _P), ("rec_head", _P), ("rec_wire", _P), ("rec_frame", _P),
         ("rec_up", _P), ("rec_ns", _P),
@@ -64,7 +64,7 @@ def library() -> ctypes.CDLL:
             ("mbs_cat_wire", _D, [_P, _I]), ("mbs_cat_predict", None, [_P, _D]), ("mbs_cat_local", _I, [_P]),
             ("mbs_cat_advance", None, [_P]), ("mbs_cat_check", _I, [_P]),
             ("mbs_cat_run", _I, [_P, ctypes.c_long, ctypes.c_long, _I]),
-            ("mbs_cat_record", None, [_P, ctypes.c_long, _D]),
+            ("mbs_cat_record", None, [_P, ctypes.c_long, _D]), ("mbs_cat_dropper_ranges", None, [_P]),
         ):
             fn = getattr(lib, name)
             fn.restype, fn.argtypes = res, args
@@ -128,7 +128,8 @@ class NativeCore:
             "present": np.zeros(nc, np.int32), "active": np.zeros(nc, np.int32), "elem": -np.ones(nc, np.int32),
             "xc": np.zeros(nc), "xs": np.asarray(x_start, float).copy(), "xend": np.asarray(x_end, float).copy(),
             "Nl": np.zeros(4 * nc), "dofs": np.zeros(4 * nc, np.int32), "w0d": np.zeros(4 * nc),
-            "cols": np.zeros((nc, 4, n)), "f": np.zeros(nc), "kce": np.full(nc, float(p.k_contact)),
+            "cols": np.zeros((nc, 4, n)), "crng": np.zeros(2 * nc, np.int32),
+            "zrng": np.zeros(2 * max(nd, 1), np.int32), "f": np.zeros(nc), "kce": np.full(nc, float(p.k_contact)),
             "cbc": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
             "Cm": np.zeros(nc * nc), "bz": np.zeros(max(nc * nd, 1)), "dstar": np.zeros(max(nd, 1)),
             "P": np.zeros(nc), "gp": np.zeros(nc), "head": np.zeros(nc),
@@ -144,6 +145,8 @@ class NativeCore:
         self._arrays = arrays
         if lib.mbs_cat_factor(ctypes.byref(j)):
             raise SolverError(f"the step matrix is not positive definite (native Cholesky, row {int(j.err_value)})")
+        if sim.slack:
+            lib.mbs_cat_dropper_ranges(ctypes.byref(j))
         self.blocked = bool(j.blocked)
 
     # --- state exchange ---------------------------------------------------------------------------------------

@@ -19,6 +19,10 @@
 #include <string.h>
 
 #define CAT_ABI 2
+/* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
+ * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
+ * rounding) */
+#define RANGE_EPS 0x1p-60
 
 typedef struct {
   /* sizes and switches */
@@ -60,6 +64,8 @@ typedef struct {
   int *dofs;     /* 4*ncon free DOFs of the element (pinned -> 0) */
   double *w0d;   /* 4*ncon static CW DOFs of the element */
   double *cols;  /* ncon*4*n: G e_d for the element's 4 CW DOFs (0 for a pinned DOF) */
+  int *crng;     /* ncon*2: [lo, hi), outside which the 4 columns are below RANGE_EPS of their largest entry */
+  int *zrng;     /* nd*2: the same for each dropper's G B_j (row j of Zg) */
   double *f;     /* ncon contact forces at the end of the last step */
   double *kce;   /* ncon contact stiffness in series with the contact wire's point-load defect there */
   double *cbc;   /* ncon the defect d_k (m/N) */
@@ -277,6 +283,32 @@ static void unit_column(const cat_job* J, int d, double* col) {
   for (int i = 0; i < J->n; i++) col[i] *= hh;
 }
 
+/* [lo, hi) of the m columns of length n at col (contiguous) outside which every entry is below RANGE_EPS of the
+ * largest (lo = hi = 0 if all are zero) */
+static void col_range(const double* col, int n, int m, int* rng) {
+  double big = 0.0;
+  for (long i = 0; i < (long)m * n; i++) big = fmax(big, fabs(col[i]));
+  const double eps = big * RANGE_EPS;
+  int lo = n, hi = 0;
+  for (int c = 0; c < m; c++) {
+    const double* v = col + (long)c * n;
+    int a = 0, b = n;
+    while (a < b && !(fabs(v[a]) > eps)) a++;
+    while (b > a && !(fabs(v[b - 1]) > eps)) b--;
+    if (a < b) {
+      lo = a < lo ? a : lo;
+      hi = b > hi ? b : hi;
+    }
+  }
+  rng[0] = lo < hi ? lo : 0;
+  rng[1] = lo < hi ? hi : 0;
+}
+
+/* the ranges of the droppers' G B_j (zrng), once Zg is set */
+void mbs_cat_dropper_ranges(cat_job* J) {
+  for (int j = 0; j < J->nd; j++) col_range(J->Zg + (long)j * J->n, J->n, 1, J->zrng + 2 * j);
+}
+
 static void set_element(cat_job* J, int k, int e) {
   const int n = J->n;
   double* cols = J->cols + (long)k * 4 * n;
@@ -290,6 +322,7 @@ static void set_element(cat_job* J, int k, int e) {
   }
   unit_column(J, J->cwdof[2 * (e + 1)], cols + 2 * (long)n);
   unit_column(J, J->cwdof[2 * (e + 1) + 1], cols + 3 * (long)n);
+  col_range(cols, n, 4, J->crng + 2 * k);
   for (int m = 0; m < 4; m++) {
     const int d = J->cwdof[2 * e + m];
     J->dofs[4 * k + m] = d >= 0 ? d : 0;
@@ -570,12 +603,14 @@ void mbs_cat_advance(cat_job* J) {
     const double* N = J->Nl + 4 * k;
     const double w0 = N[0] * J->f[k] * inv2h, w1 = N[1] * J->f[k] * inv2h, w2 = N[2] * J->f[k] * inv2h,
                  w3 = N[3] * J->f[k] * inv2h;
-    for (int i = 0; i < n; i++) vb[i] += ck[i] * w0 + ck[n + i] * w1 + ck[2 * n + i] * w2 + ck[3 * n + i] * w3;
+    const int lo = J->crng[2 * k], hi = J->crng[2 * k + 1];
+    for (int i = lo; i < hi; i++) vb[i] += ck[i] * w0 + ck[n + i] * w1 + ck[2 * n + i] * w2 + ck[3 * n + i] * w3;
   }
   for (int b = 0; b < J->nslack; b++) {
-    const double* z = J->Zg + (long)J->slk[b] * n;
+    const int j = J->slk[b];
+    const double* z = J->Zg + (long)j * n;
     const double c = J->sS[b] * inv2h;
-    for (int i = 0; i < n; i++) vb[i] -= z[i] * c;
+    for (int i = J->zrng[2 * j]; i < J->zrng[2 * j + 1]; i++) vb[i] -= z[i] * c;
   }
   for (int i = 0; i < n; i++) u[i] += h2 * vb[i];
   for (int k = 0; k < nc; k++) {

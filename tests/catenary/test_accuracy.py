@@ -204,3 +204,21 @@ def test_error_estimate_brackets_the_true_error_on_en50318(speed):
         assert true <= r.error <= 10.0 * true, (r.name, r.error, true)
     assert checked >= 4
     assert all(math.isfinite(r.error) and r.ok for r in est.rows)
+
+
+@pytest.mark.slow
+def test_workprecision_quick_rows_are_the_statistics_errors_of_direct_runs():
+    """`mbsuite workprecision catenary/en50318 --quick`: a setting's errors are those of direct passages at its
+    resolution against a direct passage at the reference's (0.5 m / 2e-4 s), computed here."""
+    from mbsuite.analysis.workprecision import find_row, workprecision
+
+    sc = mbsuite.load_scene("catenary/en50318")
+    rep = workprecision(sc, repeats=1, quick=True)
+    row = find_row(rep, "fe", "trapezoidal, corrected Hermite", "h 1 m, dt 0.0004 s")
+    a = mbsuite.run(sc.replace(params={"element_length": 1.0}, solver={"timestep": 4e-4})).stats
+    b = mbsuite.run(sc).stats
+    force = max(abs(a[s] - b[s]) for s in STATS[:6])
+    assert row["state_error"] == pytest.approx(force, rel=1e-12)
+    assert row["physics_error"] == pytest.approx(max(force, abs(a["uplift_mm"] - b["uplift_mm"]) / 0.5,
+                                                     abs(a["loss_pct"] - b["loss_pct"]) / accuracy.LOSS_TOL),
+                                                 rel=1e-12)

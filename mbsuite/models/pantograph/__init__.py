@@ -9,9 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...accuracy import AccuracySpec
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
+from . import accuracy
 from .freqresp import freqresp as freqresp_report
+from .freqresp import validate_section as validate_freqresp
 from .inputs import INPUTS
 from .mujoco import run_mujoco, view_model
 from .outputs import UNITS
@@ -52,6 +55,8 @@ SPEC = ModelSpec(
     under_wire=under_wire,
     mujoco_model=view_model,
     cases="mbsuite.models.pantograph.cases",
+    accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
+    sections={"freqresp": validate_freqresp},
     # defaults chosen from scripts/pantograph_workprecision.py: RK4 at 1e-3 s reaches 3e-5 relative physics error
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.
     solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="LSODA", rtol=1e-8, atol=1e-10,

@@ -5,19 +5,20 @@ from __future__ import annotations
 
 import argparse
 
-from ...cli.options import SCENE_HELP, add_scene_options, add_sweep_options, check_workers, load, sweep_options
+from ...cli.options import (
+    SCENE_HELP,
+    add_error_estimate,
+    add_scene_options,
+    add_sweep_options,
+    check_workers,
+    load,
+    sweep_options,
+)
 from ...errors import MbsuiteError
-from ...limits import Limit
 from ...scenes import Scene
+from .freqresp import DEFAULTS, LIMITS, METHODS, check_grid
 
 MODEL = "pantograph"
-FREQ_LIMITS = {
-    "--f-min": Limit(lo=1e-3, hi=1e3, unit="Hz"),
-    "--f-max": Limit(lo=1e-3, hi=1e3, unit="Hz"),
-    "--df": Limit(lo=1e-3, hi=1e3, unit="Hz"),
-}
-MAX_FREQUENCIES = 2000
-METHODS = ("linear", "mujoco", "reference")
 COMMANDS = {
     "equilibrium": "static equilibrium of a scene (every path)",
     "modes": "linearised natural frequencies and damping ratios",
@@ -46,11 +47,13 @@ def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> Non
                        help="ram height (m) to linearise at (default: the mean of the scene's input)")
     if name == "freqresp":
         add_scene_options(p)
-        p.add_argument("--f-min", type=float, default=1.0, help="lowest frequency (Hz)")
-        p.add_argument("--f-max", type=float, default=30.0, help="highest frequency (Hz)")
-        p.add_argument("--df", type=float, default=0.5, help="frequency step (Hz)")
-        p.add_argument("--methods", default=",".join(METHODS), help="comma list of " + ", ".join(METHODS))
+        for key in ("f_min", "f_max", "df", "peak_tol"):  # the defaults are freqresp's (one per question)
+            p.add_argument("--" + key.replace("_", "-"), type=float, default=DEFAULTS[key],
+                           help=f"{LIMITS[key].doc} (Hz; default {DEFAULTS[key]:g})")
+        p.add_argument("--methods", default=",".join(DEFAULTS["methods"]),
+                       help=f"comma list of {', '.join(METHODS)} (default {','.join(DEFAULTS['methods'])})")
         p.add_argument("--workers", type=int, default=0, help="parallel processes (0 = all cores)")
+        add_error_estimate(p)
         add_sweep_options(p)
     p.set_defaults(func=COMMAND_FUNCS[name], emit=emit)
 
@@ -78,19 +81,15 @@ def cmd_modes(args: argparse.Namespace) -> None:
 
 
 def freq_args(args: argparse.Namespace) -> dict:
-    """`--f-min/--f-max/--df/--methods/--workers`, each checked, as the freqresp hook's keyword arguments."""
-    f_min, f_max, df = (lim.check(flag, getattr(args, flag[2:].replace("-", "_")), MbsuiteError)
-                        for flag, lim in FREQ_LIMITS.items())
-    if f_max < f_min:
-        raise MbsuiteError(f"--f-max {f_max:g} Hz is below --f-min {f_min:g} Hz")
-    n = int((f_max - f_min) / df) + 1
-    if n > MAX_FREQUENCIES:
-        raise MbsuiteError(f"--f-min/--f-max/--df give {n} frequencies; at most {MAX_FREQUENCIES} (enlarge --df)")
-    methods = [m for m in args.methods.split(",") if m]
-    bad = sorted(set(methods) - set(METHODS))
-    if bad or not methods:
-        raise MbsuiteError(f"--methods {args.methods!r}: valid methods are {', '.join(METHODS)}")
-    return {"f_min": f_min, "f_max": f_max, "df": df, "methods": args.methods, "workers": check_workers(args.workers)}
+    """`--f-min/--f-max/--df/--peak-tol/--methods/--workers/--error-estimate`, each checked (`freqresp.check_grid`:
+    the Python entry's own checks), as the freqresp hook's keyword arguments."""
+    try:
+        _, methods = check_grid(args.f_min, args.f_max, args.df, args.peak_tol, args.methods, MbsuiteError)
+    except MbsuiteError as exc:
+        raise MbsuiteError(f"--f-min/--f-max/--df/--peak-tol/--methods: {exc}") from None
+    return {"f_min": args.f_min, "f_max": args.f_max, "df": args.df, "peak_tol": args.peak_tol,
+            "methods": methods, "workers": check_workers(args.workers),
+            "error_estimate": bool(getattr(args, "error_estimate", False))}
 
 
 def cmd_freqresp(args: argparse.Namespace) -> None:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...accuracy import AccuracySpec
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
+from . import accuracy
 from .mujoco import run_mujoco, view_model
 from .params import CouplerParams
 from .reference import run_reference
@@ -50,4 +52,5 @@ SPEC = ModelSpec(
     solver=SolverSettings(integrator="implicitfast", timestep=5e-4, duration=2.0, t_settle=0.5, sample_dt=2e-3),
     mujoco_model=view_model,
     file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
+    accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
 )

@@ -14,7 +14,7 @@ import numpy as np
 
 from ...errors import GeometryError, ParameterError
 from ...results import Report, format_table, write_csv
-from .criteria import double_c5, periodic_mean, revolutions, single_criteria
+from .criteria import SAMPLES_SINGLE, double_c5, revolutions, single_c1, single_criteria
 from .jacobian import (
     RANK_RTOL,
     Screw,
@@ -172,9 +172,12 @@ LBS = (1.0, 2.0, 4.0)
 
 
 def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LBS, phibcs=(0.0, math.pi / 2),
-                    n: int = 121, fig_gamma: float = GAMMAS_PAPER[1]) -> Report:
+                    n: int = SAMPLES_SINGLE, fig_gamma: float = GAMMAS_PAPER[1]) -> Report:
     """c1-c4 vs (alpha_b, gamma, e_y) and c5 vs (z_c, phi_bc, l_b); plots in the style of Figs 6-10 with --out, Figs 6-8
-    for the single coupler at gamma = `fig_gamma` (default 0.297 rad, the paper's middle design)."""
+    for the single coupler at gamma = `fig_gamma` (default 0.297 rad, the paper's middle design). Every criterion is
+    located between the samples (`criteria`); n samples per revolution (the double coupler n // 2 + 1, at least 31)
+    only bracket the extrema."""
+    n_double = max(31, n // 2 + 1)
     single_rows, single = [], []
     for g in gammas:
         for ey in eys:
@@ -191,7 +194,7 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
             p = CouplerParams(gamma=pd.gamma, e_y=pd.e_y, R=pd.R, l_b=lb, phi_bc=pbc)
             for z in zcs:
                 try:
-                    c = double_c5(p, z, n=max(31, n // 2 + 1))
+                    c = double_c5(p, z, n=n_double)
                     reason = ""
                 except GeometryError as exc:  # shaft b too inclined for e_y: no physical pose (a solver failure raises)
                     c = {"c5": math.nan, "c5_pp": math.nan, "c5_sampled": math.nan, "c1_intermediate": math.nan}
@@ -202,13 +205,16 @@ def criteria_report(gammas=GAMMAS_PAPER, eys=EYS, alphas=ALPHAS, zcs=ZCS, lbs=LB
                 double_rows.append([lb, pbc, z, c["c5"], c["c1_intermediate"]])
     data = {"single": single, "double": double,
             "double_geometry": {"gamma": pd.gamma, "e_y": pd.e_y, "R": pd.R},
-            "samples_per_revolution": {"single": n, "double": max(31, n // 2 + 1)},
+            "samples_per_revolution": {"single": n, "double": n_double},
             "definitions": {"c1": "max|phi_a-phi_b-mean|", "c2": "max(x_b)-min(x_b)", "c3": "max|beta1-beta1_0|",
                             "c4": "max|beta2-beta2_0|", "c5": "max|phi_a-phi_c-mean|",
-                            "extrema": "c1 and c5: extrema refined between samples (bounded Brent on the FPP); "
-                                       "mean over the open grid (closing sample left out); c2-c4: sampled",
+                            "extrema": "c1-c5 (and c1_b): every extremum located between the samples (bounded Brent "
+                                       "on the FPP), the samples only bracket it; means over the open grid (closing "
+                                       "sample left out)",
                             }}
-    table = (f"single coupler criteria over one revolution (R = {CouplerParams().R:g} m; c1-c4: Eqs 16-19)\n"
+    table = (f"single coupler criteria over one revolution (R = {CouplerParams().R:g} m; c1-c4: Eqs 16-19);\nevery "
+             f"extremum located between the samples (Brent on the FPP; {n} samples per revolution, {n_double} "
+             "for\nthe double coupler, only bracket them)\n"
              + format_table(["gamma [rad]", "e_y [m]", "alpha_b [rad]", "c1 [rad]", "c2 [m]", "c3 [rad]",
                              "c4 [rad]"], single_rows, ".4g")
              + f"\n\ndouble coupler c5 (Eq 20) at gamma = {pd.gamma:.5g} rad ({math.degrees(pd.gamma):.4g} deg), "
@@ -249,7 +255,8 @@ def fpp_report(p: CouplerParams, alpha_bx: float, alpha_bz: float, n: int, engin
         pr = single_revolution_pin(PinCoupler.build("single", p), alpha_bx, alpha_bz, rev.phi_a, rev.u[0])
         data["max_abs_diff_pinocchio"] = float(np.max(np.abs(pr - rev.u)))
     d = rev.phi_a - rev.u[:, 0]
-    data["c1_sampled"] = float(np.max(np.abs(d - periodic_mean(d))))
+    fl = single_c1(p, rev)
+    data.update(c1=fl["c"], c1_sampled=fl["c_sampled"], grid_step=float(rev.phi_a[1] - rev.phi_a[0]))
     step = max(1, (n - 1) // 12)
     rows = [[rev.phi_a[i], rev.u[i, 0], rev.u[i, 1], rev.u[i, 2], rev.u[i, 3], d[i] - math.pi / 2]
             for i in range(0, n, step)]
@@ -258,6 +265,8 @@ def fpp_report(p: CouplerParams, alpha_bx: float, alpha_bz: float, n: int, engin
              f"alpha_bz = {alpha_bz:.6g} rad;\nO_b = (x_b, e_y + y_b, z_b) is the centre of platform B\n"
              + format_table(["phi_a [rad]", "phi_b [rad]", "x_b [m]", "y_b [m]", "z_b [m]",
                              "phi_a-phi_b-pi/2 [rad]"], [[_z(x) for x in r] for r in rows], ".6g"))
+    table += (f"\nc1 = max |phi_a - phi_b - mean| = {fl['c']:.6g} rad, located between the samples (Brent on the "
+              f"FPP);\nread off this grid (spacing {data['grid_step']:.4g} rad) it would be {fl['c_sampled']:.6g} rad")
     if "max_abs_diff_pinocchio" in data:
         table += (f"\nmax |reference - Pinocchio| over the revolution: {data['max_abs_diff_pinocchio']:.3e} "
                   "(rad and m)")

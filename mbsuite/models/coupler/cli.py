@@ -9,6 +9,7 @@ import warnings
 from functools import partial
 from pathlib import Path
 
+from ...cli.options import add_error_estimate, add_scene_options
 from ...errors import ParameterError, SceneError
 from ...results import Report, format_table
 from ...scenes import load_scene
@@ -16,11 +17,11 @@ from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
 
 
-def mbsuite_run(scene):
+def mbsuite_run(scene, error_estimate: bool = False):
     """`mbsuite.run` (imported late: the package imports this module's model while it loads)."""
     from ... import run
 
-    return run(scene)
+    return run(scene, error_estimate=error_estimate)
 
 
 def _finite_value(name: str, s: str) -> float:
@@ -157,11 +158,19 @@ def cmd_dynamics(args: argparse.Namespace, emit) -> None:
     if scene.model != "coupler":
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; coupler dynamics needs a coupler scene "
                          "('coupler' or coupler/<scene>, e.g. coupler/double_friction)")
-    if args.engine:
-        scene = scene.replace(solver={"engine": args.engine})
-    res = mbsuite_run(scene)  # health figures judged (AccuracyError past a bound unless allowed)
+    solver: dict = {"engine": args.engine} if args.engine else {}
+    if args.allow_inaccurate:
+        solver["allow_inaccurate"] = True
+    if args.max_steps is not None:
+        solver["max_steps"] = args.max_steps
+    if solver:
+        scene = scene.replace(solver=solver)
+    # health figures judged, the error estimate's among them (AccuracyError past a bound unless allowed)
+    res = mbsuite_run(scene, error_estimate=args.error_estimate)
     inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
     table = dynamics_table(inputs, res)
+    if res.error_estimate is not None:
+        table += "\n" + res.error_estimate.table()
     emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
                 partial(write_dynamics, res)), args, scene.to_dict())
 
@@ -201,6 +210,8 @@ def register(sub, add_common, emit) -> str:
     p = gs.add_parser("dynamics", help="MuJoCo double-coupler run with agreement statistics")
     p.add_argument("scene", nargs="?", default="coupler", help="scene (default: coupler's default scene)")
     p.add_argument("--engine", choices=["mujoco", "reference"], help="override the scene's engine")
+    add_scene_options(p)
+    add_error_estimate(p)
     add_common(p)
     p.set_defaults(func=partial(cmd_dynamics, emit=emit))
     return "coupler"

@@ -173,7 +173,8 @@ def run_reference(scene) -> SimResult:
     st = {"torque_in_mean": float(np.mean(t_in[w])), "torque_in_ripple_pp": float(np.ptp(t_in[w])),
           "torque_in_ripple_quasi_static_pp": float(np.ptp(tl[w] * D1[w, 0])),
           "speed_ratio_min": float(np.min(D1[w, 0])), "speed_ratio_max": float(np.max(D1[w, 0])),
-          "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max_all": float(gap.max())}
+          "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max": float(gap[w].max()),
+          "closure_residual_max_all": float(gap.max())}
     return results.assemble(scene, t, signals, engine="reference", stats=st, always=("phi_c_err",),
                             health=[closure_figure(st["closure_residual_max_all"], p, reference=True)])
 

@@ -7,7 +7,11 @@ value, declared tolerance, estimated error, observed order, true error, estimate
 `mbsuite/models/drives/accuracy.py` are set a stated factor above the largest numbers of this table.
 
     nice .venv/bin/python scripts/drives_accuracy.py [scene ...] [--engines reference mujoco] [--workers 2] \
-        [--json out/drives_accuracy.json]
+        [--json out/drives_accuracy.jsonl]
+    .venv/bin/python scripts/drives_accuracy.py --summary out/drives_accuracy.jsonl   # the README's table
+
+`--summary` condenses the JSON lines to one row per scene and path: per headline kind (event count, speeds,
+efficiency, lock-up times, end speeds) the largest estimate and the largest true error.
 """
 
 from __future__ import annotations
@@ -33,13 +37,45 @@ def fine_scene(sc):
     return sc.replace(solver={"rtol": 1e-12, "atol": 1e-14})
 
 
+#: headline kinds of the summary: name prefix -> column
+KINDS = {"n_events": "events", "mean_": "speeds (rad/s)", "efficiency": "efficiency", "t_lock": "lock-ups (s)",
+         "w_end": "end speeds (rad/s)"}
+
+
+def _kind(name: str) -> str:
+    return next(v for k, v in KINDS.items() if name.startswith(k))
+
+
+def summary(path: str) -> None:
+    """One Markdown row per scene and path from the JSON lines of a run of this script: per kind the largest
+    estimate / the largest true error (events: the counts' spread)."""
+    rows: dict[tuple[str, str], dict[str, list[float]]] = {}
+    for line in open(path):
+        r = json.loads(line)
+        d = rows.setdefault((r["scene"], r["engine"]), {})
+        k = _kind(r["name"])
+        e, t = d.get(k, [0.0, 0.0])
+        d[k] = [max(e, r["error"]), max(t, r["true_error"])]
+    kinds = list(KINDS.values())
+    print("| scene | path | " + " | ".join(f"{k}: est. / true" for k in kinds) + " |")
+    print("|---|---|" + "---|" * len(kinds))
+    for (scene, eng), d in rows.items():
+        cells = [("–" if k not in d else (f"{d[k][0]:.0f} / {d[k][1]:.0f}" if k == "events"
+                                         else f"{d[k][0]:.2g} / {d[k][1]:.2g}")) for k in kinds]
+        print(f"| {scene} | {eng} | " + " | ".join(cells) + " |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenes", nargs="*")
     ap.add_argument("--engines", nargs="*", default=["reference", "mujoco"])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", default=None, help="also write every row as JSON lines to this file")
+    ap.add_argument("--summary", default=None, metavar="JSONL", help="only condense a previous run's JSON lines")
     a = ap.parse_args()
+    if a.summary:
+        summary(a.summary)
+        return
     names = a.scenes or sorted(load_scene("drives").spec.scene_files())
     out = open(a.json, "a") if a.json else None  # noqa: SIM115 - appended row by row
     print("| scene | path | headline | value | tol | est. error | observed order | true error | est / true |")

@@ -43,14 +43,15 @@ def efficiency_point(scene: Scene) -> dict[str, Any]:
 def _efficiency_point(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> dict[str, Any]:
     """`efficiency_point` of a run already made."""
     t0 = steady_window(scene)
-    i0 = int(np.searchsorted(res.t, t0))
+    i0 = int(np.searchsorted(res.t, t0 - drive.T0_TOL))  # the window of `drive.mean_speeds`
     T = res.t[-1] - res.t[i0]
     bal = drive.energy_balance(system, res, i0, -1)
     cs = drive.cycle_stats(res, ctrl, t0=t0) if ctrl is not None else {}
+    means = drive.mean_speeds(res, t0)
     out = {
         "tau_l": float(scene.build_params().resolved(scene.effects["param_set"])["tau_l"] or 0.0),
-        "load_speed": float(np.mean(res.w[2, i0:])),
-        "motor_speed": float(np.mean(res.w[0, i0:])),
+        "load_speed": means.get("mean_load_speed", float("nan")),
+        "motor_speed": means.get("mean_motor_speed", float("nan")),
         "P_in": bal.input / T, "P_out": bal.output / T,
         "efficiency": bal.output / bal.input if bal.input > 0 else float("nan"),
         "losses_W": {k: v / T for k, v in bal.losses.items()},

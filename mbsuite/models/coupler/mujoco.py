@@ -36,7 +36,7 @@ from .geometry import NEXT, PHI_B_OFFSET, closures, mounted_points, phi_c_offset
 from .modelfiles import DISC_RADIUS, link_inertia, platform_discs, quat_z_to, scene_layout
 from .params import CouplerParams
 from .reference import kinematic_pose
-from .scenario import closure_figure, ramp, scene_inputs
+from .scenario import closure_figure, ramp, scene_inputs, time_mean
 
 
 # -------------------------------------------------------------------------------------------- MjSpec design edits
@@ -351,7 +351,7 @@ def stats(t: np.ndarray, s: dict[str, np.ndarray], t_settle: float, inp: dict[st
         w = np.ones_like(t, bool)
     tin = s["torque_in"][w]
     f = np.array([s[f"link_force_{k + 1}"][w] for k in range(8)])
-    mean_t = float(np.mean(tin))
+    mean_t = time_mean(t[w], tin)
     return {
         "window_start": float(t[w][0]),
         "revolutions": float((s["phi_a"][w][-1] - s["phi_a"][w][0]) / (2 * math.pi)),

@@ -22,7 +22,7 @@ from .double import (
 )
 from .geometry import EY, rot_x, rot_y, rot_z
 from .params import CouplerParams
-from .scenario import closure_figure, ramp, scene_inputs
+from .scenario import closure_figure, ramp, scene_inputs, time_mean
 
 #: largest distance (rad for angles, R for lengths) between the simulated pose and the kinematic pose of a sample that
 #: still counts as the same assembly branch; the soft closures keep them ~1e-4 apart (1e-3 in the start-up ramp)
@@ -153,13 +153,13 @@ def run_reference(scene) -> SimResult:
     t = np.arange(0.0, sv.duration + 0.5 * dt, dt)
     s = ramp(t, inp["t_ramp"])
     om = inp["omega"] * s
-    al = np.gradient(om, t)
+    al = np.gradient(om, t, edge_order=2)
     phi_a = np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t))])
     U, D1 = kinematic_rates(p, inp, phi_a, revolution_guess(p, inp, phi_a), times=t)
     rates = D1 * om[:, None]
     energy = shaft_b_energy_batch(p, U, rates) + 0.5 * p.i_shaft_c * rates[:, 0] ** 2
     tl = inp["load_torque"] * s
-    power = np.gradient(energy, t) + tl * rates[:, 0]
+    power = np.gradient(energy, t, edge_order=2) + tl * rates[:, 0]  # second order at the ends too
     with np.errstate(divide="ignore", invalid="ignore"):
         t_in = np.where(om > 0, power / np.where(om > 0, om, 1.0), tl * D1[:, 0]) + p.i_shaft_a * al
     # closure gap of the rigid reference: |r_k| = ||l_k|^2 - l^2| at the solved poses, as a length |r_k| / (2 l)
@@ -170,7 +170,7 @@ def run_reference(scene) -> SimResult:
     signals = {"phi_a": phi_a, "phi_c": U[:, 0], "phi_c_kin": U[:, 0], "phi_c_err": np.zeros_like(t),
                "omega_c": rates[:, 0], "torque_in": t_in, "torque_out": tl, "closure_residual": gap}
     w = t >= max(sv.t_settle, inp["t_ramp"])
-    st = {"torque_in_mean": float(np.mean(t_in[w])), "torque_in_ripple_pp": float(np.ptp(t_in[w])),
+    st = {"torque_in_mean": time_mean(t[w], t_in[w]), "torque_in_ripple_pp": float(np.ptp(t_in[w])),
           "torque_in_ripple_quasi_static_pp": float(np.ptp(tl[w] * D1[w, 0])),
           "speed_ratio_min": float(np.min(D1[w, 0])), "speed_ratio_max": float(np.max(D1[w, 0])),
           "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max": float(gap[w].max()),

@@ -46,6 +46,15 @@ def ramp(t, t_ramp: float):
     return float(y) if y.ndim == 0 else y
 
 
+def time_mean(t: np.ndarray, f: np.ndarray) -> float:
+    """The time average of samples f(t) over [t_0, t_end] by the trapezoidal rule (second order; exact to rounding for
+    a periodic signal sampled over whole periods). A plain mean of the samples would count both ends of the window,
+    a bias of O(dt): (f_0 + f_end) / 2 - mean over the sample count, 0.07 N m of a 44 N m ripple at 2 ms."""
+    if t.size < 2 or t[-1] <= t[0]:
+        return float(np.mean(f))
+    return float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(t)) / (t[-1] - t[0]))
+
+
 #: bound of the MuJoCo closure residual over a whole run (start-up ramp included), relative to the link length: the
 #: shipped scenes reach 4.4e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.3e-5 m in steady
 #: rotation), so 5e-3 l (5x the largest) flags closures torn open by a too-soft solref or a bad model

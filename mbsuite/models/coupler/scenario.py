@@ -56,7 +56,7 @@ def time_mean(t: np.ndarray, f: np.ndarray) -> float:
 
 
 #: bound of the MuJoCo closure residual over a whole run (start-up ramp included), relative to the link length: the
-#: shipped scenes reach 4.4e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.3e-5 m in steady
+#: shipped scenes reach 1.9e-4 to 1.003e-3 l (the peak in the 0.25 s ramp, 9.5e-4 m; 2.8e-5 to 7.4e-5 m in steady
 #: rotation), so 5e-3 l (5x the largest) flags closures torn open by a too-soft solref or a bad model
 CLOSURE_BOUND_REL = 5e-3
 #: the rigid reference solves every sample's FPP to |r| <= 1e-13 R^2 (a gap ~1e-14 l): 1e-9 l flags a failed solve

@@ -21,7 +21,7 @@ ORDER = {"euler": 1.0, "implicit": 1.0, "implicitfast": 1.0, "rk4": 4.0, "discre
 #: refined run (MuJoCo: h/16 sampled at sample_dt/16; Pinocchio: LSODA rtol 1e-10; tests/iftomm/test_accuracy.py):
 #: final angle: estimate 6.6e-5 rad, true 5.0e-5 (Bricard, Pinocchio), bound 15x; closure residual: estimate 2.9e-8 m
 #: (Bricard, MuJoCo), true 2.4e-7 m (four-bar, MuJoCo: the peak between the 10 ms samples, which the timestep
-#: refinement does not see), bound 4.2x the true error; energy drift: estimate 1.5e-4 J, true 1.1e-4 J (Bricard,
+#: refinement does not see), bound 4.2x the true error; energy drift: estimate 1.5e-4 J, true 1.2e-4 J (Bricard,
 #: Pinocchio), bound 6.6x
 TOL = {"final_angle": 1e-3, "closure_residual_max": 1e-6, "energy_drift_max": 1e-3}
 

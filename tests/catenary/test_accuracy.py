@@ -181,6 +181,8 @@ def test_shipped_scene_meets_its_tolerances_against_a_4x_finer_run(name):
     sc = mbsuite.load_scene(f"catenary/{name}")
     base = accuracy.values(sc, mbsuite.run(sc))
     fine = accuracy.values(sc, mbsuite.run(_fine(sc, 4)))
+    print(f"\n{name}: |default - 4x finer| / tol:", ", ".join(
+        f"{h.name} {abs(base[h.name] - fine[h.name]):.2g} / {h.tol:g}" for h in declared(sc)))
     for h in declared(sc):
         assert abs(base[h.name] - fine[h.name]) <= h.tol, (h.name, base[h.name], fine[h.name])
 
@@ -195,6 +197,9 @@ def test_error_estimate_brackets_the_true_error_on_en50318(speed):
     est = error_estimate(sc, workers=2)
     ref = accuracy.values(sc, mbsuite.run(_fine(sc, 8)))
     checked = 0
+    print(f"\nen50318 at {speed:g} km/h: estimate / true error (8x finer), observed order:", ", ".join(
+        f"{r.name} {r.error:.2g} / {abs(r.value - ref[r.name]):.2g}, "
+        f"{'-' if r.order is None else round(r.order, 2)}" for r in est.rows))
     for r in est.rows:
         true = abs(r.value - ref[r.name])
         if true <= max(abs(r.refined[1] - ref[r.name]), 1e-6):

@@ -40,11 +40,13 @@ def _finite(name: str) -> partial:
     return partial(_finite_value, name)
 
 
-def _geometry_args(p: argparse.ArgumentParser, ey_default: float) -> None:
-    p.add_argument("--gamma", type=_finite("--gamma"), default=GAMMA_17DEG,
-                   help="platform proportion angle [rad] (default 17 deg = 0.29671, reproduces Eq 15)")
-    p.add_argument("--ey", type=_finite("--ey"), default=ey_default, help="axial shift e_y [R]")
-    p.add_argument("--R", type=_finite("--R"), default=1.0, help="joint-circle radius (default 1)")
+def _geometry_args(p: argparse.ArgumentParser) -> None:
+    """--gamma, --ey, --R with the defaults of `CouplerParams` (one default for the Python API and the CLI)."""
+    d = CouplerParams()
+    p.add_argument("--gamma", type=_finite("--gamma"), default=d.gamma,
+                   help=f"platform proportion angle [rad] (default 17 deg = {GAMMA_17DEG:.5f}, reproduces Eq 15)")
+    p.add_argument("--ey", type=_finite("--ey"), default=d.e_y, help=f"axial shift e_y [R] (default {d.e_y:g})")
+    p.add_argument("--R", type=_finite("--R"), default=d.R, help=f"joint-circle radius (default {d.R:g})")
 
 
 def _params(args: argparse.Namespace) -> CouplerParams:
@@ -182,7 +184,7 @@ def register(sub, add_common, emit) -> str:
     gs = g.add_subparsers(dest="coupler_command", required=True)
 
     p = gs.add_parser("jacobian", help="mechanism Jacobian, singular values, rank, condition number, screws")
-    _geometry_args(p, 0.0)
+    _geometry_args(p)
     p.add_argument("--phi-a", type=_finite("--phi-a"), default=0.0, help="input angle [rad]")
     p.add_argument("--alpha-bx", type=_finite("--alpha-bx"), default=0.0, help="inclination about x [rad]")
     p.add_argument("--alpha-bz", type=_finite("--alpha-bz"), default=0.0, help="inclination about z [rad]")
@@ -191,7 +193,7 @@ def register(sub, add_common, emit) -> str:
     p.set_defaults(func=partial(cmd_jacobian, emit=emit))
 
     p = gs.add_parser("fpp", help="single-coupler pose over one revolution of phi_a (continuation)")
-    _geometry_args(p, 0.1)
+    _geometry_args(p)
     p.add_argument("--alpha-bx", type=_finite("--alpha-bx"), default=0.0525, help="inclination about x [rad]")
     p.add_argument("--alpha-bz", type=_finite("--alpha-bz"), default=0.0, help="inclination about z [rad]")
     p.add_argument("--n", type=_count("--n"), default=73, help="samples over the revolution (both ends included)")

@@ -222,12 +222,21 @@ def halving(setting: str, order: float, refine: Callable[[Any, int], Any], doc: 
 
 
 def refine_timestep(scene: Any, level: int) -> Any:
-    """The scene with `solver.timestep` (and a nonzero `solver.sample_dt`'s grid unchanged) halved `level` times;
-    the size guard `solver.max_steps` grows with it (the user asked for the finer run)."""
+    """The scene with `solver.timestep` halved `level` times (`solver.sample_dt` left as it is); the size guard
+    `solver.max_steps` grows with it (the user asked for the finer run)."""
     if level == 0:
         return scene
     s = scene.solver
     return scene.replace(solver={"timestep": s.timestep / 2**level, "max_steps": s.max_steps * 2**level})
+
+
+def refine_timestep_and_samples(scene: Any, level: int) -> Any:
+    """`refine_timestep`, and a nonzero `solver.sample_dt` halved with it: for headlines read off the samples
+    (maxima, means), whose grid is then refined too."""
+    out = refine_timestep(scene, level)
+    if level and scene.solver.sample_dt > 0:
+        out = out.replace(solver={"sample_dt": scene.solver.sample_dt / 2**level})
+    return out
 
 
 def refine_rtol(scene: Any, level: int) -> Any:
@@ -243,8 +252,11 @@ def refine_rtol(scene: Any, level: int) -> Any:
     return scene.replace(solver={"rtol": s.rtol / 10**level, "atol": s.atol / 10**level})
 
 
-def timestep_refinement(order: float) -> Refinement:
-    """Fixed-step integration of nominal `order`: halve `solver.timestep`."""
+def timestep_refinement(order: float, samples: bool = False) -> Refinement:
+    """Fixed-step integration of nominal `order`: halve `solver.timestep` (with `samples`, a nonzero
+    `solver.sample_dt` too)."""
+    if samples:
+        return halving("solver.timestep + solver.sample_dt", order, refine_timestep_and_samples)
     return halving("solver.timestep", order, refine_timestep)
 
 

@@ -92,7 +92,9 @@ def test_estimate_brackets_the_true_error_against_a_finer_run_on_mujoco():
     assert row.order == pytest.approx(1.0, abs=0.3)
     # it is in the result's summary (JSON) with the levels that ran
     d = json.loads(json.dumps(res.summary()["error_estimate"]))
-    assert d["levels"] == ["solver.timestep = 0.001", "solver.timestep = 0.0005", "solver.timestep = 0.00025"]
+    assert d["levels"] == ["solver.timestep = 0.001, solver.sample_dt = 0.01",
+                           "solver.timestep = 0.0005, solver.sample_dt = 0.005",
+                           "solver.timestep = 0.00025, solver.sample_dt = 0.0025"]
     assert {r["name"] for r in d["rows"]} == {"final_angle", "closure_residual_max", "energy_drift_max"}
 
 

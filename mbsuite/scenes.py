@@ -20,7 +20,7 @@ integrator = "implicitfast"
 timestep = 5e-4
 duration = 10.0
 [accuracy]           # optional: tolerances of headline outputs (their units), replacing the model's declared ones
-F1_amplitude = 1.0
+F1_amp = 2e-5          # m
 ```
 
 `load_scene(x)` accepts a path to a TOML file, a model name (its default scene) or `model/scene` (a shipped scene).

@@ -13,6 +13,7 @@ import argparse
 import contextlib
 import io
 import json
+import math
 import os
 import sys
 import time
@@ -36,6 +37,16 @@ def _step(title: str, argv: list[str]) -> tuple[dict, float]:
     return json.loads((out / "summary.json").read_text())["results"], wall
 
 
+def _peaks(pk: list[dict]) -> str:
+    """Refined peaks with their resolution: `4.263 ± 0.002`; a grid maximum keeps its grid resolution."""
+    out = []
+    for p in pk:
+        res = p["resolution_hz"]
+        digits = max(2, min(6, 1 - math.floor(math.log10(max(res, 1e-9)))))
+        out.append(f"{p['f_hz']:.{digits}f} ± {res:.1g}" + ("" if p["refined"] else " (grid)"))
+    return ", ".join(out)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/demo", help="output directory (default out/demo)")
@@ -57,10 +68,10 @@ def main(argv: list[str] | None = None) -> int:
         t_cat += t
 
     print("\n== Summary", flush=True)
-    peaks = fr.get("peaks_hz", {})
-    for m, pk in peaks.items():
-        print(f"pantograph {m:>17}: F1 peaks {', '.join(f'{x:.2f}' for x in pk['F1'])} Hz; "
-              f"HD peaks {', '.join(f'{x:.2f}' for x in pk['HD'])} Hz")
+    for m, pk in fr.get("peaks", {}).items():
+        print(f"pantograph {m:>17}: F1 peaks {_peaks(pk['F1'])} Hz; HD peaks {_peaks(pk['HD'])} Hz")
+    print("(each peak refined from its 0.5 Hz grid maximum by more runs at the frequencies the search asks for; "
+          "± the search's last correction)")
     if "thesis_resonances_simulated_hz" in fr:
         print(f"thesis (Eppinger 1984): simulated {fr['thesis_resonances_simulated_hz']} Hz, "
               f"measured {fr['thesis_resonances_measured_hz']} Hz")

@@ -254,7 +254,8 @@ def test_freqresp_error_estimate_through_the_command_line(tmp_path, capsys, monk
     from mbsuite.models.pantograph import freqresp as fr
 
     scene = _short_scene(tmp_path)
-    monkeypatch.setitem(fr.FR_TOL, "amp_rel", 1e-6 * fr.FR_TOL["amp_rel"])
+    for k in ("amp_rel", "amp_floor"):
+        monkeypatch.setitem(fr.FR_TOL, k, 1e-6 * fr.FR_TOL[k])
     argv = ["pantograph", "freqresp", str(scene), "--f-min", "4", "--f-max", "4", "--methods", "mujoco",
             "--error-estimate", "--workers", "2", "--json", "--allow-inaccurate"]
     with pytest.warns(InaccurateResultWarning, match="mujoco.F1.amp@4Hz"):
@@ -282,15 +283,19 @@ def test_freqresp_error_estimate_through_the_command_line(tmp_path, capsys, monk
 def test_freqresp_headlines_and_section(lab_scene):
     sec = {"f_min": 4.0, "f_max": 5.0, "df": 0.5, "method": "mujoco", "peak_tol": 0.005,
            "peaks": {"mujoco.F1": [4.26], "mujoco.HD": [4.4], "mujoco_no_coulomb.F1": [4.25],
-                     "mujoco_no_coulomb.HD": [4.3]}}
+                     "mujoco_no_coulomb.HD": [4.3]}, "lost": {"mujoco_no_coulomb": [4.5]}}
     job = lab_scene.replace(freqresp=sec)
     heads = {h.name: h for h in estimate_headlines(job)}
     assert len(heads) == 2 * 2 * 3 * 2 + 4  # curves x signals x frequencies x (amp, phase) + peaks
+    # where the scene's own run lost contact (and for peaks within a grid spacing of it) nothing is declared
+    free = sorted(n for n, h in heads.items() if h.tol is None)
+    assert free == sorted([f"mujoco_no_coulomb.{s}.{q}@4.5Hz" for s in ("F1", "HD") for q in ("amp", "phase")]
+                          + ["mujoco_no_coulomb.F1.peak1", "mujoco_no_coulomb.HD.peak1"])
     assert heads["mujoco.HD.peak1"].unit == "Hz" and heads["mujoco.HD.peak1"].tol == FR_TOL["peak_hz"]
     p = lab_scene.build_params()
     _, A, B, C, _ = linear_model(p, config_of(lab_scene), operating_height(lab_scene, p))
-    assert heads["mujoco.F1.amp@4.5Hz"].tol == pytest.approx(
-        FR_TOL["amp_rel"] * abs(linear_response(A, B, C, np.array([4.5]))[0, 0]))
+    H = np.abs(linear_response(A, B, C, np.array([4.0, 4.5, 5.0]))[:, 0])
+    assert heads["mujoco.F1.amp@4.5Hz"].tol == pytest.approx(FR_TOL["amp_rel"] * H[1] + FR_TOL["amp_floor"] * H.max())
     assert acc.refinement(job.replace(solver={"engine": "reference"})).setting == "solver.timestep"
     assert acc.refinement(job.replace(freqresp={"method": "reference"})).setting == "solver.rtol"
     with pytest.raises(SceneError, match="frequency-response job"):

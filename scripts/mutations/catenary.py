@@ -32,7 +32,8 @@ MUTATIONS: tuple[Mutation, ...] = (
              "tests/catenary/test_assembly.py"),
     # --- contact, start state, damping
     Mutation("catenary_static_force_without_wire_compliance", "mbsuite/models/catenary/passage.py",
-             "        f = panto.static(w0, 1.0 / (1.0 / self.kce + c_static))", "        f = panto.static(w0, self.kce)",
+             "        f = panto.static(w0, 1.0 / (1.0 / self.kce + c_static))",
+             "        f = panto.static(w0, self.kce)",
              "the start state's contact force ignores the wire's static compliance (a rigid wire)",
              "tests/catenary/test_assembly.py"),
     Mutation("catenary_core_head_compliance_dropped", "mbsuite/models/catenary/native/catenary.c",

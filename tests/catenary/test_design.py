@@ -17,7 +17,8 @@ def _short():
 
 def test_grid_points_are_the_passages_they_stand_for(tmp_path):
     """2 speeds x 2 head masses on two worker processes: each point's statistics equal a direct run of the scene with
-    that speed and head mass (the pool changes nothing: bit-equal), sigma/Fm is their ratio, the grid states their element length and time step, and the plot is written."""
+    that speed and head mass (the pool changes nothing: bit-equal), sigma/Fm is their ratio, the grid states their
+    element length and time step, and the plot is written."""
     scene = _short()
     grid = design_grid(scene, [200.0, 300.0], {"m1": [7.2, 10.8]}, workers=2, progress=False)
     assert [(p["speed_kmh"], p["m1"]) for p in grid["points"]] == [(200.0, 7.2), (200.0, 10.8), (300.0, 7.2),

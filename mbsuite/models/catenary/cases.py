@@ -253,7 +253,7 @@ class CatenaryStudy(Study):
     state_doc = ("max |statistic - ref| over the six force statistics (Fm, sigma, Fm +/- 3 sigma, actual max and "
                  "min of the 20 Hz filtered force), every pantograph and both speeds (N)")
     physics_doc = ("max |statistic - ref| / declared tolerance over the eight statistics (1 N on the forces, 0.5 mm "
-                   "on the uplift, 0.02 % on the contact loss), every pantograph and both speeds (1 = the tolerance)")
+                   "on the uplift, 0.1 % on the contact loss), every pantograph and both speeds (1 = the tolerance)")
 
     def __init__(self, scene: Scene, quick: bool = False):
         super().__init__(scene, quick)

@@ -410,13 +410,15 @@ def _scene(a: argparse.Namespace):
         upd["duration"] = a.duration
         if sc.solver.t_settle >= a.duration:
             upd["t_settle"] = 0.5 * a.duration
-    # the scene's solver checks duration / timestep against solver.max_steps (the size guard)
-    return _solver_options(sc.replace(solver=upd) if upd else sc, a)
+    # the scene's solver checks duration / timestep against solver.max_steps (the size guard), in one replace with
+    # --max-steps
+    return _solver_options(sc, a, upd)
 
 
-def _solver_options(sc, a: argparse.Namespace):
-    """The scene with `--allow-inaccurate` and `--max-steps` applied (`mbsuite.cli.options.add_scene_options`)."""
-    upd: dict = {}
+def _solver_options(sc, a: argparse.Namespace, upd: dict | None = None):
+    """The scene with the solver overrides `upd` and `--allow-inaccurate`, `--max-steps` applied (one replace, so
+    the size guard sees the new duration and the new max_steps together; `mbsuite.cli.options.add_scene_options`)."""
+    upd = dict(upd or {})
     if getattr(a, "allow_inaccurate", False):
         upd["allow_inaccurate"] = True
     if getattr(a, "max_steps", None) is not None:

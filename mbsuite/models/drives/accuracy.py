@@ -22,7 +22,7 @@ The tolerances bound the discretisation error of each path as posed. Between the
 refinement removes (docs/accuracy.md): the controllers truncate waits computed from the state to controller samples,
 so a state difference far below the tolerances can put a command, and the lock-up after it, one sample (1-2 ms) from
 the hand path's; that is not a discretisation error of either path. The same truncation makes MuJoCo's drive
-headlines piecewise smooth in the step: within a piece they converge (observed orders 1-2.5), across a piece's end a
+headlines piecewise smooth in the step: within a piece they converge (observed orders 0.8-2.6), across a piece's end a
 lock-up moves by whole samples, which the estimate sees only when it happens between its levels (TOL).
 """
 

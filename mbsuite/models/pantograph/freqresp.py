@@ -208,19 +208,20 @@ def grid_maxima(amp: np.ndarray) -> list[int]:
 
 
 def vertex(f: Sequence[float], amp: Sequence[float]) -> tuple[float, float] | None:
-    """The peak (frequency, amplitude) of the curve through three points: the vertex of the quadratic in f^2 through
-    1 / amp^2. Exact for a single-degree-of-freedom oscillator, whose |H|^-2 = k^2 ((f_n^2 - f^2)^2 + (2 zeta f_n f)^2)
-    / f_n^4 is that quadratic, and second order in the stencil for any smooth peak. None if the points do not
-    bracket a maximum (the quadratic is not convex or its vertex is at f^2 <= 0)."""
-    x = np.asarray(f, float) ** 2
-    y = 1.0 / np.asarray(amp, float) ** 2
-    if not (np.all(np.isfinite(y)) and np.ptp(x) > 0):
+    """The peak (frequency, amplitude) of the curve through three points: the vertex of the parabola in x = f^2
+    through y = 1 / amp^2. Exact for a single-degree-of-freedom oscillator, whose |H|^-2 = k^2 ((f_n^2 - f^2)^2 +
+    (2 zeta f_n f)^2) / f_n^4 is that parabola, and second order in the spacing for any smooth peak. None if the points
+    do not give a maximum (the parabola is not convex, or its vertex is at x <= 0 or y <= 0)."""
+    x1, x2, x3 = (float(v) ** 2 for v in f)
+    if not all(math.isfinite(a) and a > 0 for a in amp) or len({x1, x2, x3}) < 3:
         return None
-    c2, c1, c0 = np.polyfit(x - x[1], y, 2)
-    if c2 <= 0:
+    y1, y2, y3 = (1.0 / float(a) ** 2 for a in amp)
+    d21, d32 = (y2 - y1) / (x2 - x1), (y3 - y2) / (x3 - x2)
+    c2 = (d32 - d21) / (x3 - x1)  # second divided difference: the parabola's curvature
+    if not c2 > 0:
         return None
-    u = -c1 / (2.0 * c2) + x[1]
-    ymin = c0 - c1**2 / (4.0 * c2)
+    u = 0.5 * (x1 + x2) - 0.5 * d21 / c2  # where y' = d21 + c2 (2x - x1 - x2) vanishes
+    ymin = y1 + d21 * (u - x1) + c2 * (u - x1) * (u - x2)
     if u <= 0 or ymin <= 0:
         return None
     return math.sqrt(u), 1.0 / math.sqrt(ymin)
@@ -228,19 +229,21 @@ def vertex(f: Sequence[float], amp: Sequence[float]) -> tuple[float, float] | No
 
 def refine_peaks(freqs: np.ndarray, amps: dict[str, np.ndarray],
                  evaluate: Callable[[list[float]], list[dict[str, float]]], tol: float,
-                 max_stages: int = MAX_STAGES) -> dict[str, list[Peak]]:
+                 max_stages: int = MAX_STAGES, starts: dict[str, list[float]] | None = None) -> dict[str, list[Peak]]:
     """The peaks of each curve `amps[key]` on the grid `freqs`, each grid maximum refined until the search moves it by
     at most `tol` (Hz).
 
     A search starts at the vertex through the grid maximum and its neighbours (`vertex`), kept inside the grid bracket
-    of the maximum, with a stencil h of a quarter of the grid spacing. Each stage evaluates the curve at c - h, c,
-    c + h around the current estimate c (`evaluate(frequencies) -> [{key: amplitude}]`, all searches of a stage in one
-    call). If the middle point is the largest, the three bracket the maximum: c moves to their vertex (stays, if the
-    stencil is too coarse for the fit) and the stencil shrinks by `STENCIL_SHRINK`; the search stops when that move
-    is at most `tol`, and the move is the peak's `resolution_hz` (the error left behind it is about STENCIL_SHRINK^2
-    times smaller). Otherwise c climbs to the larger end point with the stencil kept. A search not done after
-    `max_stages` reports its stencil as the
-    resolution and `converged=False`. `tol = 0` reports the grid maxima with half the grid spacing, unrefined."""
+    of the maximum, with a stencil h of a quarter of the grid spacing; or, where `starts[key]` offers a guess inside
+    that bracket (the time paths take the linearisation's peaks), at the guess with a sixteenth. Each stage evaluates
+    the curve at c - h and c + h around the current estimate c, and at c unless a point evaluated before lies within
+    h/2 of it (which then serves as the middle point; `evaluate(frequencies) -> [{key: amplitude}]`, all searches of
+    a stage in one call). If the middle point is the largest, the three bracket the maximum: c moves to their vertex
+    (stays, if the stencil is too coarse for the fit) and the stencil shrinks by `STENCIL_SHRINK`; the search stops
+    when that move is at most `tol` (after two stages at least), and the move is the peak's `resolution_hz` (the error
+    left behind it is about STENCIL_SHRINK^2 times smaller). Otherwise c climbs past the larger end point with the
+    stencil kept. A search not done after `max_stages` reports its stencil as the resolution and `converged=False`.
+    `tol = 0` reports the grid maxima with half the grid spacing, unrefined."""
     df = float(freqs[1] - freqs[0]) if len(freqs) > 1 else 0.0
     out: dict[str, list[Peak]] = {}
     searches = []
@@ -253,30 +256,46 @@ def refine_peaks(freqs: np.ndarray, amps: dict[str, np.ndarray],
                 continue
             v = vertex(freqs[i - 1:i + 2], amp[i - 1:i + 2])
             lo, hi = float(freqs[i - 1]), float(freqs[i + 1])
-            c = min(max(v[0] if v else float(freqs[i]), lo), hi)
-            searches.append({"key": key, "grid": float(freqs[i]), "lo": lo, "hi": hi, "c": c, "h": 0.25 * df,
-                             "amp": float(amp[i]), "delta": math.inf, "done": False, "n": 0})
+            c, h = min(max(v[0] if v else float(freqs[i]), lo), hi), 0.25 * df
+            guess = [g for g in (starts or {}).get(key, []) if lo < g < hi]
+            if guess:
+                c, h = min(guess, key=lambda g, f=float(freqs[i]): abs(g - f)), df / 16.0
+            searches.append({"key": key, "grid": float(freqs[i]), "lo": lo, "hi": hi, "c": c, "h": h,
+                             "amp": float(amp[i]), "delta": math.inf, "done": False, "n": 0, "stages": 0,
+                             "pts": [(float(freqs[j]), float(amp[j])) for j in (i - 1, i, i + 1)]})
     for _ in range(max_stages):
         todo = [s for s in searches if not s["done"]]
         if not todo:
             break
-        pts = [s["c"] + d * s["h"] for s in todo for d in (-1.0, 0.0, 1.0)]
-        vals = evaluate(pts)
-        for k, s in enumerate(todo):
-            f3 = pts[3 * k:3 * k + 3]
-            a3 = [vals[3 * k + j][s["key"]] for j in range(3)]
-            s["n"] += 3
-            if a3[1] < max(a3[0], a3[2]):  # no bracket: climb to the larger end, inside the grid bracket
-                j = 0 if a3[0] > a3[2] else 2
-                new = min(max(f3[j], s["lo"]), s["hi"])
+        asks, plans = [], []
+        for s in todo:  # c - h, c + h, and c itself unless a point already evaluated lies in the stencil's middle half
+            mid = min(s["pts"], key=lambda q, c=s["c"]: abs(q[0] - c))
+            reuse = abs(mid[0] - s["c"]) < 0.5 * s["h"]
+            fs = [s["c"] - s["h"], s["c"] + s["h"]] + ([] if reuse else [s["c"]])
+            plans.append((len(asks), fs, mid if reuse else None))
+            asks += fs
+        vals = evaluate(asks)
+        for s, (k0, fs, mid) in zip(todo, plans, strict=True):
+            new_pts = [(f, float(vals[k0 + j][s["key"]])) for j, f in enumerate(fs)]
+            s["pts"] += new_pts
+            s["n"] += len(fs)
+            s["stages"] += 1
+            f3, a3 = zip(*sorted(new_pts + ([mid] if mid else [])), strict=True)
+            if a3[1] < max(a3[0], a3[2]):  # no bracket: climb past the larger end (to the fit's vertex if it lies
+                j = 0 if a3[0] > a3[2] else 2  # further uphill, at most 4 stencils), inside the grid bracket
+                v = vertex(f3, a3)
+                new = f3[j]
+                if v is not None and (v[0] - f3[j]) * (f3[j] - f3[1]) > 0:
+                    new = f3[j] + max(-4 * s["h"], min(4 * s["h"], v[0] - f3[j]))
+                new = min(max(new, s["lo"]), s["hi"])
                 s["delta"], s["c"], s["amp"] = abs(new - s["c"]), new, max(a3)
                 continue
             v = vertex(f3, a3)
             if v is None:  # bracketed, but too coarse a stencil for the fit: the middle, known to within h
-                s["delta"], s["amp"] = s["h"], a3[1]
+                s["delta"], s["c"], s["amp"] = s["h"], f3[1], a3[1]
             else:
                 s["delta"], s["c"], s["amp"] = abs(v[0] - s["c"]), v[0], v[1]
-            if s["delta"] <= tol:
+            if s["delta"] <= tol and s["stages"] >= 2:
                 s["done"] = True
             else:
                 s["h"] /= STENCIL_SHRINK
@@ -303,15 +322,16 @@ def linear_peaks(A: np.ndarray, B: np.ndarray, C: np.ndarray, freqs: np.ndarray,
 
 
 def time_peaks(scene: Scene, method: str, freqs: np.ndarray, curves: dict[str, np.ndarray], tol: float, *,
-               workers: int = 0, progress: bool | None = None,
-               options: SweepOptions | None = None) -> dict[str, list[Peak]]:
-    """The peaks of F1 and HD of the time path `method`, refined with more runs of that path (`refine_peaks`)."""
+               workers: int = 0, progress: bool | None = None, options: SweepOptions | None = None,
+               starts: dict[str, list[float]] | None = None) -> dict[str, list[Peak]]:
+    """The peaks of F1 and HD of the time path `method`, refined with more runs of that path (`refine_peaks`; the
+    searches start at `starts`, signal -> guesses, where one lies in a grid maximum's bracket)."""
 
     def evaluate(fs: list[float]) -> list[dict[str, float]]:
         rows = sweep_method(scene, method, fs, workers=workers, progress=progress, options=options)
         return [{s: r[s][0] for s in PEAK_SIGNALS} for r in rows]
 
-    return refine_peaks(freqs, {s: np.abs(curves[s]) for s in PEAK_SIGNALS}, evaluate, tol)
+    return refine_peaks(freqs, {s: np.abs(curves[s]) for s in PEAK_SIGNALS}, evaluate, tol, starts=starts)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -322,15 +342,22 @@ def method_curves(scene: Scene, freqs: np.ndarray, method: str, peak_tol: float,
                   progress: bool | None = None, options: SweepOptions | None = None
                   ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, dict[str, list[Peak]]]]:
     """The curves (curve -> signal -> complex ratio; also `contact_force_min`) and refined peaks of one time method:
-    "reference", or "mujoco" with its friction-free twin "mujoco_no_coulomb" when the scene has Coulomb friction."""
+    "reference", or "mujoco" with its friction-free twin "mujoco_no_coulomb" when the scene has Coulomb friction. The
+    peak searches start at the linearisation's peaks (its exact FRF, microseconds per frequency)."""
     names = [method] + (["mujoco_no_coulomb"] if method == "mujoco" and config_of(scene).coulomb else [])
+    sc = scene.replace(input={"type": "sine"})
+    p = sc.build_params()
+    _, A, B, C, _ = linear_model(p, config_of(sc), operating_height(sc, p))
+    H = linear_response(A, B, C, freqs)
+    starts = {s: [pk.f_hz for pk in v] for s, v in
+              linear_peaks(A, B, C, freqs, {s: H[:, i] for i, s in enumerate(FR_SIGNALS)}).items()}
     curves, pks = {}, {}
     for m in names:
         rows = sweep_method(scene, m, freqs, workers=workers, progress=progress, options=options)
         curves[m] = _complex_rows(rows)
         curves[m]["contact_force_min"] = np.array([r["contact_force_min"] for r in rows])
         pks[m] = time_peaks(scene, m, freqs, curves[m], peak_tol, workers=workers, progress=progress,
-                            options=options)
+                            options=options, starts=starts if peak_tol > 0 else None)
     return curves, pks
 
 

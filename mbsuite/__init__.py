@@ -7,8 +7,6 @@
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
-
 from . import native  # noqa: E402  (mbsuite.native.load(): register the engine plugins with MuJoCo)
 from .errors import (  # noqa: E402
     GeometryError,
@@ -24,6 +22,8 @@ from .paths import model_file, model_files  # noqa: E402
 from .registry import get_model  # noqa: E402
 from .registry import models as model_specs
 from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
+from .timerun import run_judged, run_name  # noqa: E402
+from .version import __version__
 
 
 def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool = False, workers: int = 0):
@@ -36,24 +36,23 @@ def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool =
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     spec = scene.spec
-    if not spec.paths:
-        raise SceneError(f"model '{spec.name}' has no time simulation")
-    if engine is not None:
+    if engine is not None and spec.paths:
         scene = scene.replace(solver={"engine": engine})
-    if error_estimate and spec.accuracy is None:
+    if error_estimate and spec.paths and spec.accuracy is None:
         raise SceneError(f"model '{spec.name}' declares no headline outputs: no error estimate")
-    res = spec.paths[scene.solver.engine].run(scene)
+    res = run_judged(scene)
     if error_estimate:
         from .analysis.errorestimate import error_estimate as estimate_error
 
         res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers)
-        res.health.extend(res.error_estimate.figures())
-    res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate,
-                              what=f"{spec.name} scene {scene.name or scene.source or ''}".strip()))
+        figures = res.error_estimate.figures()
+        res.health.extend(figures)
+        res.warnings.extend(judge(figures, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene)))
     return res
 
 
 __all__ = [
+    "__version__",
     "AccuracyError",
     "GeometryError",
     "MbsuiteError",

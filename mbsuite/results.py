@@ -191,7 +191,7 @@ def versions() -> dict[str, str]:
     import pinocchio
     import scipy
 
-    from . import __version__
+    from .version import __version__
 
     return {
         "mbsuite": __version__,

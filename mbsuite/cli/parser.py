@@ -28,7 +28,7 @@ class Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     """The `mbsuite` argument parser: the generic commands plus each model's own command group. The groups, model ->
     command name, are the parser's default `cli_groups` (what `mbsuite list` shows)."""
-    from .. import __version__
+    from ..version import __version__
 
     ap = Parser(
         prog="mbsuite", description="Cross-checked multibody models of railway mechanisms on Pinocchio and MuJoCo: "

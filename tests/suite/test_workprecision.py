@@ -20,11 +20,17 @@ def test_cheapest_picks_the_fastest_row_meeting_each_tolerance():
     assert best[(1e-6, "a")]["setting"] is None
 
 
-def test_unknown_model_is_a_clear_error():
-    from mbsuite import MbsuiteError
+def test_unknown_model_is_a_clear_error(monkeypatch):
+    """A model whose suite module declares no study (a stand-in: every model ships one) is refused by name."""
+    import types
 
-    with pytest.raises(MbsuiteError, match="no work-precision study"):
+    from mbsuite import MbsuiteError
+    from mbsuite.registry import ModelSpec
+
+    monkeypatch.setattr(ModelSpec, "suite", lambda self: types.SimpleNamespace())
+    with pytest.raises(MbsuiteError, match="no work-precision study for model 'catenary'"):
         workprecision(load_scene("catenary"), repeats=1, quick=True)
+    monkeypatch.undo()
     with pytest.raises(MbsuiteError, match="four-bar"):
         workprecision(load_scene("iftomm/bricard"), repeats=1, quick=True)
 

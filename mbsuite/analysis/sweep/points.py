@@ -14,8 +14,8 @@ def scene_point(job: tuple[dict, dict] | tuple[dict, dict, int]) -> dict[str, An
     returns per-signal statistics (min, max, mean, final) and the solver stats. With a `level`, the scene is first
     refined that many times (`mbsuite.accuracy`: its path's refinement) and the result also holds its headline values
     (`headlines`), for the point's error estimate. Module-level, so it pickles to any executor."""
-    from ... import run
     from ...scenes import scene_from_dict
+    from ...timerun import run_judged as run
 
     scene_d, sections, *rest = job
     scene = scene_from_dict(scene_d)

@@ -2,7 +2,7 @@
 
 Hand path: the event-exact DOP853 simulation; MuJoCo path: RK4 at `--timestep` with the stick/slip state machine as
 the native core's stepper (event times interpolated within the step). The reference is the Modelica Association's
-result in tests/data/msl/.
+result in mbsuite/models/drives/data/msl/.
 
 Usage: .venv/bin/python scripts/drives_coupled_clutches.py [--timestep 1e-4]
 """

@@ -56,7 +56,7 @@ def test_declared_headlines_of_every_shipped_scene(name):
 
 def test_lockup_counts_are_the_reference_results():
     """LOCKUPS of CoupledClutches, Friction and OneWayClutch read back from the Modelica Association's results
-    (mode changes to stuck per element; tests/data/msl/). OneWayClutchDisengaged (4) and SimpleGearShift (1) are the
+    (mode changes to stuck per element; data/msl/). OneWayClutchDisengaged (4) and SimpleGearShift (1) are the
     closed forms asserted in test_msl.py."""
     got = {"coupled_clutches": {}}
     for e in cc.reference_events(cc.load_reference()):

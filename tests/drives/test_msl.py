@@ -1,6 +1,6 @@
 """Modelica Rotational examples (MSL 4.1.0) as drives scenes, on the hand path and MuJoCo.
 
-Friction and OneWayClutch: against the Modelica Association's reference results (`tests/data/msl/`): the same mode
+Friction and OneWayClutch: against the Modelica Association's reference results (`data/msl/`): the same mode
 sequence, every mode change within 1e-5 s (hand path; the reference is a tolerance-1e-6 DASSL result, its event times
 good to a few microseconds; measured <= 1.7e-6 s) and within one MuJoCo timestep (measured <= 5e-5 s at 1e-4 s);
 every compared signal inside the Association's regression tube (2e-3 of the signal's range; measured <= 0.30 of it

@@ -41,7 +41,7 @@ SWITCHED = {"step_up": {"brake": "spring_ground", "clutch": "clutch"},
             "step_up_down": {"clutch_a": "clutch_a", "clutch_b": "clutch_b"}}
 
 #: lock-ups per element of each Modelica example: CoupledClutches, Friction and OneWayClutch from the Modelica
-#: Association's reference results (`tests/data/msl/`), OneWayClutchDisengaged and SimpleGearShift from the MSL
+#: Association's reference results (`data/msl/`), OneWayClutchDisengaged and SimpleGearShift from the MSL
 #: equations' closed forms (tests/drives/test_msl.py); a test reads them back from those sources
 LOCKUPS = {"coupled_clutches": {"clutch1": 2, "clutch2": 1, "clutch3": 1},
            "msl_friction": {"clutch": 3, "brake": 1},

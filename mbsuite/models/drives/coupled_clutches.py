@@ -15,8 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ...engines.signals import Signal, Sine, Step
-from ...errors import ModelFileError
-from ...paths import models_root
+from . import msl
 from .rotor_system import Friction, Part, RotorSystem, Source
 
 T_END = 1.5
@@ -54,13 +53,9 @@ REFERENCE_CSV = "CoupledClutches_MSL-4.1.0_reference.csv"
 
 
 def reference_path() -> Path:
-    """The Modelica Association's reference result (MSL 4.1.0), kept in the repository at `tests/data/msl/`
-    (provenance in the README there)."""
-    p = models_root() / "tests" / "data" / "msl" / REFERENCE_CSV
-    if not p.is_file():
-        raise ModelFileError(f"CoupledClutches reference result not found: {p} (it ships with the repository in "
-                             "tests/data/msl/)")
-    return p
+    """The Modelica Association's reference result (MSL 4.1.0), shipped inside the package in `data/msl/`
+    (provenance and licence in the README there)."""
+    return msl.data_file(REFERENCE_CSV)
 
 
 def load_reference(path: Path | None = None) -> dict[str, np.ndarray]:

@@ -16,7 +16,7 @@ Components (reusable parts of the drives package, equations of `Modelica/Mechani
 
 Examples: `Friction` (3 s), `OneWayClutch` (2 s), `OneWayClutchDisengaged` (2 s), `SimpleGearShift` (5 s), each
 an `Example` with its rotor system, initial state, compared signals on the reference's names and mode conventions.
-Reference results (Friction, OneWayClutch): the Modelica Association's, in `tests/data/msl/` (README there).
+Reference results (Friction, OneWayClutch): the Modelica Association's, in the package's `data/msl/` (README there).
 """
 
 from __future__ import annotations
@@ -31,7 +31,6 @@ import numpy as np
 
 from ...engines.signals import Pulse, Ramp, Signal, Sine, Step
 from ...errors import ModelFileError, ParameterError
-from ...paths import models_root
 from .rotor_system import Friction, Part, RefResult, RotorSystem, Source, Spring
 
 MU0 = 0.5  #: Modelica's default mu_pos = [0, 0.5]
@@ -225,12 +224,22 @@ def signals_of(ex: Example, res: RefResult) -> dict[str, np.ndarray]:
 
 
 def reference_path(ex: Example) -> Path:
-    """Path of the example's reference result (Modelica Association, MSL 4.1.0) in `tests/data/msl/`."""
+    """Path of the example's reference result (Modelica Association, MSL 4.1.0) in the package's `data/msl/`."""
     if ex.reference is None:
         raise ModelFileError(f"{ex.name}: the Modelica Association publishes no reference result for this example")
-    p = models_root() / "tests" / "data" / "msl" / ex.reference
+    return data_file(ex.reference)
+
+
+#: the Modelica Association's reference results, shipped inside the package (provenance and licence: README there)
+DATA_DIR = Path(__file__).parent / "data" / "msl"
+
+
+def data_file(name: str) -> Path:
+    """A reference result in the package's `data/msl/` (a ModelFileError naming the file if it is missing)."""
+    p = DATA_DIR / name
     if not p.is_file():
-        raise ModelFileError(f"reference result not found: {p} (it ships with the repository in tests/data/msl/)")
+        raise ModelFileError(f"Modelica reference result not found: {p} (it ships inside the package in "
+                             "mbsuite/models/drives/data/msl/; a broken install?)")
     return p
 
 

@@ -15,7 +15,7 @@ from ...accuracy import AccuracySpec
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import accuracy, equations, mujoco
+from . import accuracy, design_scene, equations, mujoco
 from .params import PARAM_SETS, DriveParams
 from .scene_run import SIGNALS
 
@@ -61,6 +61,7 @@ SPEC = ModelSpec(
         "mujoco": RunPath(run=mujoco.run, label="mujoco",
                           what="MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
     },
+    sections={"design": design_scene.validate_section},
     cases="mbsuite.models.drives.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),

@@ -17,11 +17,12 @@ from ...health import judge
 from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
-from ...scenes import DEFAULT_MAX_STEPS, load_scene
+from ...scenes import DEFAULT_MAX_STEPS, load_scene, scene_from_dict
 from . import accuracy
 from . import coupled_clutches as cc
 from . import design as D
 from .analysis import coupled_clutches_table, design_tables, efficiency, simulate_scene
+from .design_scene import BASE_SETS, DesignInputs, design_scene, scene_toml
 from .plots import cadjs_figure, coupled_clutches_figure, loss_label, run_figure
 from .scene_run import sim_result
 
@@ -61,7 +62,18 @@ OPTION_LIMITS: dict[str, Limit] = {
     "--duration": Limit(**_POS, hi=1e5, unit="s", doc="simulated time"),
     "--loads": Limit(lo=-1e4, hi=1e4, unit="N m", doc="load torque"),
     "--timestep": Limit(**_POS, hi=1e-2, unit="s", doc="MuJoCo timestep"),
+    "--wop": Limit(lo=0.0, hi=1e5, unit="rad/s", doc="operating speed of the design's scene"),
+    "--pmotor": Limit(**_POS, hi=1e7, unit="W", doc="largest motor power (at --vm)"),
+    "--scene-duration": Limit(**_POS, hi=1e5, unit="s", doc="simulated time of the design's scene"),
 }
+
+
+def _help(flag: str, extra: str = "") -> str:
+    """The help text of a numeric option: its meaning, unit and valid range (`OPTION_LIMITS`), then `extra`."""
+    lim = OPTION_LIMITS[flag]
+    lo = "(" if lim.lo_open else "["
+    text = f"{lim.doc}, {lim.unit or '1'}; valid {lo}{lim.lo:g}, {lim.hi:g}]"
+    return f"{text}; {extra}" if extra else text
 
 
 def _floats(flag: str):
@@ -152,27 +164,45 @@ def register(sub, add_common, emit) -> str:
     add_common(q)
     q.set_defaults(func=partial(design_tables_cmd, emit))
 
-    q = ds.add_parser("srmin", help="Eq 5.1: minimum switching rate")
+    q = ds.add_parser("srmin", help="Eq 5.1: minimum switching rate Sr_min = P / (w_min w_rip J_l)")
     for k in ("P", "wmin", "wrip", "Jl"):
-        q.add_argument(f"--{k}", type=float, required=True)
+        q.add_argument(f"--{k}", type=float, required=True, help=_help(f"--{k}"))
     add_common(q)
     q.set_defaults(func=partial(srmin_cmd, emit))
 
-    q = ds.add_parser("cadjs", help="CADJS: K, clutch torque, x_max, Sr_max per J_s (Eqs 5.9-5.13 corrected)")
-    q.add_argument("--P", type=float, required=True)
-    q.add_argument("--srmin", type=_floats("--srmin"), required=True, help="comma list")
-    q.add_argument("--wmin", type=float, default=0.0)
-    q.add_argument("--wmax", type=float, required=True)
-    q.add_argument("--vm", type=float, required=True)
-    q.add_argument("--js", type=_floats("--js"), default=None, help="comma list (default 1e-5 ... 1e-4)")
-    q.add_argument("--tau-c", type=float, default=None, help="read the family at this clutch torque")
+    q = ds.add_parser("cadjs", help="CADJS: K, clutch torque, x_max, Sr_max per J_s (Eqs 5.9-5.13 corrected); "
+                      "--scene-out writes one design point as a runnable step-up/step-down scene")
+    q.add_argument("--P", type=float, required=True, help=_help("--P", "P of Eqs 5.9-5.13"))
+    q.add_argument("--srmin", type=_floats("--srmin"), required=True,
+                   help=_help("--srmin", "comma list (Sr_min of Eq 5.1: drive design srmin)"))
+    q.add_argument("--wmin", type=float, default=0.0, help=_help("--wmin", "w_min, default 0"))
+    q.add_argument("--wmax", type=float, required=True, help=_help("--wmax", "w_max"))
+    q.add_argument("--vm", type=float, required=True, help=_help("--vm", "V_m, the motor's running speed"))
+    q.add_argument("--js", type=_floats("--js"), default=None,
+                   help=_help("--js", "J_s, comma list (default 1e-5 ... 1e-4)"))
+    q.add_argument("--tau-c", type=float, default=None,
+                   help=_help("--tau-c", "read the family at this clutch torque (as Tables 5.2, 6.2)"))
+    g = q.add_argument_group("design -> scene (with --scene-out; one --srmin and --tau-c or one --js)")
+    g.add_argument("--scene-out", metavar="FILE", default=None,
+                   help="write the design point as a step-up/step-down scene TOML (mbsuite run FILE runs it)")
+    g.add_argument("--wop", type=float, default=None,
+                   help=_help("--wop", "speed the scene's PI tracks, in [--wmin, --wmax]; default their middle"))
+    g.add_argument("--Jl", type=float, default=None, help=_help("--Jl", "default: the base set's"))
+    g.add_argument("--taul", type=float, default=None,
+                   help=_help("--taul", "Coulomb load torque of the scene; default P / wop"))
+    g.add_argument("--pmotor", type=float, default=None,
+                   help=_help("--pmotor", "the App. J straight-line motor's largest power, at --vm; default 1.5 P"))
+    g.add_argument("--base", default="design_100w", choices=list(BASE_SETS),
+                   help="parameter set giving bearings, delays, controller rate, motor inertia (default design_100w)")
+    g.add_argument("--scene-duration", type=float, default=6.0,
+                   help=_help("--scene-duration", "default 6 (statistics over its second half)"))
     add_common(q)
     q.set_defaults(func=partial(cadjs_cmd, emit))
 
     q = ds.add_parser("springsz", help="SPRINGSZ: wire diameter, D*N and volume (Eqs 5.14-5.21)")
-    q.add_argument("--K", type=float, required=True)
-    q.add_argument("--xmax", type=float, required=True)
-    q.add_argument("--fatigue", type=float, default=0.25)
+    q.add_argument("--K", type=float, required=True, help=_help("--K"))
+    q.add_argument("--xmax", type=float, required=True, help=_help("--xmax"))
+    q.add_argument("--fatigue", type=float, default=0.25, help=_help("--fatigue", "default 0.25"))
     q.add_argument("--sigma-uts", type=float, default=D.SIGMA_UTS_CALIBRATED,
                    help="ultimate tensile stress, Pa (default: calibrated to the thesis' 1.58e-4 m^3, not a material)")
     q.add_argument("--E", type=float, default=D.E_TABLE_6_3, help="Young's modulus, Pa (default: implied by Table 6.3)")
@@ -181,9 +211,9 @@ def register(sub, add_common, emit) -> str:
 
     q = ds.add_parser("gains", help="gain selection (Eqs 5.32-5.37) and stability line (5.36)")
     for k in ("Jl", "ts", "taul", "w0"):
-        q.add_argument(f"--{k}", type=float, required=True)
-    q.add_argument("--btotal", type=float, default=None, help="default: Eq 5.38 from --P")
-    q.add_argument("--P", type=float, default=None)
+        q.add_argument(f"--{k}", type=float, required=True, help=_help(f"--{k}"))
+    q.add_argument("--btotal", type=float, default=None, help=_help("--btotal", "default: Eq 5.38 from --P"))
+    q.add_argument("--P", type=float, default=None, help=_help("--P", "for Eq 5.38"))
     add_common(q)
     q.set_defaults(func=partial(gains_cmd, emit))
 
@@ -222,21 +252,31 @@ def design_tables_cmd(emit, a: argparse.Namespace) -> None:
     emit(design_tables(), a, None)
 
 
+def _inputs(a: argparse.Namespace, *flags: str) -> dict:
+    """The values of a design command's options as given (None: not given), by flag: the `inputs` of its
+    summary.json, what reruns it."""
+    return {flag: getattr(a, flag[2:].replace("-", "_"), None) for flag in flags}
+
+
 def srmin_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design srmin`: Eq 5.1."""
-    _check_options(a, "--P", "--wmin", "--wrip", "--Jl")
+    flags = ("--P", "--wmin", "--wrip", "--Jl")
+    _check_options(a, *flags)
     v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
     items = [("P", "drive power", a.P, "W"), ("w_min", "lowest load speed", a.wmin, "rad/s"),
              ("w_rip", "allowed speed ripple", a.wrip, "rad/s"), ("J_l", "load inertia", a.Jl, "kg m^2"),
              ("Sr_min", "minimum switching rate (Eq 5.1)", v, "1/s")]
-    emit(Report({"Sr_min": v}, _quantity_table(items),
+    emit(Report({"inputs": _inputs(a, *flags), "Sr_min": v}, _quantity_table(items),
                 _csv_writer("srmin", [(k, u, [x]) for k, _, x, u in items])), a, None)
 
 
 def cadjs_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design cadjs`: the CADJS families (Eqs 5.9-5.13 corrected), or one read at --tau-c."""
-    _check_options(a, "--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c")
+    flags = ("--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c", "--wop", "--Jl", "--taul", "--pmotor",
+             "--scene-duration")
+    _check_options(a, *flags)
     _check_speed_range(a.wmin, a.wmax)
+    scene = _design_scene(a) if a.scene_out else None
     rows, data = [], []
     for sr in a.srmin:
         ds_ = ([D.at_clutch_torque(a.P, sr, a.wmin, a.wmax, a.vm, a.tau_c)] if a.tau_c
@@ -253,13 +293,46 @@ def cadjs_cmd(emit, a: argparse.Namespace) -> None:
         "torque; x_max: largest spring twist; capacity: spring energy 1/2 K x_max^2 (Eqs 5.9-5.13 corrected).", 100)
     fig = partial(cadjs_figure, data) if len(data) > len(a.srmin) else None
     cols = [(n, u, [r[i] for r in rows]) for i, (n, u) in enumerate(zip(names, units, strict=True))]
-    emit(Report({"designs": data}, table, _csv_writer("cadjs", cols, fig)), a, None)
+    inputs = _inputs(a, *flags, "--base", "--scene-out") if a.scene_out else _inputs(a, *flags[:7])
+    if scene is not None:
+        Path(a.scene_out).write_text(scene_toml(scene), encoding="utf-8")
+        d = scene["design"]["derived"]
+        msg = (f"wrote {a.scene_out}: the design at J_s = {d['J_s']:.4g} kg m^2 as a step-up/step-down scene, "
+               f"closed loop at {d['w_op']:g} rad/s against tau_l = {d['tau_l']:.4g} N m (Sr = {d['Sr_op']:.4g} /s "
+               f"there: K_p = {d['Kp']:.4g}, K_I = {d['Ki']:.4g}); run it: mbsuite run {a.scene_out}")
+        table += "\n\n" + textwrap.fill(msg, 100)
+    emit(Report({"inputs": inputs, "designs": data, **({"scene_file": a.scene_out} if scene else {})}, table,
+                _csv_writer("cadjs", cols, fig)), a, scene)
+
+
+def _design_scene(a: argparse.Namespace) -> dict:
+    """The scene of `drive design cadjs ... --scene-out FILE` (checked before any file is written): one design point,
+    at --tau-c or at a single --js (`design_scene.design_scene`)."""
+    if len(a.srmin) != 1:
+        raise MbsuiteError(f"--scene-out writes one design: give one --srmin, got {len(a.srmin)} ({a.srmin})")
+    if (a.tau_c is None) == (a.js is None or len(a.js) != 1):
+        raise MbsuiteError("--scene-out writes one design point: give --tau-c, or a single --js (got "
+                           f"--tau-c {a.tau_c}, --js {a.js})")
+    if a.wop is not None and not a.wmin <= a.wop <= a.wmax:
+        raise MbsuiteError(f"--wop {a.wop:g} rad/s must lie in the design's speed band [--wmin, --wmax] = "
+                           f"[{a.wmin:g}, {a.wmax:g}] rad/s")
+    out = Path(a.scene_out)
+    if out.suffix != ".toml":
+        raise MbsuiteError(f"--scene-out {a.scene_out}: a scene file ends in .toml")
+    if not out.parent.is_dir():
+        raise MbsuiteError(f"--scene-out {a.scene_out}: directory {out.parent} does not exist")
+    inp = DesignInputs(P=a.P, Sr_min=a.srmin[0], w_min=a.wmin, w_max=a.wmax, V_m=a.vm, tau_c=a.tau_c,
+                       J_s=a.js[0] if a.tau_c is None else None, J_l=a.Jl, w_op=a.wop, tau_l=a.taul,
+                       P_motor=a.pmotor, base=a.base, duration=a.scene_duration)
+    scene = design_scene(inp, name=out.stem)
+    scene_from_dict(scene, source=str(out))  # the loader accepts it (a SceneError here, not when run)
+    return scene
 
 
 def springsz_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design springsz`: SPRINGSZ (Eqs 5.14-5.21)."""
     _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
-    r = D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E)
+    r = dict(D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E))
     items = [("K", "spring rate", a.K, "N m/rad"), ("x_max", "largest twist", a.xmax, "rad"),
              ("fatigue", "allowed / ultimate tensile stress", a.fatigue, "1"),
              ("sigma_uts", "ultimate tensile stress", a.sigma_uts, "Pa"), ("E", "Young's modulus", a.E, "Pa"),
@@ -267,13 +340,15 @@ def springsz_cmd(emit, a: argparse.Namespace) -> None:
              ("DN", "coil diameter x number of turns (Eq 5.14)", r["DN"], "m"),
              ("V", "spring volume (Eq 5.19)", r["V"], "m^3"),
              ("V_check", "pi^2 DN d^2 (same volume from d, DN)", r["V_check"], "m^3")]
-    emit(Report(r, _quantity_table(items), _csv_writer("springsz", [(k, u, [x]) for k, _, x, u in items])),
+    emit(Report({"inputs": _inputs(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E"), **r},
+                _quantity_table(items), _csv_writer("springsz", [(k, u, [x]) for k, _, x, u in items])),
          a, None)
 
 
 def gains_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design gains`: gain selection (Eqs 5.32-5.37), closed-loop poles and the stability line (5.36)."""
     _check_options(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
+    inputs = _inputs(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
     if a.btotal is None:
         if a.P is None:
             raise SceneError("give --btotal or --P (Eq 5.38)")
@@ -281,7 +356,7 @@ def gains_cmd(emit, a: argparse.Namespace) -> None:
     kp, ki = D.gains(a.Jl, a.ts, a.btotal, a.taul, a.w0)
     poles = D.closed_loop_poles(kp, ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
     kp_crit = D.stability_kp(ki, a.Jl, a.ts, a.btotal, a.taul, a.w0)
-    data = {"B_total": a.btotal, "Kp": kp, "KI": ki, "poles": [complex(x).real for x in poles],
+    data = {"inputs": inputs, "B_total": a.btotal, "Kp": kp, "KI": ki, "poles": [complex(x).real for x in poles],
             "Kp_stability_line": kp_crit}
     items = [("J_l", "load inertia", a.Jl, "kg m^2"), ("t_s", "energy-cycle period", a.ts, "s"),
              ("tau_l", "load torque", a.taul, "N m"), ("w0", "operating speed", a.w0, "rad/s"),

@@ -5,21 +5,53 @@ A parameter dataclass declares its fields with `param(default, lo=..., hi=..., u
 (`Limit(...)` in `ModelSpec.inputs`). The scene validator, the error messages and the docs (`limits_table`) all read the
 same declaration, so a range is written once.
 
-Numbers must be finite real numbers (bools are not numbers here); a range end may be open or closed.
+Numbers must be finite real numbers; a range end may be open or closed. What counts as a number is `real`: every
+real number type a Python or numpy user passes (int, float, `fractions.Fraction`, `decimal.Decimal`, numpy integers
+and floats of every width, 0-d arrays of them), taken as the Python int or float it holds. Bools (Python's and
+numpy's) are not numbers here, so true/false is never taken for 1/0; complex numbers are refused even with a zero
+imaginary part.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import decimal
 import math
+import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from . import perturbation
 from .errors import ParameterError
 
 _NO_DEFAULT = object()
+
+
+def real(value: Any) -> int | float | None:
+    """`value` as the Python int or float it holds if it is a real number of any type (see the module docstring),
+    else None (bools, complex numbers, strings, containers). Integral types give an int, the others a float; numpy's
+    float16/float32 give the shortest decimal that reads back as the same narrow float (`np.float32(0.001)` is
+    0.001, the number the user wrote, not its binary neighbour 0.0010000000474974513). A Fraction or Decimal too
+    large for a float gives inf (then refused as not finite)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, bool | np.bool_):
+        return None
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, np.floating) and value.dtype.itemsize < 8:
+        return float(str(value))
+    if isinstance(value, numbers.Real | decimal.Decimal):
+        try:
+            return float(value)
+        except OverflowError:
+            return math.inf if value > 0 else -math.inf
+        except ValueError:  # a signalling Decimal NaN
+            return math.nan
+    return None
 
 
 @dataclass(frozen=True)
@@ -65,8 +97,10 @@ class Limit:
             if not isinstance(value, str) or (self.choices is not None and value not in self.choices):
                 raise error(bad)
             return value
-        if isinstance(value, bool) or not isinstance(value, int | float):
+        number = real(value)
+        if number is None:
             raise error(f"{name} = {value!r} is not a number; valid: {self.describe()}")
+        value = number
         if not math.isfinite(value):
             raise error(bad)
         if self.kind is int:

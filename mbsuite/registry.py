@@ -28,13 +28,14 @@ class Effect:
     default: Any
     doc: str = ""
 
-    def check(self, name: str, value: Any) -> Any:
-        """Return `value` if it is one of the choices, else a SceneError listing them."""
+    def check(self, name: str, value: Any, where: str = "") -> Any:
+        """Return `value` if it is one of the choices, else a SceneError listing them (`where`: where the value came
+        from, a phrase with a leading space)."""
         # bools are compared by identity so that 1/0 are not silently taken for true/false
         ok = any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool))
                  for c in self.choices)
         if not ok:
-            raise SceneError(f"effect '{name}' = {value!r} is not allowed; valid values: {list(self.choices)}")
+            raise SceneError(f"effect '{name}' = {value!r}{where} is not allowed; valid values: {list(self.choices)}")
         return value
 
 

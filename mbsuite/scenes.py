@@ -24,7 +24,13 @@ F1_amp = 2e-5          # m
 ```
 
 `load_scene(x)` accepts a path to a TOML file, a model name (its default scene) or `model/scene` (a shipped scene).
-Unknown keys, effects, parameters, input types and engines raise `SceneError` listing the valid ones.
+Unknown keys, effects, parameters, input types and engines raise `SceneError` listing the valid ones, and say where
+the value came from: the file, the dictionary, Python (`Scene.replace`) or the command line (`origin=`).
+
+Values are taken as a numpy user passes them (`plain`): every real number type (`mbsuite.limits.real`: numpy scalars
+and 0-d arrays, `Fraction`, `Decimal`) is the Python number it holds, tuples and arrays are lists. A string is never
+split into a list: where a list is meant (`outputs.signals`, list-valued parameters such as the catenary's
+`dropper_positions`, a model section's lists) a string is an error, except `replace(outputs="F1")`, one signal.
 """
 
 from __future__ import annotations
@@ -42,16 +48,16 @@ import numpy as np
 
 from . import perturbation
 from .accuracy import check_tolerances, declared
-from .errors import SceneError
-from .limits import Limit
+from .errors import MbsuiteError, ParameterError, SceneError
+from .limits import Limit, real
 from .registry import ModelSpec, get_model, models
 from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver", "accuracy")
 MAX_SCENE_BYTES = 1_000_000
 
-
-
+#: where a value set through `Scene.replace` came from, unless the caller says (the CLI: "on the command line (--set)")
+PYTHON_ORIGIN = "set in Python (Scene.replace)"
 
 SOLVER_KEYS = tuple(f.name for f in dataclasses.fields(SolverSettings))
 
@@ -96,33 +102,73 @@ class Scene:
             **{k: copy.deepcopy(v) for k, v in self.sections.items()},
         }
 
-    def replace(self, **sections: Mapping[str, Any] | Any) -> Scene:
+    def replace(self, *, origin: str | None = None, **sections: Mapping[str, Any] | Any) -> Scene:
         """A new validated scene with sections merged: `scene.replace(effects={"gravity": False}, solver={"timestep":
-        1e-4})`.
-        Scalars (`name`, `description`) replace; mappings are merged key by key."""
+        1e-4})`. Scalars (`name`, `description`) replace; mappings are merged key by key; `outputs` may be one
+        signal name or a sequence of them. `origin` says in error messages where the new values came from (default
+        `PYTHON_ORIGIN`; the command line passes e.g. "on the command line (--speed)"); the values kept from the
+        scene's file are still blamed on the file."""
         d = self.to_dict()
         valid = [*TOP_KEYS[1:], *self.spec.sections]
+        changed: dict[str, frozenset[str] | None] = {}
         for key, val in sections.items():
             if key not in valid:
                 raise SceneError(f"cannot replace scene section {key!r}; valid sections: {valid}")
             if key == "outputs" and not isinstance(val, Mapping):
-                val = {"signals": [val] if isinstance(val, str) else list(val)}
+                val = {"signals": [val] if isinstance(val, str) else plain(val)}
             if isinstance(val, Mapping):
                 merged = dict(d.get(key) or {})
                 merged.update(val)
                 d[key] = merged
+                changed[key] = frozenset(str(k) for k in val)
             else:
                 d[key] = val
-        changed = ", ".join(f"[{k}]" for k in sections)
-        origin = f"{self.source} (with overrides of {changed})" if self.source else f"the overrides of {changed}"
-        return scene_from_dict(d, source=self.source, origin=origin)
+                changed[key] = None
+        return scene_from_dict(d, source=self.source, origin=origin or PYTHON_ORIGIN, changed=changed)
+
+
+@dataclass(frozen=True)
+class Where:
+    """Where a scene's values came from, as error messages say it: `base` for the file's (or dictionary's) values,
+    `origin` for the keys in `changed` (section -> the keys set there; None: the whole section)."""
+
+    base: str = ""
+    origin: str = ""
+    changed: Mapping[str, frozenset[str] | None] = field(default_factory=dict)
+
+    def __call__(self, section: str | None = None, key: str | None = None) -> str:
+        """The phrase (with a leading space) for `section.key`, or for the section as a whole (key None: names the
+        keys set elsewhere too, since a check across keys may involve them)."""
+        if section in self.changed:
+            keys = self.changed[section]
+            if keys is None or key in keys:
+                return f" {self.origin}"
+            if key is None and keys:
+                names = ", ".join(f"{section}.{k}" for k in sorted(keys))
+                return f"{self.base} with {names} {self.origin}"
+        return self.base
+
+    def any_of(self, section: str, keys: list[str]) -> str:
+        """The phrase for a list of bad keys of `section`: the origin if any of them was set there."""
+        return next((self(section, k) for k in keys if self(section, k) != self.base), self.base)
+
+
+def _told(exc: MbsuiteError, where: str) -> MbsuiteError:
+    """`exc` (an error of a check that does not know the origin) with `where` appended in parentheses."""
+    return type(exc)(f"{exc} ({where.strip()})") if where else exc
 
 
 def plain(value: Any) -> Any:
-    """`value` with numpy scalars and 0-d arrays as Python numbers (bools, ints, floats), in lists and tables too: what
-    a numpy user passes is taken as the number it holds."""
-    if isinstance(value, np.generic) or (isinstance(value, np.ndarray) and value.ndim == 0):
-        return value.item()
+    """`value` as plain Python data, in lists and tables too: every real number type (`mbsuite.limits.real`) as the
+    int or float it holds, numpy bools as bools, other numpy scalars (strings) as their Python value, tuples and
+    arrays of any dimension as lists. Strings stay strings (never a list of characters)."""
+    if isinstance(value, np.ndarray) and value.ndim > 0:
+        return [plain(v) for v in value]
+    number = real(value)
+    if number is not None:
+        return number
+    if isinstance(value, np.generic | np.ndarray):
+        return value.item() if isinstance(value, np.generic) else value[()].item()
     if isinstance(value, Mapping):
         return {k: plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
@@ -130,106 +176,151 @@ def plain(value: Any) -> Any:
     return value
 
 
-def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origin: str | None = None) -> Scene:
+def _list_field(f: dataclasses.Field) -> bool:
+    """True if dataclass field `f` holds a list (its type says list/tuple, or its default factory makes one)."""
+    if f.default_factory is not dataclasses.MISSING and isinstance(f.default_factory(), list | tuple):
+        return True
+    return str(f.type).startswith(("list", "tuple"))
+
+
+def _param_value(spec: ModelSpec, key: str, value: Any, where: str) -> Any:
+    """A `[params]` value checked against its field: a list-valued field takes a list of numbers (a string is an
+    error, not a list of characters), any other field a single value within its declared `Limit`."""
+    f = next(f for f in dataclasses.fields(spec.params_cls) if f.name == key)
+    lim = f.metadata.get("limit")
+    if value is None and f.default is None:
+        return None  # unset: the model derives it
+    if _list_field(f):
+        if isinstance(value, str):
+            raise SceneError(f"parameter {key} = {value!r}{where} is a string, but a list of numbers is meant: "
+                             f"{key} = [x1, x2, ...] (SI units)")
+        if not isinstance(value, list) or any(real(x) is None for x in value):
+            raise SceneError(f"parameter {key} = {value!r}{where} must be a list of numbers (SI units)")
+        return [float(real(x)) if "float" in str(f.type) else real(x) for x in value]
+    if isinstance(value, list | Mapping):
+        raise SceneError(f"parameter {key} = {value!r}{where} must be a single value (SI units), not a "
+                         f"{'list' if isinstance(value, list) else 'table'}")
+    if lim is not None:
+        return lim.check(f"{spec.name} parameter {key}{where}", value, ParameterError)
+    if isinstance(value, str) or real(value) is None:
+        raise SceneError(f"parameter {key} = {value!r}{where} must be a number (SI units)")
+    if not math.isfinite(real(value)):
+        raise SceneError(f"parameter {key} = {value!r}{where} must be a finite number (SI units)")
+    return real(value)
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origin: str | None = None,
+                    changed: Mapping[str, frozenset[str] | None] | None = None) -> Scene:
     """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones, and
-    where the value came from (`origin`, default `source`). Numpy scalars and 0-d arrays count as the numbers they
-    hold."""
-    where = f" in {origin or source}" if (origin or source) else ""
+    say where the value came from: "in SOURCE" (the file; "in the scene dictionary" without one), or `origin` (a
+    phrase such as "set in Python" or "on the command line (--set)") for the keys in `changed` (section -> keys,
+    None: the whole section; without `changed`, every value). Values are taken as `plain` makes them."""
+    base = f" in {source}" if source else " in the scene dictionary"
+    if origin and changed is None:
+        base, changed = f" {origin}", {}
+    where = Where(base, origin or "", dict(changed or {}))
     data = {k: plain(v) for k, v in copy.deepcopy(dict(data)).items()}
     if "model" not in data:
-        raise SceneError(f"scene{where} does not name a model; valid models: {sorted(models())}")
+        raise SceneError(f"scene{where()} does not name a model; valid models: {sorted(models())}")
     if not isinstance(data["model"], str):
-        raise SceneError(f"model = {data['model']!r}{where} must be a model name; valid models: {sorted(models())}")
+        raise SceneError(f"model = {data['model']!r}{where('model')} must be a model name; valid models: "
+                         f"{sorted(models())}")
     spec = get_model(data["model"])
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
-            raise SceneError(f"{key} = {data[key]!r}{where} must be a string")
+            raise SceneError(f"{key} = {data[key]!r}{where(key)} must be a string")
     for key in ("effects", "params", "input", "solver", "accuracy", *spec.sections):
         if key in data and not isinstance(data[key], Mapping):
-            raise SceneError(f"{key} = {data[key]!r}{where} must be a table ([{key}] section with key = value lines)")
-    if "outputs" in data and not isinstance(data["outputs"], Mapping | list | tuple):
-        raise SceneError(f"outputs = {data['outputs']!r}{where} must be a table with signals = [...]")
+            raise SceneError(f"{key} = {data[key]!r}{where(key)} must be a table ([{key}] section with key = value "
+                             "lines)")
+    if "outputs" in data and not isinstance(data["outputs"], Mapping | list):
+        raise SceneError(f"outputs = {data['outputs']!r}{where('outputs')} must be a table with signals = [...]")
     unknown = sorted(set(data) - set(TOP_KEYS) - set(spec.sections))
     if unknown:
-        raise SceneError(f"unknown scene key(s) {unknown}{where}; valid keys: {[*TOP_KEYS, *spec.sections]}")
-    extra = {k: spec.sections[k](data[k]) for k in spec.sections if k in data}
+        raise SceneError(f"unknown scene key(s) {unknown}{where()}; valid keys: {[*TOP_KEYS, *spec.sections]}")
+    extra = {}
+    for k in spec.sections:
+        if k in data:
+            try:
+                extra[k] = spec.sections[k](data[k])
+            except MbsuiteError as exc:
+                raise _told(exc, where(k)) from None
 
     effects_in = data.get("effects") or {}
-    if not isinstance(effects_in, Mapping):
-        raise SceneError(f"[effects]{where} must be a table")
     bad = sorted(set(effects_in) - set(spec.effects))
     if bad:
         raise SceneError(
-            f"unknown effect(s) {bad} for model '{spec.name}'{where}; valid effects: {sorted(spec.effects)}")
+            f"unknown effect(s) {bad} for model '{spec.name}'{where.any_of('effects', bad)}; valid effects: "
+            f"{sorted(spec.effects)}")
     effects = {}
     for name, eff in spec.effects.items():
-        effects[name] = eff.check(name, effects_in.get(name, eff.default))
+        effects[name] = eff.check(name, effects_in.get(name, eff.default), where("effects", name))
 
-    params = data.get("params") or {}
+    params = dict(data.get("params") or {})
     valid_params = spec.param_names()
     bad = sorted(set(params) - set(valid_params))
     if bad:
-        raise SceneError(f"unknown parameter(s) {bad} for model '{spec.name}'{where}; valid parameters: {valid_params}")
+        raise SceneError(f"unknown parameter(s) {bad} for model '{spec.name}'{where.any_of('params', bad)}; "
+                         f"valid parameters: {valid_params}")
     for k, v in params.items():
-        if isinstance(v, bool) or not isinstance(v, int | float | str | list):
-            raise SceneError(f"parameter {k!r}{where} must be a number (SI units), got {v!r}")
-        if isinstance(v, float) and not math.isfinite(v):
-            raise SceneError(f"parameter {k} = {v!r}{where} must be a finite number (SI units)")
+        params[k] = _param_value(spec, k, v, where("params", k))
 
     inp = dict(data.get("input") or {})
     if spec.inputs:
         itype = inp.get("type", next(iter(spec.inputs)))
         if not isinstance(itype, str) or itype not in spec.inputs:
-            raise SceneError(f"input type {itype!r}{where} unknown for '{spec.name}'; valid types: {list(spec.inputs)}")
+            raise SceneError(f"input type {itype!r}{where('input', 'type')} unknown for '{spec.name}'; valid types: "
+                             f"{list(spec.inputs)}")
         bad = sorted(set(inp) - set(spec.inputs[itype]) - {"type"})
         if bad:
             raise SceneError(
-                f"unknown input key(s) {bad} for input type {itype!r}{where}; valid keys: {sorted(spec.inputs[itype])}"
-            )
+                f"unknown input key(s) {bad} for input type {itype!r}{where.any_of('input', bad)}; valid keys: "
+                f"{sorted(spec.inputs[itype])}")
         inp["type"] = itype
         for key, decl in spec.inputs[itype].items():
             if not isinstance(decl, Limit):
                 continue
             if key in inp:
-                inp[key] = decl.check(f"input.{key}{where}", inp[key], SceneError)
+                inp[key] = decl.check(f"input.{key}{where('input', key)}", inp[key], SceneError)
             elif decl.has_default:
                 inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
             if decl.kind is float and decl.choices is None and isinstance(inp.get(key), float):
                 inp[key] = perturbation.value(inp[key], decl, f"input.{key}")  # unchanged outside the stability check
     for key, v in inp.items():  # keys without a declared Limit: at least finite, never a nested table
         if isinstance(v, float) and not math.isfinite(v):
-            raise SceneError(f"input.{key} = {v!r}{where} must be a finite number")
+            raise SceneError(f"input.{key} = {v!r}{where('input', key)} must be a finite number")
         if isinstance(v, Mapping):
-            raise SceneError(f"input.{key}{where} must be a value, not a table")
+            raise SceneError(f"input.{key}{where('input', key)} must be a value, not a table")
 
     outputs = data.get("outputs") or {}
     if isinstance(outputs, Mapping):
         bad = sorted(set(outputs) - {"signals"})
         if bad:
-            raise SceneError(f"unknown key(s) {bad} in [outputs]{where}; valid keys: ['signals']")
+            raise SceneError(f"unknown key(s) {bad} in [outputs]{where.any_of('outputs', bad)}; valid keys: "
+                             "['signals']")
         signals = outputs.get("signals", tuple(spec.outputs))
     else:
         signals = outputs
-    if isinstance(signals, str) or not isinstance(signals, list | tuple) or not all(
-            isinstance(x, str) for x in signals):
-        raise SceneError(f"outputs.signals = {signals!r}{where} must be a list of signal names; valid signals: "
+    w = where("outputs", "signals")
+    if isinstance(signals, str):
+        raise SceneError(f"outputs.signals = {signals!r}{w} is a string, but a list of signal names is meant: "
+                         f"signals = [{signals!r}]; valid signals: {list(spec.outputs)}")
+    if not isinstance(signals, list | tuple) or not all(isinstance(x, str) for x in signals):
+        raise SceneError(f"outputs.signals = {signals!r}{w} must be a list of signal names; valid signals: "
                          f"{list(spec.outputs)}")
     signals = tuple(signals)
     bad = [s for s in signals if s not in spec.outputs]
     if bad:
-        raise SceneError(f"unknown output signal(s) {bad}{where}; valid signals: {list(spec.outputs)}")
+        raise SceneError(f"unknown output signal(s) {bad}{w}; valid signals: {list(spec.outputs)}")
 
-    solver_in = data.get("solver") or {}
+    solver_in = dict(data.get("solver") or {})
     bad = sorted(set(solver_in) - set(SOLVER_KEYS))
     if bad:
-        raise SceneError(f"unknown solver key(s) {bad}{where}; valid keys: {list(SOLVER_KEYS)}")
+        raise SceneError(f"unknown solver key(s) {bad}{where.any_of('solver', bad)}; valid keys: {list(SOLVER_KEYS)}")
     if isinstance(solver_in.get("engine"), str):
         solver_in["engine"] = spec.path_key(solver_in["engine"])  # a path's label ("equations") names its key
-    try:
-        solver = dataclasses.replace(spec.solver, **solver_in)
-    except TypeError as exc:
-        raise SceneError(f"[solver]{where}: {exc}") from exc
-    solver.check(spec.engines)
+    solver = dataclasses.replace(spec.solver, **solver_in)
+    solver = solver.check(spec.engines, lambda key=None: where("solver", key))
 
     scene = Scene(
         model=spec.name,
@@ -242,13 +333,19 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
         solver=solver,
         source=source,
         sections=extra,
-        accuracy=check_tolerances(data.get("accuracy") or {}, where),
+        accuracy=check_tolerances(data.get("accuracy") or {}, where("accuracy")),
     )
-    scene.build_params()  # parameter dataclasses validate themselves (negative mass etc.)
+    try:
+        scene.build_params()  # parameter dataclasses validate themselves across fields (d1 <= l1 etc.)
+    except MbsuiteError as exc:
+        raise _told(exc, where("params")) from None
     if scene.accuracy:
         if spec.accuracy is None:
-            raise SceneError(f"[accuracy]{where}: model '{spec.name}' declares no headline outputs")
-        declared(scene)  # every name a headline of this scene
+            raise SceneError(f"[accuracy]{where('accuracy')}: model '{spec.name}' declares no headline outputs")
+        try:
+            declared(scene)  # every name a headline of this scene
+        except MbsuiteError as exc:
+            raise _told(exc, where("accuracy")) from None
     return scene
 
 

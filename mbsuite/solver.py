@@ -4,6 +4,8 @@ method and tolerances, the run's length and its size guard. Every model declares
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from .errors import SceneError
@@ -35,42 +37,49 @@ class SolverSettings:
     allow_inaccurate: bool = False
     max_steps: float = DEFAULT_MAX_STEPS
 
-    def check(self, engines: tuple[str, ...]) -> None:
-        """Check every setting (type, finiteness, range, the size guard); a SceneError names the first bad one."""
+    def check(self, engines: tuple[str, ...], where: Callable[..., str] | None = None) -> SolverSettings:
+        """Check every setting (type, finiteness, range, the size guard); a SceneError names the first bad one and,
+        through `where(key)` (a phrase with a leading space; `where()` for a check across settings), where its value
+        came from. Returns the settings with every number as a Python float (any real number type is accepted)."""
+        w = where or (lambda key=None: "")
         for name in ("engine", "integrator", "method"):
             v = getattr(self, name)
             if not isinstance(v, str):
-                raise SceneError(f"solver.{name} = {v!r} must be a string")
+                raise SceneError(f"solver.{name} = {v!r}{w(name)} must be a string")
         if self.engine not in engines:
-            raise SceneError(f"solver.engine = {self.engine!r} is not available; valid engines: {list(engines)}")
+            raise SceneError(f"solver.engine = {self.engine!r}{w('engine')} is not available; valid engines: "
+                             f"{list(engines)}")
         if self.integrator not in INTEGRATORS:
-            raise SceneError(f"solver.integrator = {self.integrator!r}; valid integrators: {list(INTEGRATORS)}")
+            raise SceneError(f"solver.integrator = {self.integrator!r}{w('integrator')}; valid integrators: "
+                             f"{list(INTEGRATORS)}")
         if self.method not in SCIPY_METHODS:
-            raise SceneError(f"solver.method = {self.method!r}; valid methods: {list(SCIPY_METHODS)}")
+            raise SceneError(f"solver.method = {self.method!r}{w('method')}; valid methods: {list(SCIPY_METHODS)}")
         if not isinstance(self.allow_inaccurate, bool):
-            raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r} must be true or false")
-        for name, lim in SOLVER_LIMITS.items():
-            lim.check(f"solver.{name}", getattr(self, name), SceneError)
-        if self.t_settle >= self.duration:
+            raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r}{w('allow_inaccurate')} must be "
+                             "true or false")
+        s = dataclasses.replace(self, **{name: lim.check(f"solver.{name}{w(name)}", getattr(self, name), SceneError)
+                                         for name, lim in SOLVER_LIMITS.items()})
+        if s.t_settle >= s.duration:
             raise SceneError(
-                f"solver.t_settle ({self.t_settle}) must be shorter than solver.duration ({self.duration})")
-        if self.timestep >= self.duration:
-            raise SceneError(f"solver.timestep ({self.timestep} s) must be shorter than solver.duration "
-                             f"({self.duration} s)")
-        if self.engine == "reference" and self.max_step > 0 and self.duration / self.max_step > self.max_steps:
+                f"solver.t_settle ({s.t_settle}) must be shorter than solver.duration ({s.duration}){w()}")
+        if s.timestep >= s.duration:
+            raise SceneError(f"solver.timestep ({s.timestep} s) must be shorter than solver.duration "
+                             f"({s.duration} s){w()}")
+        if s.engine == "reference" and s.max_step > 0 and s.duration / s.max_step > s.max_steps:
             raise SceneError(
-                f"solver.duration / solver.max_step = {self.duration:g} s / {self.max_step:g} s = "
-                f"{self.duration / self.max_step:.3g} steps exceeds solver.max_steps = {self.max_steps:.3g}; enlarge "
+                f"solver.duration / solver.max_step = {s.duration:g} s / {s.max_step:g} s = "
+                f"{s.duration / s.max_step:.3g} steps exceeds solver.max_steps = {s.max_steps:.3g}{w()}; enlarge "
                 "solver.max_step or raise solver.max_steps (CLI: --max-steps) if you mean it")
-        steps = self.duration / self.timestep
-        if steps > self.max_steps:
+        steps = s.duration / s.timestep
+        if steps > s.max_steps:
             raise SceneError(
-                f"solver.duration / solver.timestep = {self.duration:g} s / {self.timestep:g} s = {steps:.3g} steps "
-                f"exceeds solver.max_steps = {self.max_steps:.3g}; shorten the run, enlarge the step, or raise "
+                f"solver.duration / solver.timestep = {s.duration:g} s / {s.timestep:g} s = {steps:.3g} steps "
+                f"exceeds solver.max_steps = {s.max_steps:.3g}{w()}; shorten the run, enlarge the step, or raise "
                 "solver.max_steps (CLI: --max-steps) if you mean it")
-        if self.sample_dt > 0 and self.sample_dt > self.duration:
-            raise SceneError(f"solver.sample_dt ({self.sample_dt} s) must not exceed solver.duration "
-                             f"({self.duration} s)")
+        if s.sample_dt > 0 and s.sample_dt > s.duration:
+            raise SceneError(f"solver.sample_dt ({s.sample_dt} s) must not exceed solver.duration "
+                             f"({s.duration} s){w()}")
+        return s
 
 
 # the valid range of every numeric solver setting (the error message and the docs read this table)

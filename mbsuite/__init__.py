@@ -3,12 +3,17 @@
     >>> import mbsuite
     >>> scene = mbsuite.load_scene("pantograph")          # the model's default scene
     >>> res = mbsuite.run(scene)                            # engine from scene.solver.engine
+
+The names below are imported on first use (PEP 562), so `import mbsuite` and `mbsuite --version` load neither the
+engines nor the models.
 """
 
 from __future__ import annotations
 
-from . import native  # noqa: E402  (mbsuite.native.load(): register the engine plugins with MuJoCo)
-from .errors import (  # noqa: E402
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from .errors import (
     GeometryError,
     MbsuiteError,
     ModelFileError,
@@ -16,14 +21,49 @@ from .errors import (  # noqa: E402
     SceneError,
     SolverError,
 )
-from .health import AccuracyError, judge  # noqa: E402
-from .modelfiles import load_model_file  # noqa: E402
-from .paths import model_file, model_files  # noqa: E402
-from .registry import get_model  # noqa: E402
-from .registry import models as model_specs
-from .scenes import Scene, load_scene, scene_from_dict  # noqa: E402
-from .timerun import run_judged, run_name  # noqa: E402
 from .version import __version__
+
+if TYPE_CHECKING:
+    from . import native
+    from .health import AccuracyError
+    from .modelfiles import load_model_file
+    from .paths import model_file, model_files
+    from .registry import get_model
+    from .registry import models as model_specs
+    from .scenes import Scene, load_scene, scene_from_dict
+
+# public name -> (module, attribute; None: the module itself)
+_LAZY = {
+    "native": ("mbsuite.native", None),
+    "AccuracyError": ("mbsuite.health", "AccuracyError"),
+    "judge": ("mbsuite.health", "judge"),
+    "load_model_file": ("mbsuite.modelfiles", "load_model_file"),
+    "model_file": ("mbsuite.paths", "model_file"),
+    "model_files": ("mbsuite.paths", "model_files"),
+    "get_model": ("mbsuite.registry", "get_model"),
+    "model_specs": ("mbsuite.registry", "models"),
+    "Scene": ("mbsuite.scenes", "Scene"),
+    "load_scene": ("mbsuite.scenes", "load_scene"),
+    "scene_from_dict": ("mbsuite.scenes", "scene_from_dict"),
+    "run_judged": ("mbsuite.timerun", "run_judged"),
+    "run_name": ("mbsuite.timerun", "run_name"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use (and keep it in the module, so the next use is a plain lookup)."""
+    try:
+        module, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'mbsuite' has no attribute {name!r}") from None
+    value = importlib.import_module(module)
+    value = value if attr is None else getattr(value, attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
 
 
 def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool = False, workers: int = 0):
@@ -33,6 +73,10 @@ def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool =
     `error_estimate=True` also runs the scene refined once and twice (`mbsuite.accuracy`; `workers` local processes,
     0 = all cores) and attaches `res.error_estimate`: per headline output the estimated error and the observed order;
     an estimate above its declared tolerance is a health figure like any other."""
+    from .health import judge
+    from .scenes import Scene, load_scene
+    from .timerun import run_judged, run_name
+
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     spec = scene.spec

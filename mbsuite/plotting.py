@@ -5,13 +5,16 @@ same functions work headless, in scripts and in notebooks (where `display(fig)` 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from matplotlib.figure import Figure
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def figure(nrows: int = 1, ncols: int = 1, *, size: tuple[float, float] = (8.0, 5.0), **kw: Any) -> tuple[Figure, Any]:
     """A new figure and its axes (`Figure.subplots`), attached to no pyplot window."""
+    from matplotlib.figure import Figure  # here, not at import: a command that draws nothing does not pay for it
+
     fig = Figure(figsize=size, layout="constrained")
     return fig, fig.subplots(nrows, ncols, **kw)
 

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 from ..errors import MbsuiteError
 from .output import check_out, fail, quiet_stdout
-from .parser import UsageError, build_parser
+from .parser import UsageError, build_parser, parser_for
 
 __all__ = ["build_parser", "main"]
 
@@ -25,8 +25,8 @@ __all__ = ["build_parser", "main"]
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line. Exit status: 0 success, 2 any error (one line naming the input; under --json also a JSON
     object `{"error": {...}}` on stdout), 130 interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
-    ap = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
+    ap = parser_for(argv)
     try:
         args = ap.parse_args(argv)
     except UsageError as exc:

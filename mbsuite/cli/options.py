@@ -5,11 +5,14 @@ Model command groups use them too."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from ..analysis.sweep import EXECUTORS, MAX_POINTS, SweepOptions
+from ..analysis.sweep.options import EXECUTORS, MAX_POINTS
 from ..errors import MbsuiteError
-from ..scenes import Scene, load_scene
-from ..solver import DEFAULT_MAX_STEPS
+
+if TYPE_CHECKING:
+    from ..analysis.sweep import SweepOptions
+    from ..scenes import Scene
 
 MAX_REPEATS = 100
 SCENE_HELP = "scene TOML path, model name (default scene) or model/scene"
@@ -21,7 +24,7 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
                    help="keep a result whose health figures exceed their bounds (with a loud warning) instead of an "
                         "error")
     p.add_argument("--max-steps", type=float, metavar="N",
-                   help=f"size guard: most steps a run may take (default {DEFAULT_MAX_STEPS:.0e})")
+                   help="size guard: most steps a run may take (default: the scene's solver.max_steps)")
 
 
 def add_error_estimate(p: argparse.ArgumentParser) -> None:
@@ -36,6 +39,8 @@ def add_error_estimate(p: argparse.ArgumentParser) -> None:
 def load(args: argparse.Namespace) -> Scene:
     """The command's scene with the command-line solver overrides applied (and validated); `--engine` may name a
     path by its key or its label (`mbsuite list`)."""
+    from ..scenes import load_scene
+
     scene = load_scene(args.scene)
     solver: dict = {}
     engine = getattr(args, "engine", None)
@@ -66,6 +71,8 @@ def add_sweep_options(p: argparse.ArgumentParser) -> None:
 
 def sweep_options(args: argparse.Namespace) -> SweepOptions:
     """The `SweepOptions` of `--executor/--scheduler/--store/--max-points` (checked here, once)."""
+    from ..analysis.sweep import SweepOptions
+
     max_points = getattr(args, "max_points", None)
     return SweepOptions(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
                         store=getattr(args, "store", None), max_points=MAX_POINTS if max_points is None else max_points)

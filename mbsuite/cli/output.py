@@ -9,9 +9,12 @@ import os
 import sys
 import textwrap
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import MbsuiteError
-from ..results import Report, to_jsonable
+
+if TYPE_CHECKING:
+    from ..results import Report
 
 
 def add_common(p: argparse.ArgumentParser) -> None:
@@ -22,6 +25,8 @@ def add_common(p: argparse.ArgumentParser) -> None:
 
 def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> None:
     """Print `report` (its table, or its data as JSON under `--json`) and write its files under `--out`."""
+    from ..results import to_jsonable
+
     files = report.save(args.out, scene_dict) if getattr(args, "out", None) else []
     if args.json:
         payload = dict(report.data)

@@ -1,16 +1,61 @@
 """The `mbsuite` argument parser: the generic commands, then each model's own command group (`register(sub,
-add_common, emit)` in the model's `cli` module, which returns the group's command name)."""
+add_common, emit)` in the model's `cli` module, which returns the group's command name).
+
+A model's `cli` module also declares the top-level commands its `register` adds, `CLI_COMMANDS = {name: help}`, as a
+literal read here without importing the model (`declared_commands`): `mbsuite --version`, `--help`, a generic command
+and an argument error then build the light parser (`build_parser(models=False)`), which imports no model, engine,
+numpy, scipy or matplotlib; only a model's own command builds the whole parser."""
 
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
+from collections.abc import Callable
+from pathlib import Path
 
-from .. import registry
-from . import commands
 from .options import SCENE_HELP, add_error_estimate, add_scene_options, add_sweep_options
 from .output import add_common, emit
-from .sweep import cmd_sweep
+
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+GENERIC = ("list", "run", "view", "sweep", "workprecision", "perturb", "hardcases")
+
+
+def deferred(module: str, name: str) -> Callable:
+    """A command function imported when the command runs, not when the parser is built."""
+
+    def call(args: argparse.Namespace) -> None:
+        return getattr(importlib.import_module(module, __package__), name)(args)
+
+    call.__name__ = call.__qualname__ = name
+    return call
+
+
+def declared_commands() -> dict[str, dict[str, str]] | None:
+    """Model package -> the top-level commands its `cli` module declares (`CLI_COMMANDS`, the first is its group),
+    read from the source without importing it; None if a model's `cli` module declares none (then only the whole
+    parser knows its commands)."""
+    out: dict[str, dict[str, str]] = {}
+    for folder in sorted(p for p in MODELS_DIR.iterdir() if (p / "__init__.py").is_file()):
+        cli = folder / "cli.py"
+        if not cli.is_file():
+            continue
+        value = None
+        for node in ast.parse(cli.read_text()).body:
+            target = node.target if isinstance(node, ast.AnnAssign) else (
+                node.targets[0] if isinstance(node, ast.Assign) and len(node.targets) == 1 else None)
+            if isinstance(target, ast.Name) and target.id == "CLI_COMMANDS" and node.value is not None:
+                value = ast.literal_eval(node.value)
+        if not value:
+            return None
+        out[folder.name] = dict(value)
+    return out
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The command a command line names: its first argument that is not an option (the top level has no option that
+    takes a value)."""
+    return next((a for a in argv if not a.startswith("-")), None)
 
 
 class UsageError(Exception):
@@ -25,9 +70,10 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(f"{message} (usage: {self.prog} --help)")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The `mbsuite` argument parser: the generic commands plus each model's own command group. The groups, model ->
-    command name, are the parser's default `cli_groups` (what `mbsuite list` shows)."""
+def build_parser(models: bool = True) -> argparse.ArgumentParser:
+    """The `mbsuite` argument parser: the generic commands plus each model's own command group (`models=False`: the
+    light parser, whose model commands are declared stubs that parse nothing). The groups, model -> command name, are
+    the parser's default `cli_groups` (what `mbsuite list` shows)."""
     from ..version import __version__
 
     ap = Parser(
@@ -37,15 +83,36 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
     add_generic_commands(sub)
-    ap.set_defaults(cli_groups=add_model_groups(sub))
+    declared = None if models else (declared_commands() or {})
+    if declared is None:
+        ap.set_defaults(cli_groups=add_model_groups(sub))
+    else:
+        for commands in declared.values():
+            for name, helptext in commands.items():
+                sub.add_parser(name, help=helptext, add_help=False)
+        ap.set_defaults(cli_groups={model: next(iter(commands)) for model, commands in declared.items()})
     return ap
+
+
+def parser_for(argv: list[str]) -> argparse.ArgumentParser:
+    """The light parser when the command line needs no model's commands (`--version`, `--help`, a generic command, an
+    unknown command), else the whole one. While a model's `cli` module declares no `CLI_COMMANDS`, only `--version`
+    and the generic commands but `list` take the light parser (the others must know that model's commands)."""
+    command = command_of(argv)
+    declared = declared_commands()
+    if declared is None:
+        light = command in GENERIC and command != "list" or (command is None and "--version" in argv
+                                                                 and not {"-h", "--help"} & set(argv))
+        return build_parser(models=not light)
+    model_commands = {c for commands in declared.values() for c in commands}
+    return build_parser(models=command in model_commands)
 
 
 def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     """`list`, `run`, `view`, `sweep`, `workprecision`, `perturb`, `hardcases`: commands every model's scenes take."""
     p = sub.add_parser("list", help="models, their paths and their shipped scenes")
     add_common(p)
-    p.set_defaults(func=commands.cmd_list)
+    p.set_defaults(func=deferred(".commands", "cmd_list"))
 
     p = sub.add_parser("run", help="time simulation of a scene")
     p.add_argument("scene", help=SCENE_HELP)
@@ -54,11 +121,11 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--engine", metavar="PATH",
                    help="override the scene's path: a key or label of the model's path table (mbsuite list)")
     add_error_estimate(p)
-    p.set_defaults(func=commands.cmd_run)
+    p.set_defaults(func=deferred(".commands", "cmd_run"))
 
     p = sub.add_parser("view", help="open MuJoCo's viewer on a scene's model, its effects active")
     p.add_argument("scene", help=SCENE_HELP)
-    p.set_defaults(func=commands.cmd_view)
+    p.set_defaults(func=deferred(".commands", "cmd_view"))
 
     p = sub.add_parser("sweep", help="parameter study: run a scene over a grid of inputs/parameters/settings")
     p.add_argument("scene", help=SCENE_HELP)
@@ -71,7 +138,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     add_sweep_options(p)
     add_scene_options(p)
     add_common(p)
-    p.set_defaults(func=cmd_sweep)
+    p.set_defaults(func=deferred(".sweep", "cmd_sweep"))
 
     p = sub.add_parser("workprecision", help="what accuracy costs: error vs wall time for every engine and method")
     p.add_argument("scene", help=SCENE_HELP)
@@ -79,7 +146,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quick", action="store_true", help="a few settings and short runs (smoke test)")
     p.add_argument("--verbose", action="store_true", help="print each setting as it finishes (stderr)")
     add_common(p)
-    p.set_defaults(func=commands.cmd_workprecision)
+    p.set_defaults(func=deferred(".commands", "cmd_workprecision"))
 
     p = sub.add_parser("perturb", help="stability under perturbation: every parameter, input and initial state "
                                        "changed by a relative eps; invariants, sensitivities, jumps")
@@ -94,7 +161,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-slow", action="store_true", help="leave out the slow hard cases")
     p.add_argument("--verbose", action="store_true", help="print each row as it finishes (stderr)")
     add_common(p)
-    p.set_defaults(func=commands.cmd_perturb)
+    p.set_defaults(func=deferred(".commands", "cmd_perturb"))
 
     p = sub.add_parser("hardcases", help="the hard-case registry: what is hard, the scene, what is asserted")
     p.add_argument("--run", action="store_true", help="run the cases and report each assertion (exit 2 on failure)")
@@ -102,11 +169,13 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--name", action="append", help="only this case (repeatable)")
     p.add_argument("--no-slow", action="store_true", help="leave out the slow cases")
     add_common(p)
-    p.set_defaults(func=commands.cmd_hardcases)
+    p.set_defaults(func=deferred(".commands", "cmd_hardcases"))
 
 
 def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:
     """Let each model with a `cli` module add its command group; returns model -> the group's command name."""
+    from .. import registry
+
     groups: dict[str, str] = {}
     for name in sorted(registry.models()):
         try:

@@ -60,13 +60,41 @@ batches), `points.py` (the generic scene point of `mbsuite sweep`).
 
 from __future__ import annotations
 
-from .driver import run_sweep
-from .encoding import StoreError, StoreWarning, decode_value, encode_value, point_key
-from .grid import check_grid, parse_values
-from .options import EXECUTORS, MAX_POINTS, SweepOptions
-from .points import scene_point
-from .rollout import get_state, rollout_sweep, state_size
-from .store import FORMAT, SCHEMA_VERSION, SweepStore
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .driver import run_sweep
+    from .encoding import StoreError, StoreWarning, decode_value, encode_value, point_key
+    from .grid import check_grid, parse_values
+    from .options import EXECUTORS, MAX_POINTS, SweepOptions
+    from .points import scene_point
+    from .rollout import get_state, rollout_sweep, state_size
+    from .store import FORMAT, SCHEMA_VERSION, SweepStore
+
+# public name -> the module holding it, imported on first use (so the command line's parser, which reads only the
+# options' constants, does not load the executors and the engines)
+_HOME = {
+    "run_sweep": "driver", "StoreError": "encoding", "StoreWarning": "encoding", "decode_value": "encoding",
+    "encode_value": "encoding", "point_key": "encoding", "check_grid": "grid", "parse_values": "grid",
+    "EXECUTORS": "options", "MAX_POINTS": "options", "SweepOptions": "options", "scene_point": "points",
+    "get_state": "rollout", "rollout_sweep": "rollout", "state_size": "rollout", "FORMAT": "store",
+    "SCHEMA_VERSION": "store", "SweepStore": "store",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """A public name, imported from its module on first use."""
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_HOME})
+
 
 __all__ = [
     "EXECUTORS", "FORMAT", "MAX_POINTS", "SCHEMA_VERSION", "StoreError", "StoreWarning", "SweepOptions", "SweepStore",

@@ -8,8 +8,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ...errors import SceneError
 
 EXECUTORS = ("local", "threads", "dask")
@@ -27,6 +25,8 @@ def check_executor(executor: str, scheduler: Any) -> None:
 
 def check_max_points(max_points: Any) -> int:
     """`max_points` as an int, or a `SceneError` unless it is an integer >= 1."""
+    import numpy as np
+
     if isinstance(max_points, bool) or not isinstance(max_points, int | np.integer) or max_points < 1:
         raise SceneError(f"max_points = {max_points!r} is invalid; valid: an integer >= 1")
     return int(max_points)

@@ -12,11 +12,13 @@ from ...results import Progress, Report
 from ...scenes import Scene, load_scene
 
 COMMAND = "catenary"
+# the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
+CLI_COMMANDS = {"catenary": "pantograph passage under the FE catenary: EN 50318 statistics, plots, CSV"}
 
 
 def register(sub, add_common, emit) -> str:
     """Add the `mbsuite catenary` command to the CLI's subparsers `sub`; returns its name."""
-    p = sub.add_parser(COMMAND, help="pantograph passage under the FE catenary: EN 50318 statistics, plots, CSV")
+    p = sub.add_parser(COMMAND, help=CLI_COMMANDS[COMMAND])
     p.add_argument("scene", nargs="?", default="catenary",
                    help="scene TOML path, 'catenary' (default scene) or catenary/<scene>")
     p.add_argument("--speed", type=float, default=None, help="train speed (km/h); default: the scene's input.speed")

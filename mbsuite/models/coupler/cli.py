@@ -16,6 +16,9 @@ from ...scenes import load_scene
 from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
 
+# the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
+CLI_COMMANDS = {"coupler": "4-link coupler kinematics (Jacobian, FPP, criteria) and dynamics"}
+
 
 def mbsuite_run(scene, error_estimate: bool = False):
     """`mbsuite.run` (imported late: the package imports this module's model while it loads)."""
@@ -180,7 +183,7 @@ def cmd_dynamics(args: argparse.Namespace, emit) -> None:
 def register(sub, add_common, emit) -> str:
     """Add the `mbsuite coupler jacobian | fpp | criteria | dynamics` commands to the parser `sub`; return the group's
     command name."""
-    g = sub.add_parser("coupler", help="4-link coupler kinematics (Jacobian, FPP, criteria) and dynamics")
+    g = sub.add_parser("coupler", help=CLI_COMMANDS["coupler"])
     gs = g.add_subparsers(dest="coupler_command", required=True)
 
     p = gs.add_parser("jacobian", help="mechanism Jacobian, singular values, rank, condition number, screws")

@@ -24,17 +24,25 @@ COMMANDS = {
     "modes": "linearised natural frequencies and damping ratios",
     "freqresp": "frequency response (linearisation, reference and MuJoCo time simulations)",
 }
+# the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
+CLI_COMMANDS = {
+    "pantograph": "the pantograph's analyses: equilibrium, modes, frequency response",
+    "equilibrium": "static equilibrium of a scene (every path) (as `mbsuite pantograph equilibrium`)",
+    "modes": "linearised natural frequencies and damping ratios (as `mbsuite pantograph modes`)",
+    "freqresp": "frequency response (linearisation, reference and MuJoCo time simulations) (as `mbsuite pantograph "
+                "freqresp`)",
+}
 
 
 def register(sub: argparse._SubParsersAction, add_common, emit) -> str:
     """Add the `pantograph` command group and its top-level aliases to the CLI's subparsers `sub`."""
-    g = sub.add_parser("pantograph", help="the pantograph's analyses: equilibrium, modes, frequency response")
+    g = sub.add_parser(MODEL, help=CLI_COMMANDS[MODEL])
     gs = g.add_subparsers(dest="pantograph_command", required=True)
     for name, helptext in COMMANDS.items():
         p = gs.add_parser(name, help=helptext)
         p.add_argument("scene", nargs="?", default=MODEL, help=SCENE_HELP + " (default: the pantograph's)")
         _add_options(p, name, add_common, emit)
-        p = sub.add_parser(name, help=f"{helptext} (as `mbsuite pantograph {name}`)")
+        p = sub.add_parser(name, help=CLI_COMMANDS[name])
         p.add_argument("scene", help=SCENE_HELP)
         _add_options(p, name, add_common, emit)
     return MODEL

@@ -117,7 +117,7 @@ def test_regression_criteria_table_double_c5(capsys):
 # ------------------------------------------------------------------------------------- declared limits, inputs
 def test_every_parameter_declares_its_range():
     assert undeclared(CouplerParams) == []
-    with pytest.raises(mbsuite.ParameterError, match=r"coupler parameter m_link = -1.0 is invalid; valid: \(0, "):
+    with pytest.raises(mbsuite.ParameterError, match=r"coupler parameter m_link = -1.0 is invalid; valid: \[1e-06, "):
         CouplerParams(m_link=-1.0)
 
 

@@ -49,10 +49,10 @@ class CatenaryParams:
     element_length: float = param(0.5, lo=0.0, lo_open=True, hi=1000.0, unit="m",
                                   doc="target FE element length; key points (supports, droppers) are always nodes")
     # --- reference pantograph (two lumped masses on a fixed base) ----------------------------------------------------
-    m1: float = param(7.2, lo=0.0, lo_open=True, hi=1e4, unit="kg", doc="head mass")
+    m1: float = param(7.2, lo=1e-6, hi=1e4, unit="kg", doc="head mass (>= 1e-6 kg, the other models' floor)")
     k1: float = param(4200.0, lo=0.0, lo_open=True, hi=1e9, unit="N/m", doc="head suspension stiffness")
     c1: float = param(10.0, lo=0.0, hi=1e7, unit="N s/m", doc="head suspension damping")
-    m2: float = param(15.0, lo=0.0, lo_open=True, hi=1e4, unit="kg", doc="frame mass")
+    m2: float = param(15.0, lo=1e-6, hi=1e4, unit="kg", doc="frame mass (>= 1e-6 kg, the other models' floor)")
     k2: float = param(50.0, lo=0.0, hi=1e9, unit="N/m",
                       doc="frame stiffness to the base, referenced to the undisturbed CW level")
     c2: float = param(90.0, lo=0.0, hi=1e7, unit="N s/m", doc="frame damping to the base")

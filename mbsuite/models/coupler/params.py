@@ -16,6 +16,12 @@ from ...limits import check_fields, param
 
 GAMMA_17DEG = math.radians(17.0)  # 0.29671 rad: the value that reproduces Eq (15) (README, erratum 7)
 GAMMAS_PAPER = (0.11, 0.297, 0.391)  # the paper's Sect. 3.1 and 3.4
+#: the smallest mass [kg] and principal inertia [kg m^2] a moving body may get: MuJoCo refuses a body whose mass or
+#: inertia is below mjMINVAL = 1e-15 ("mass and inertia of moving bodies must be larger than mjMINVAL"), which names
+#: no parameter; these floors (the pantograph's) refuse such values by name, well above it
+MASS_MIN, INERTIA_MIN = 1e-6, 1e-9
+#: the smallest principal inertia of an SS link (axial, m r^2 / 2; in the massless limit the mass is scaled too)
+LINK_INERTIA_MIN = 1e-12
 
 
 @dataclass(frozen=True)
@@ -47,15 +53,15 @@ class CouplerParams:
     R: float = param(1.0, lo=0.0, hi=1000.0, lo_open=True, unit="m", doc="radius of the circle through the joints")
     l_b: float = param(2.0, lo=0.0, hi=1000.0, lo_open=True, unit="m", doc="length of the intermediate shaft b")
     phi_bc: float = param(0.0, lo=-math.pi, hi=math.pi, unit="rad", doc="angle between platforms BA and BC")
-    m_link: float = param(5.0, lo=0.0, hi=1e6, lo_open=True, unit="kg", doc="mass of one SS link")
-    link_radius: float = param(0.02, lo=0.0, hi=10.0, lo_open=True, unit="m", doc="capsule radius of one SS link")
-    massless_factor: float = param(1e-3, lo=0.0, hi=1.0, lo_open=True, doc="link mass scale of the massless limit")
-    m_shaft_b: float = param(80.0, lo=0.0, hi=1e7, lo_open=True, unit="kg", doc="mass of the intermediate shaft b")
-    i_shaft_b_axial: float = param(20.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of shaft b")
-    i_shaft_b_trans: float = param(40.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2",
+    m_link: float = param(5.0, lo=MASS_MIN, hi=1e6, unit="kg", doc="mass of one SS link")
+    link_radius: float = param(0.02, lo=1e-4, hi=10.0, unit="m", doc="capsule radius of one SS link")
+    massless_factor: float = param(1e-3, lo=1e-6, hi=1.0, doc="link mass scale of the massless limit")
+    m_shaft_b: float = param(80.0, lo=MASS_MIN, hi=1e7, unit="kg", doc="mass of the intermediate shaft b")
+    i_shaft_b_axial: float = param(20.0, lo=INERTIA_MIN, hi=1e7, unit="kg m^2", doc="axial inertia of shaft b")
+    i_shaft_b_trans: float = param(40.0, lo=INERTIA_MIN, hi=1e7, unit="kg m^2",
                                    doc="transverse inertia of shaft b about its centre")
-    i_shaft_a: float = param(10.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of input shaft a")
-    i_shaft_c: float = param(30.0, lo=0.0, hi=1e7, lo_open=True, unit="kg m^2", doc="axial inertia of output shaft c")
+    i_shaft_a: float = param(10.0, lo=INERTIA_MIN, hi=1e7, unit="kg m^2", doc="axial inertia of input shaft a")
+    i_shaft_c: float = param(30.0, lo=INERTIA_MIN, hi=1e7, unit="kg m^2", doc="axial inertia of output shaft c")
     joint_friction: float = param(2.0, lo=0.0, hi=1e6, unit="N m", doc="dry friction in every S joint and bearing")
     joint_damping: float = param(0.05, lo=0.0, hi=1e6, unit="N m s/rad", doc="viscous damping in the S joints")
     kv_drive: float = param(2.0e5, lo=0.0, hi=1e12, lo_open=True, unit="N m s/rad",
@@ -73,6 +79,17 @@ class CouplerParams:
         if self.l_b <= 2.0 * self.link_radius:
             raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for link_radius = "
                                  f"{self.link_radius!r} m (need l_b > 2 link_radius)")
+        ia = self.m_link * self.massless_factor * self.link_radius ** 2 / 2
+        if ia < LINK_INERTIA_MIN:
+            raise ParameterError(
+                f"coupler parameters m_link = {self.m_link!r} kg, massless_factor = {self.massless_factor!r}, "
+                f"link_radius = {self.link_radius!r} m give the massless link an axial inertia m_link massless_factor "
+                f"link_radius^2 / 2 = {ia:.3g} kg m^2 below {LINK_INERTIA_MIN:g} (a body MuJoCo cannot move): raise "
+                "one of them")
+        if self.i_shaft_b_axial > 2.0 * self.i_shaft_b_trans:
+            raise ParameterError(
+                f"coupler parameters i_shaft_b_axial = {self.i_shaft_b_axial!r} kg m^2 > 2 i_shaft_b_trans = "
+                f"{2.0 * self.i_shaft_b_trans!r} kg m^2: no rigid body has these principal inertias (A + B >= C)")
 
     @property
     def l0(self) -> float:

@@ -1,11 +1,13 @@
 """Declared accuracy and error estimates: what a scene promises about its headline outputs, and how a run checks it.
 
 A model declares (`ModelSpec.accuracy`, an `AccuracySpec`):
-- `headlines(scene)`: its headline outputs (`Headline`: name, unit, the absolute tolerance its defaults meet);
+- `headlines(scene)`: its headline outputs (`Headline`: name, unit, the tolerance its defaults meet: `tol`, plus
+  `rtol` times the value where the error scales with the value);
 - `values(scene, result)`: the headline values of one run's result;
 - `refinement(scene)`: how the scene's path is refined (`Refinement`: the setting, the factor per level, the
   method's nominal order, and `refine(scene, level)` giving the refined scene).
-A scene may tighten or loosen a tolerance in its `[accuracy]` section (`name = tolerance`, in the headline's unit);
+A scene may tighten or loosen a tolerance in its `[accuracy]` section (`name = tolerance`: absolute, in the headline's
+unit, replacing the declared tolerance);
 a name that is not a headline of the scene is an error.
 
 The error estimate (`estimate`) follows the grid-convergence index of Roache ("Verification and Validation in
@@ -41,12 +43,20 @@ ROUND_OFF = 1e-12
 
 @dataclass(frozen=True)
 class Headline:
-    """One headline output of a scene: `tol` is the absolute tolerance (in `unit`) its default settings meet."""
+    """One headline output of a scene: its default settings meet the tolerance `tol + rtol |value|` (in `unit`;
+    `rtol` for an output whose error scales with its size, e.g. a fraction of time lost, 0 for most)."""
 
     name: str
     unit: str
     tol: float
     doc: str = ""
+    rtol: float = 0.0
+
+    def bound(self, value: float) -> float | None:
+        """The tolerance at `value`: tol + rtol |value| (None where no tolerance is declared)."""
+        if self.tol is None or not math.isfinite(value):
+            return self.tol
+        return self.tol + self.rtol * abs(value)
 
 
 @dataclass(frozen=True)
@@ -184,7 +194,7 @@ def estimate(levels: list[Mapping[str, float]], headlines: tuple[Headline, ...],
             raise KeyError(f"headline {h.name!r} missing from the values of level(s) {missing}")
         q = [float(lv[h.name]) for lv in levels]
         err, p_obs, asym = estimate_one(q[0], q[1], q[2], refinement.factor, refinement.order)
-        out.rows.append(Estimate(h.name, h.unit, q[0], (q[1], q[2]), err, p_obs, asym, h.tol))
+        out.rows.append(Estimate(h.name, h.unit, q[0], (q[1], q[2]), err, p_obs, asym, h.bound(q[0])))
     return out
 
 
@@ -213,7 +223,7 @@ def declared(scene: Any) -> tuple[Headline, ...]:
     bad = sorted(set(over) - set(names))
     if bad:
         raise SceneError(f"unknown headline(s) {bad} in [accuracy]; headlines of this scene: {names}")
-    return tuple(Headline(h.name, h.unit, over.get(h.name, h.tol), h.doc) for h in heads)
+    return tuple(Headline(h.name, h.unit, over[h.name], h.doc) if h.name in over else h for h in heads)
 
 
 def halving(setting: str, order: float, refine: Callable[[Any, int], Any], doc: str = "") -> Refinement:

@@ -139,3 +139,18 @@ def test_sweep_and_run_error_estimates_agree_point_by_point(tmp_path, capsys):
         for row in pt["error_estimate"]["rows"]:
             assert row["value"] == one[row["name"]].value
             assert row["error"] == pytest.approx(one[row["name"]].error, rel=1e-12, abs=1e-300)
+
+
+def test_a_relative_tolerance_scales_with_the_value():
+    """`Headline(tol, rtol)`: the bound is tol + rtol |value| of the run (level 0). A second-order sequence with a
+    known limit (hand values: q_k = 2 + 0.4 / 4^k, true error of q0 0.4, estimate 1.25 * 0.3 * 4/3 = 0.5) is within
+    0.05 + 0.3 * 2.4 = 0.77 and outside 0.05 + 0.1 * 2.4 = 0.29; an [accuracy] override is absolute."""
+    from mbsuite.accuracy import Headline, estimate, timestep_refinement
+
+    ref = timestep_refinement(2.0)
+    levels = [{"q": 2.0 + 0.4 / 4**k} for k in range(3)]
+    ok = estimate(levels, (Headline("q", "1", 0.05, rtol=0.3),), ref)["q"]
+    bad = estimate(levels, (Headline("q", "1", 0.05, rtol=0.1),), ref)["q"]
+    assert ok.error == pytest.approx(0.5) and ok.tol == pytest.approx(0.77) and ok.ok
+    assert bad.tol == pytest.approx(0.29) and not bad.ok
+    assert Headline("q", "1", 0.05, rtol=0.1).bound(-3.0) == pytest.approx(0.35)

@@ -7,7 +7,8 @@ percentage of contact loss). A single pantograph's are named as its SimResult's 
 
 Tolerances (absolute, at the scene's default settings): 1 N on every force statistic and 0.5 mm on the uplift (the
 accuracy an EN 50318 / EN 50367 assessment reads its statistics to: the accepted ranges are 5-35 N wide, the uplift
-range 7-10 mm); the contact loss `LOSS_TOL` (below). The measured errors behind them are in `TOL`'s comment.
+range 7-10 mm); the contact loss `LOSS_TOL` + `LOSS_RTOL` times its value (below). The measured errors behind them
+are in the comments below.
 
 Refinement: the element length and the time step halved together (`refine`), which keeps the wave Courant number
 c dt / h of the run. The trapezoidal rule is second order in dt (README, against a DOP853 solution: 4.0x per
@@ -30,9 +31,16 @@ STATS = tuple(STAT_NAMES)
 UNITS = {**{k: "N" for k in STATS}, "uplift_mm": "mm", "loss_pct": "%"}
 #: nominal order of the refinement (element length and time step halved together: the trapezoidal rule's 2)
 ORDER = 2.0
-#: contact loss (percentage points of the window's samples): half the AC arcing limit NQ <= 0.2 % and the DC limit
-#: itself (`quality.SYSTEMS`), so that a loss judged against those limits is known to a fraction of them
-LOSS_TOL = 0.1
+#: contact loss (percentage of the window's samples): 0.05 % + 10 % of the value. The lost time is a sum of loss
+#: events whose durations each carry the discretisation's error, so the error scales with the loss: on the two
+#: pantographs at 300 km/h (trailing loss 1.51 %) the default 0.5 m / 2e-4 s is 0.078 % off a run 8x finer, the
+#: error estimate says 0.127 % (bound 0.20 %); with linear droppers at 300 km/h (3.18 %) 0.041 % off a run 4x finer
+#: (bound 0.37 %); every other shipped scene loses no contact at any resolution. Where a verdict is read (the AC
+#: arcing limit NQ <= 0.2 %, the DC limit 0.1 %) the bound is 0.06-0.07 %, a third of the AC limit. Counting the lost
+#: time between samples (the gap's zero crossings interpolated) moves the trailing pantograph's 1.430 % to 1.440 %
+#: only: the error is the dynamics', not the sampling's.
+LOSS_TOL = 0.05
+LOSS_RTOL = 0.1
 #: declared tolerances at the shipped settings
 TOL = {**{k: 1.0 for k in STATS}, "uplift_mm": 0.5, "loss_pct": LOSS_TOL}
 
@@ -63,7 +71,8 @@ def headlines(scene: Scene) -> tuple[Headline, ...]:
     for name in names(n):
         stat = _stat_of(name)
         who = "" if n == 1 else f"pantograph {name.partition('_')[0][1:]}: "
-        out.append(Headline(name, UNITS[stat], TOL[stat], who + STAT_NAMES[stat]))
+        out.append(Headline(name, UNITS[stat], TOL[stat], who + STAT_NAMES[stat],
+                            rtol=LOSS_RTOL if stat == "loss_pct" else 0.0))
     return tuple(out)
 
 

@@ -63,15 +63,17 @@ class SimResult:
         return write_csv(path, cols)
 
     def to_pandas(self) -> Any:
-        """The signals as a `pandas.DataFrame` indexed by time `t [s]`, columns `name [unit]` (needs pandas:
-        `pip install mbsuite[pandas]`)."""
+        """The signals as a `pandas.DataFrame` indexed by time `t`, one column per signal named by the signal
+        (`df["F1"]`); the SI units are in `df.attrs["units"]` (signal -> unit, and `t` -> "s"). Needs pandas:
+        `pip install mbsuite[pandas]`."""
         try:
             import pandas as pd
         except ModuleNotFoundError as exc:
             raise ModuleNotFoundError("SimResult.to_pandas() needs pandas: pip install 'mbsuite[pandas]'") from exc
-        cols = {f"{k} [{self.units.get(k, '')}]" if self.units.get(k) else k: np.asarray(v)
-                for k, v in self.signals.items()}
-        return pd.DataFrame(cols, index=pd.Index(np.asarray(self.t), name="t [s]"))
+        df = pd.DataFrame({k: np.asarray(v) for k, v in self.signals.items()},
+                          index=pd.Index(np.asarray(self.t), name="t"))
+        df.attrs["units"] = {"t": "s", **{k: self.units.get(k, "") for k in self.signals}}
+        return df
 
     def plot(self, signals: Sequence[str] | None = None, axes: Any = None) -> Any:
         """Time histories, one panel per unit (signals sharing a unit share a panel). Draws on `axes` (a sequence
@@ -221,13 +223,56 @@ def to_jsonable(obj: Any) -> Any:
     return obj
 
 
-def write_summary(out_dir: str | Path, scene: Mapping[str, Any] | None, results: Mapping[str, Any]) -> Path:
-    """Write `summary.json` (versions, scene, results) into `out_dir`."""
+def git_commit() -> dict[str, Any] | None:
+    """The commit of the checkout mbsuite runs from (`commit`, and `dirty`: tracked files changed since), or None
+    when it runs from an installed package or git is missing."""
+    import subprocess
+
+    root = Path(__file__).resolve().parent.parent
+    if not (root / ".git").exists():
+        return None
+    try:
+        commit = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
+                                timeout=10, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10, check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return {"commit": commit, "dirty": bool(dirty)}
+
+
+def write_summary(out_dir: str | Path, scene: Mapping[str, Any] | None, results: Mapping[str, Any],
+                  command: Mapping[str, Any] | None = None) -> Path:
+    """Write `summary.json` into `out_dir`: the versions (mbsuite, engines, Python; the git commit when run from a
+    checkout), the command that made it (`command`: its argv and options), the full scene as run (every default
+    resolved: `mbsuite run summary.json` runs it again) and the results."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = out / "summary.json"
-    p.write_text(json.dumps(to_jsonable({"versions": versions(), "scene": scene, "results": results}), indent=2))
+    body = {"versions": versions(), "checkout": git_commit(), "command": dict(command) if command else None,
+            "scene": scene, "results": results}
+    p.write_text(json.dumps(to_jsonable(body), indent=2))
     return p
+
+
+def read_summary_scene(path: str | Path) -> dict[str, Any]:
+    """The scene a `summary.json` records (what `mbsuite run summary.json` reruns); a SceneError naming the file
+    when it is no summary or holds no scene."""
+    from .errors import SceneError
+
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except OSError as exc:
+        raise SceneError(f"cannot read {p}: {exc.strerror or exc}") from exc
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{p} is not a summary.json (not valid JSON: {exc})") from exc
+    scene = data.get("scene") if isinstance(data, dict) else None
+    if not isinstance(scene, dict):
+        raise SceneError(f"{p} records no scene (the command that wrote it ran none); rerun that command instead"
+                         + (f": mbsuite {' '.join(data['command']['argv'])}" if isinstance(data, dict)
+                            and isinstance(data.get("command"), dict) and data["command"].get("argv") else ""))
+    return scene
 
 
 def format_table(headers: Sequence[str], rows: Sequence[Sequence[Any]], floatfmt: str = ".6g") -> str:
@@ -286,10 +331,12 @@ class Report:
     table: str
     write: Any = None  # Callable[[Path], list[Path]] | None
 
-    def save(self, out_dir: str | Path, scene: Mapping[str, Any] | None) -> list[Path]:
-        """Write the report's files and summary.json into `out_dir`; return their paths."""
+    def save(self, out_dir: str | Path, scene: Mapping[str, Any] | None,
+             command: Mapping[str, Any] | None = None) -> list[Path]:
+        """Write the report's files and summary.json (`write_summary`: with the scene and the command) into
+        `out_dir`; return their paths."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         files = list(self.write(out)) if self.write else []
-        files.append(write_summary(out, scene, self.data))
+        files.append(write_summary(out, scene, self.data, command))
         return files

@@ -5,8 +5,12 @@ Each analysis prints a human table by default, JSON with `--json`, and with `--o
 header), PNG plots and `summary.json` (versions + scene). A model package adds its own commands by defining
 `register(sub, add_common, emit) -> str` in its `cli` module (returning its group's command name).
 
+Every command that reads a scene also takes a `summary.json` an earlier command wrote (the scene it ran), and the
+model analyses take `--set SECTION.KEY=VALUE` and `--vary SECTION.KEY=VALUES` (a parameter study of the analysis).
+
 The package: `parser.py` (the parser, the model groups), `commands.py` (the generic commands), `sweep.py` (`mbsuite
-sweep`), `options.py` (options several commands share), `output.py` (tables, JSON, files, one-line errors).
+sweep`), `study.py` (`--set`/`--vary` on the analyses), `options.py` (options several commands share), `output.py`
+(tables, JSON, files, one-line errors).
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return fail(str(exc), "--json" in argv, "UsageError")
     except SystemExit as exc:  # --help / --version
         return int(exc.code or 0)
+    args.argv = argv  # summary.json records the command
     as_json = bool(getattr(args, "json", False))
     try:
         check_out(getattr(args, "out", None))

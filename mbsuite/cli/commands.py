@@ -12,7 +12,7 @@ from .. import registry
 from ..errors import MbsuiteError
 from ..results import Report, format_table
 from ..scenes import load_scene
-from .options import MAX_REPEATS, load
+from .options import MAX_REPEATS, load, scene_of
 from .output import emit, wrap
 
 ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view")
@@ -84,7 +84,7 @@ def cmd_workprecision(args: argparse.Namespace) -> None:
     """`mbsuite workprecision SCENE`: error against wall time for every engine and method."""
     from ..analysis.workprecision import workprecision
 
-    scene = load_scene(args.scene)
+    scene = scene_of(args.scene)
     if not 1 <= args.repeats <= MAX_REPEATS:
         raise MbsuiteError(f"--repeats {args.repeats} is invalid; valid: integer in [1, {MAX_REPEATS}] (runs per "
                            "setting; the wall time is their median)")

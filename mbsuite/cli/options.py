@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from ..scenes import Scene
 
 MAX_REPEATS = 100
-SCENE_HELP = "scene TOML path, model name (default scene) or model/scene"
+SCENE_HELP = "scene TOML path, model name (default scene), model/scene or a summary.json (the scene it ran)"
 
 
 def add_scene_options(p: argparse.ArgumentParser) -> None:
@@ -39,9 +39,7 @@ def add_error_estimate(p: argparse.ArgumentParser) -> None:
 def load(args: argparse.Namespace) -> Scene:
     """The command's scene with the command-line solver overrides applied (and validated); `--engine` may name a
     path by its key or its label (`mbsuite list`)."""
-    from ..scenes import load_scene
-
-    scene = load_scene(args.scene)
+    scene = scene_of(args.scene)
     solver: dict = {}
     engine = getattr(args, "engine", None)
     if engine:
@@ -54,7 +52,21 @@ def load(args: argparse.Namespace) -> Scene:
         solver["allow_inaccurate"] = True
     if getattr(args, "max_steps", None) is not None:
         solver["max_steps"] = args.max_steps
-    return scene.replace(solver=solver) if solver else scene
+    flags = "/".join(f for f, k in (("--engine", "engine"), ("--allow-inaccurate", "allow_inaccurate"),
+                                     ("--max-steps", "max_steps")) if k in solver)
+    return scene.replace(solver=solver, origin=f"on the command line ({flags})") if solver else scene
+
+
+def scene_of(ref: str) -> Scene:
+    """The scene a command line names: a TOML path, a model name, model/scene, or a `summary.json` an earlier
+    command wrote (the full scene it ran, every default resolved: the same run again)."""
+    from ..scenes import load_scene, scene_from_dict
+
+    if str(ref).endswith(".json"):
+        from ..results import read_summary_scene
+
+        return scene_from_dict(read_summary_scene(ref), source=str(ref))
+    return load_scene(ref)
 
 
 def add_sweep_options(p: argparse.ArgumentParser) -> None:

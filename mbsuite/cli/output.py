@@ -27,7 +27,7 @@ def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> N
     """Print `report` (its table, or its data as JSON under `--json`) and write its files under `--out`."""
     from ..results import to_jsonable
 
-    files = report.save(args.out, scene_dict) if getattr(args, "out", None) else []
+    files = report.save(args.out, scene_dict, command_record(args)) if getattr(args, "out", None) else []
     if args.json:
         payload = dict(report.data)
         if files:
@@ -37,6 +37,13 @@ def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> N
         print(report.table)
         for f in files:
             print(f"wrote {f}")
+
+
+def command_record(args: argparse.Namespace) -> dict:
+    """What summary.json records of the command: its argv (as typed, when `main` ran it) and every option's value."""
+    options = {k: v for k, v in vars(args).items()
+               if k not in ("func", "cli_groups", "argv") and (v is None or isinstance(v, str | int | float | list))}
+    return {"argv": getattr(args, "argv", None), "options": options}
 
 
 def wrap(text: str, width: int = 100, indent: str = "  ") -> str:

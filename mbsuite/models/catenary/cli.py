@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import argparse
 
-from ...cli.options import add_error_estimate, add_scene_options, check_workers
+from ...cli.options import add_error_estimate, add_scene_options, check_workers, scene_of
+from ...cli.study import add_study_options, run_or_study
 from ...errors import SceneError
 from ...results import Progress, Report
-from ...scenes import Scene, load_scene
+from ...scenes import Scene
 
 COMMAND = "catenary"
 # the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
@@ -41,6 +42,7 @@ def register(sub, add_common, emit) -> str:
                    help="local processes for the refined passages of --error-estimate (0 = all cores)")
     add_error_estimate(p)
     add_scene_options(p)
+    add_study_options(p)
     add_common(p)
     p.set_defaults(func=cmd_catenary, emit=emit)
     return COMMAND
@@ -61,37 +63,42 @@ class _Percent:
 
 def _scene(args: argparse.Namespace) -> Scene:
     """The command's catenary scene with the command line's overrides."""
-    scene = load_scene(args.scene)
+    scene = scene_of(args.scene)
     if scene.model != "catenary":
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "
                          "catenary scene")
-    if args.engine is not None:
-        scene = scene.replace(solver={"engine": args.engine})
-    if args.timestep is not None:
-        scene = scene.replace(solver={"timestep": args.timestep})
-    if args.element_length is not None:
-        scene = scene.replace(params={"element_length": args.element_length})
-    if args.speed is not None:
-        scene = scene.replace(input={"speed": args.speed})
-    if getattr(args, "allow_inaccurate", False):
-        scene = scene.replace(solver={"allow_inaccurate": True})
-    if getattr(args, "max_steps", None) is not None:
-        scene = scene.replace(solver={"max_steps": args.max_steps})
+    old = scene.input.get("speed")
+    flags = [("--engine", "solver", "engine", args.engine), ("--timestep", "solver", "timestep", args.timestep),
+             ("--element-length", "params", "element_length", args.element_length),
+             ("--speed", "input", "speed", args.speed),
+             ("--allow-inaccurate", "solver", "allow_inaccurate", True if args.allow_inaccurate else None),
+             ("--max-steps", "solver", "max_steps", getattr(args, "max_steps", None))]
+    for flag, section, key, value in flags:
+        if value is not None:
+            scene = scene.replace(origin=f"on the command line ({flag})", **{section: {key: value}})
+    new = scene.input.get("speed")
+    if args.speed is not None and old is not None and old != new and f"{old:g} km/h" in scene.description:
+        # the description names the scene's speed: say the speed this run is at
+        scene = scene.replace(description=scene.description.replace(f"{old:g} km/h", f"{new:g} km/h"))
     if args.spacings is not None:
         if "train" not in scene.sections:
             raise SceneError("--spacings needs a scene with a [train] section (e.g. catenary/en50318_two_pantographs)")
-        scene = scene.replace(train={"spacings": list(args.spacings)})
+        scene = scene.replace(train={"spacings": list(args.spacings)}, origin="on the command line (--spacings)")
     return scene
 
 
 def cmd_catenary(args: argparse.Namespace) -> None:
-    """One passage (or a train's, with `[train]`) of the scene, and its report."""
+    """One passage (or a train's, with `[train]`) of the scene, and its report (or a --vary study of it)."""
+    run_or_study(args, _scene(args), f"{__name__}:catenary_of", parallel_inside=bool(args.error_estimate))
+
+
+def catenary_of(scene: Scene, args: argparse.Namespace) -> Report:
+    """The report of one passage (or a train's) of `scene`: the command's, or a study point's."""
     from .analysis import run_scene, run_train_scene
     from .reports import report, train_report
 
-    scene = _scene(args)
     criteria = None
-    if args.quality or args.system is not None:
+    if getattr(args, "quality", False) or getattr(args, "system", None) is not None:
         from .quality import criteria_from
 
         sec = dict(scene.sections.get("quality") or {})
@@ -105,8 +112,7 @@ def cmd_catenary(args: argparse.Namespace) -> None:
         rep = train_report(run, quality=criteria)
         if args.error_estimate:
             add_estimate(rep, scene, run.stats, workers)
-        args.emit(rep, args, scene.to_dict())
-        return
+        return rep
     variants = [scene]
     if args.with_linear and scene.effects["droppers"] != "linear":
         variants.append(scene.replace(effects={"droppers": "linear"}))
@@ -117,7 +123,7 @@ def cmd_catenary(args: argparse.Namespace) -> None:
     rep = report(runs[0], scene.to_dict(), runs[1:], quality=criteria)
     if args.error_estimate:
         add_estimate(rep, scene, [runs[0].stats], workers)
-    args.emit(rep, args, scene.to_dict())
+    return rep
 
 
 def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0) -> None:

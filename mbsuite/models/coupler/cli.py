@@ -9,10 +9,11 @@ import warnings
 from functools import partial
 from pathlib import Path
 
-from ...cli.options import add_error_estimate, add_scene_options
+from ...cli.options import add_error_estimate, add_scene_options, scene_of
+from ...cli.study import add_study_options, run_or_study
 from ...errors import ParameterError, SceneError
 from ...results import Report, format_table
-from ...scenes import load_scene
+from ...scenes import Scene
 from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
 
@@ -157,9 +158,9 @@ def write_dynamics(res, out: Path) -> list[Path]:
     return [res.write_csv(out / "timeseries.csv"), save(dynamics_figure(res), out / "timeseries.png")]
 
 
-def cmd_dynamics(args: argparse.Namespace, emit) -> None:
-    """`mbsuite coupler dynamics`: a double-coupler run of a coupler scene with its statistics and health."""
-    scene = load_scene(args.scene)
+def _dynamics_scene(args: argparse.Namespace) -> Scene:
+    """The command's coupler scene with the command line's solver overrides."""
+    scene = scene_of(args.scene)
     if scene.model != "coupler":
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; coupler dynamics needs a coupler scene "
                          "('coupler' or coupler/<scene>, e.g. coupler/double_friction)")
@@ -169,15 +170,27 @@ def cmd_dynamics(args: argparse.Namespace, emit) -> None:
     if args.max_steps is not None:
         solver["max_steps"] = args.max_steps
     if solver:
-        scene = scene.replace(solver=solver)
+        scene = scene.replace(solver=solver, origin="on the command line (--engine/--allow-inaccurate/--max-steps)")
+    return scene
+
+
+def dynamics_of(scene: Scene, args: argparse.Namespace) -> Report:
+    """The double-coupler run of `scene` with its statistics and health (the command's, or a study point's)."""
     # health figures judged, the error estimate's among them (AccuracyError past a bound unless allowed)
-    res = mbsuite_run(scene, error_estimate=args.error_estimate)
+    res = mbsuite_run(scene, error_estimate=bool(getattr(args, "error_estimate", False)))
     inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
     table = dynamics_table(inputs, res)
     if res.error_estimate is not None:
         table += "\n" + res.error_estimate.table()
-    emit(Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
-                partial(write_dynamics, res)), args, scene.to_dict())
+    return Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
+                  partial(write_dynamics, res))
+
+
+def cmd_dynamics(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler dynamics`: a double-coupler run of a coupler scene with its statistics and health (or a
+    --vary study of them)."""
+    args.emit = emit
+    run_or_study(args, _dynamics_scene(args), f"{__name__}:dynamics_of")
 
 
 def register(sub, add_common, emit) -> str:
@@ -217,6 +230,7 @@ def register(sub, add_common, emit) -> str:
     p.add_argument("--engine", choices=["mujoco", "reference"], help="override the scene's engine")
     add_scene_options(p)
     add_error_estimate(p)
+    add_study_options(p)
     add_common(p)
     p.set_defaults(func=partial(cmd_dynamics, emit=emit))
     return "coupler"

@@ -14,6 +14,7 @@ from ...cli.options import (
     load,
     sweep_options,
 )
+from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError
 from ...scenes import Scene
 from .freqresp import DEFAULTS, LIMITS, METHODS, check_grid
@@ -50,6 +51,8 @@ def register(sub: argparse._SubParsersAction, add_common, emit) -> str:
 
 def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> None:
     add_common(p)
+    if name != "freqresp":
+        add_scene_options(p)
     if name == "modes":
         p.add_argument("--height", type=float,
                        help="ram height (m) to linearise at (default: the mean of the scene's input)")
@@ -63,6 +66,7 @@ def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> Non
         p.add_argument("--workers", type=int, default=0, help="parallel processes (0 = all cores)")
         add_error_estimate(p)
         add_sweep_options(p)
+    add_study_options(p)
     p.set_defaults(func=COMMAND_FUNCS[name], emit=emit)
 
 
@@ -75,17 +79,31 @@ def _scene(args: argparse.Namespace, hook: str) -> Scene:
     return scene
 
 
+# the units of the numbers the analyses report, by their names (a --vary study's table, CSV and figure)
+UNITS = {"f_n": "Hz", "f_d": "Hz", "tau": "s", "zeta": "1", "linearised_at_height_m": "m", "theta1": "rad",
+         "theta2": "rad", "thetah": "rad", "theta_e": "rad", "elbow_windup": "rad", "y_d": "m", "contact_force": "N",
+         "dtheta_e_dtheta1": "1", "mujoco": "rad", "pinocchio": "rad"}
+
+
+def equilibrium_of(scene: Scene, args: argparse.Namespace):
+    """The equilibrium report of `scene` (the command's, or a study point's)."""
+    return scene.spec.equilibrium(scene)
+
+
+def modes_of(scene: Scene, args: argparse.Namespace):
+    """The modes report of `scene`, at `--height` or at the mean of its input."""
+    height = getattr(args, "height", None)
+    return scene.spec.modes(scene, **({"height": height} if height is not None else {}))
+
+
 def cmd_equilibrium(args: argparse.Namespace) -> None:
-    """The static equilibrium of the scene in every path."""
-    scene = _scene(args, "equilibrium")
-    args.emit(scene.spec.equilibrium(scene), args, scene.to_dict())
+    """The static equilibrium of the scene in every path (or a --vary study of it)."""
+    run_or_study(args, _scene(args, "equilibrium"), f"{__name__}:equilibrium_of", units=UNITS)
 
 
 def cmd_modes(args: argparse.Namespace) -> None:
-    """The linearised modes, at `--height` or at the mean of the scene's input."""
-    scene = _scene(args, "modes")
-    kwargs = {"height": args.height} if args.height is not None else {}
-    args.emit(scene.spec.modes(scene, **kwargs), args, scene.to_dict())
+    """The linearised modes, at `--height` or at the mean of the scene's input (or a --vary study of them)."""
+    run_or_study(args, _scene(args, "modes"), f"{__name__}:modes_of", units=UNITS)
 
 
 def freq_args(args: argparse.Namespace) -> dict:
@@ -100,12 +118,16 @@ def freq_args(args: argparse.Namespace) -> dict:
             "error_estimate": bool(getattr(args, "error_estimate", False))}
 
 
+def freqresp_of(scene: Scene, args: argparse.Namespace):
+    """The frequency-response report of `scene`; its sweeps run where `--executor/--scheduler/--store/--max-points`
+    say (the time histories only when a figure is written)."""
+    return scene.spec.freqresp(scene, **freq_args(args), options=sweep_options(args),
+                               time_histories=getattr(args, "out", None) is not None)
+
+
 def cmd_freqresp(args: argparse.Namespace) -> None:
-    """The frequency response; its sweeps run where `--executor/--scheduler/--store/--max-points` say."""
-    scene = _scene(args, "freqresp")
-    report = scene.spec.freqresp(scene, **freq_args(args), options=sweep_options(args),
-                                 time_histories=getattr(args, "out", None) is not None)  # only the figure needs them
-    args.emit(report, args, scene.to_dict())
+    """The frequency response (or a --vary study of it: its points one after another, each on all workers)."""
+    run_or_study(args, _scene(args, "freqresp"), f"{__name__}:freqresp_of", units=UNITS, parallel_inside=True)
 
 
 COMMAND_FUNCS = {"equilibrium": cmd_equilibrium, "modes": cmd_modes, "freqresp": cmd_freqresp}

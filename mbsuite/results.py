@@ -75,23 +75,49 @@ class SimResult:
         df.attrs["units"] = {"t": "s", **{k: self.units.get(k, "") for k in self.signals}}
         return df
 
+    def panels(self, signals: Sequence[str] | None = None, ratio: float = 10.0) -> list[list[str]]:
+        """The signals grouped for plotting, so that no line reads as flat beside another: signals share a panel only
+        if they have one unit and the panel's range (lowest to highest value of its signals) is at most `ratio`
+        times each signal's own range, i.e. every line spans at least 1/`ratio` of its panel's height. A constant
+        signal joins a panel whose range holds its value. Signals are taken in their order (`signals`, or the
+        result's), each into the first panel it fits."""
+        names = list(signals) if signals is not None else list(self.signals)
+        lo = {k: float(np.nanmin(self.signals[k])) if np.size(self.signals[k]) else 0.0 for k in names}
+        hi = {k: float(np.nanmax(self.signals[k])) if np.size(self.signals[k]) else 0.0 for k in names}
+        groups: list[list[str]] = []
+
+        def fits(group: list[str], k: str) -> bool:
+            if self.units.get(group[0], "") != self.units.get(k, ""):
+                return False
+            members = [*group, k]
+            span = max(hi[m] for m in members) - min(lo[m] for m in members)
+            own = [hi[m] - lo[m] for m in members if hi[m] > lo[m]]
+            return span == 0.0 or (bool(own) and span <= ratio * min(own))
+
+        for k in names:
+            group = next((g for g in groups if fits(g, k)), None)
+            if group is None:
+                groups.append([k])
+            else:
+                group.append(k)
+        return groups
+
     def plot(self, signals: Sequence[str] | None = None, axes: Any = None) -> Any:
-        """Time histories, one panel per unit (signals sharing a unit share a panel). Draws on `axes` (a sequence
-        of Axes, one per unit) if given, else returns a new `matplotlib.figure.Figure`."""
+        """Time histories, one panel per group of signals of one unit whose lines each span at least a tenth of the
+        panel (`panels`), so a 100 N force does not read as a flat line beside a 9 kN one. Draws on `axes` (a
+        sequence of Axes, one per panel) if given, else returns a new `matplotlib.figure.Figure`."""
         from .plotting import figure
 
-        names = list(signals) if signals is not None else list(self.signals)
-        by_unit: dict[str, list[str]] = {}
-        for k in names:
-            by_unit.setdefault(self.units.get(k, "") or "-", []).append(k)
+        groups = self.panels(signals)
         fig = None
         if axes is None:
-            fig, axes = figure(len(by_unit), 1, size=(9.0, 1.8 + 1.9 * len(by_unit)), sharex=True, squeeze=False)
+            fig, axes = figure(len(groups), 1, size=(9.0, 1.8 + 1.7 * len(groups)), sharex=True, squeeze=False)
             axes = axes[:, 0]
-        for ax, (unit, ks) in zip(axes, by_unit.items(), strict=True):
+        for ax, ks in zip(axes, groups, strict=True):
+            unit = self.units.get(ks[0], "") or "-"
             for k in ks:
                 ax.plot(self.t, self.signals[k], lw=0.9, label=k)
-            ax.set_ylabel(f"[{unit}]")
+            ax.set_ylabel(f"{', '.join(ks) if len(ks) <= 2 else ks[0] + ', ...'} [{unit}]", fontsize=8)
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=7, loc="upper right")
         axes[-1].set_xlabel("t [s]")

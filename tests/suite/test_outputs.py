@@ -86,3 +86,19 @@ def test_catenary_negative_speed_is_blamed_on_the_command_line(capsys):
     assert main(["catenary", "--speed", "-250"]) == 2
     err = capsys.readouterr().err
     assert "--speed" in err and "command line" in err and ".toml" not in err
+
+
+def test_plot_gives_each_signal_a_panel_it_fills():
+    """`SimResult.plot()`: a ~100 N contact force does not share an axis with a ~8.7 kN cylinder force; signals of one
+    unit whose ranges are comparable (within 10x of the panel's range) share one; a constant joins a panel holding its
+    value; a small swing about a large offset gets its own (the grouping worked out by hand)."""
+    t = np.linspace(0.0, 1.0, 201)
+    wave = np.sin(2 * np.pi * 5 * t)
+    sig = {"contact_force": 100 + 100 * wave, "a": 0.5 + 0.5 * wave, "cylinder_force": 8735 + 95 * wave,
+           "b": 0.25 + 0.25 * wave, "c": np.full_like(t, 0.3), "d": 5 + 0.005 * wave}
+    units = {"contact_force": "N", "cylinder_force": "N", "a": "m", "b": "m", "c": "m", "d": "m"}
+    res = SimResult(t, sig, units, "test")
+    expected = [["contact_force"], ["a", "b", "c"], ["cylinder_force"], ["d"]]
+    assert res.panels() == expected
+    fig = res.plot()
+    assert [[line.get_label() for line in ax.get_lines()] for ax in fig.axes] == expected

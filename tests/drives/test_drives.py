@@ -271,13 +271,13 @@ def test_regression_susd_100w_switching_rate(susd_design):
 # ---- bad input -------------------------------------------------------------------------------------------------------
 def test_bad_input():
     sc = load_scene("drives/step_up_pwm")
-    with pytest.raises(ParameterError, match=r"\bJ_m = -0\.0001 is invalid"):
+    with pytest.raises(ParameterError, match=r"\bJ_m\b.* = -0\.0001 is invalid"):
         sc.replace(params={"J_m": -1e-4})
-    with pytest.raises(ParameterError, match=r"\bK = 0\.0 is invalid"):
+    with pytest.raises(ParameterError, match=r"\bK\b.* = 0\.0 is invalid"):
         sc.replace(params={"K": 0.0})
     with pytest.raises(SceneError, match="controller"):
         sc.replace(effects={"controller": "fuzzy"})
-    with pytest.raises(SceneError, match="unknown controller"):
+    with pytest.raises(SceneError, match="controller = 'energy_packet' .*does not drive mechanism 'step_up'"):
         simulate_scene(sc.replace(effects={"controller": "energy_packet"}))
     with pytest.raises(ParameterError, match="longer than"):
         simulate_scene(load_scene("drives/susd_100w_design").replace(params={"d_on": 0.2}))
@@ -293,13 +293,13 @@ def test_bad_input():
     ("tau_slope", 0.05), ("twist_tol", -0.1), ("min_motor_vel", -1.0),
 ])
 def test_bad_parameter_values_named(name, value):
-    with pytest.raises(ParameterError, match=rf"\b{name} = {value!r} is invalid; valid: "):
+    with pytest.raises(ParameterError, match=rf"\b{name}\b.* = {value!r} is invalid; valid: "):
         load_scene("drives/susd_100w_design").replace(params={name: value})
 
 
 def test_non_finite_parameter_named_by_the_scene_loader():
-    # the scene loader refuses a non-finite number before the parameters are built (SceneError naming it)
-    with pytest.raises(SceneError, match="Kp"):
+    # a non-finite number is refused when the scene is built, naming the parameter
+    with pytest.raises((SceneError, ParameterError), match="Kp"):
         load_scene("drives/susd_100w_design").replace(params={"Kp": float("nan")})
 
 

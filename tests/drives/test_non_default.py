@@ -121,8 +121,8 @@ SD_PARAMS.update(tau_0=7.0, tau_slope=-0.03, d_on=0.003, d_off=0.005, fs=1250.0,
 def susd_moved():
     out = {}
     for eng in ("reference", "mujoco"):
-        sc = load_scene("drives/susd_100w_design").replace(
-            params=SD_PARAMS, input={"value": -400.0},
+        sc = load_scene("drives/susd_100w_design").replace(  # open loop: the PI gains are not read (config.py)
+            params={k: v for k, v in SD_PARAMS.items() if k not in ("Kp", "Ki")}, input={"value": -400.0},
             solver={"duration": 0.6, "t_settle": 0.0, "engine": eng, "timestep": 2e-5})
         out[eng] = simulate_scene(sc)
     return out

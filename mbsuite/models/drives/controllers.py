@@ -95,10 +95,13 @@ class StepUpController:
         self.tki = self.tli = self.tci = self.tni = 0
         self.tccount = -1
         self.c_on = 0
-        if self.max_tk is None:
+        # each count only where the scheme reads it (`config.used_params`): t_l not by motor-resonant switching, t_n
+        # not by PWM
+        if self.max_tk is None and self.kind != "motor_resonant":
             self.max_tk = 0.5 * self.t_l
-        self.tlcount = time_to_samples(self.t_l, self.fs, "nearest", "cycle time t_l")
-        self.tncount = time_to_samples(self.t_n, self.fs, "nearest", "dead time t_n")
+        self.tlcount = (time_to_samples(self.t_l, self.fs, "nearest", "cycle time t_l")
+                        if self.kind != "motor_resonant" else 0)
+        self.tncount = time_to_samples(self.t_n, self.fs, "nearest", "dead time t_n") if self.kind != "pwm" else 0
 
     def _loiter(self, q: np.ndarray, w: np.ndarray) -> int:
         if not self.clutch_matching:

@@ -104,7 +104,7 @@ def build_controller(mechanism: str, kind: str, p: Mapping[str, Any], effects: M
         if kind not in ("pwm", "resonant", "motor_resonant"):
             raise SceneError(f"unknown controller {kind!r} for the step-up drive; valid: "
                              "['pwm', 'resonant', 'motor_resonant']")
-        if delays and p["d_on"] >= p["t_l"]:
+        if delays and kind != "motor_resonant" and p["d_on"] >= p["t_l"]:
             raise ParameterError(f"delay {p['d_on']} s is longer than the PWM cycle t_l = {p['t_l']} s")
         # the transfer ends when the twist falls below twist_tol; the friction on the spring end and the load holds a
         # static twist (C_s + C_l)/K, so a smaller twist_tol is never reached and the transfer never ends

@@ -19,6 +19,7 @@ from . import coupled_clutches as cc
 from . import drive, msl
 from .accuracy import window_efficiency
 from .commands import Controller
+from .config import check_scene
 from .rotor_system import RefResult, RotorSystem
 
 SIGNALS = {
@@ -98,6 +99,8 @@ def setup(scene: Scene) -> RunSetup:
     eff = dict(scene.effects)
     mech = eff["mechanism"]
     sv = scene.solver
+    if mech not in ("step_up", "step_up_down"):
+        check_scene(scene, None)
     if mech in msl.EXAMPLES:
         ex = msl.example(mech)
         return RunSetup(ex.system, *_initial(ex.q0, ex.w0), None, sv.sample_dt or 5e-4, f"drive_{mech}")
@@ -105,19 +108,11 @@ def setup(scene: Scene) -> RunSetup:
         system = cc.build_system()
         return RunSetup(system, *_initial(cc.Q0, cc.W0), None, sv.sample_dt or 5e-4, "coupled_clutches")
     p = scene.build_params().resolved(eff["param_set"])
+    check_scene(scene, p)  # nothing set that the configuration does not read, nothing it reads missing
     system = drive.build_system(mech, p, eff)
     ref = reference_signal(dict(scene.input), p["ref"] or 0.0)
     kind = eff["controller"]
-    if kind == "none":
-        raise SceneError(f"mechanism {mech!r} needs a controller; valid: pwm, resonant, motor_resonant, energy_packet")
     ctrl = drive.build_controller(mech, kind, p, eff, ref=ref)
-    if mech == "step_up" and callable(ref):
-        raise SceneError("the step-up drive takes a constant reference (input.value)")
-    if mech == "step_up" and not eff.get("closed_loop", False) and "value" in scene.input:
-        # open loop the step-up controllers switch on duty x t_l, t_n or the motor speed band: no reference acts
-        raise SceneError(f"input.value = {scene.input['value']!r} rad/s has no effect on the open-loop step-up drive "
-                         f"(controller {kind!r} switches on its duty/timing parameters); leave input.value out, or "
-                         f"set effects.closed_loop = true for the PI on t_k to track it")
     if mech == "step_up" and not callable(ref):
         ctrl.ref = ref
     dt_c = 1.0 / p["fs"]

@@ -73,3 +73,18 @@ def test_readme_lists_every_parameter():
     readme = (Path(__file__).parents[2] / "mbsuite" / "models" / "drives" / "README.md").read_text()
     for key, *_ in limits_table(DriveParams):
         assert f"| `{key}` |" in readme, key
+
+
+def test_drive_run_writes_what_mbsuite_run_writes(tmp_path):
+    """`drive run --out` and `mbsuite run --out` name the same data alike (run.csv, one writer): the same scene gives
+    the same file byte for byte; the drive command's summary.json holds the scene as run and its options."""
+    import json
+
+    scene = tmp_path / "short.toml"
+    text = (Path(__file__).parents[2] / "mbsuite/models/drives/scenes/step_up_pwm.toml").read_text()
+    scene.write_text(text.replace("duration = 6.0", "duration = 0.3").replace("t_settle = 3.0", "t_settle = 0.1"))
+    assert main(["drive", "run", str(scene), "--out", str(tmp_path / "a")]) == 0
+    assert main(["run", str(scene), "--out", str(tmp_path / "b")]) == 0
+    assert (tmp_path / "a" / "run.csv").read_bytes() == (tmp_path / "b" / "run.csv").read_bytes()
+    s = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert s["scene"]["solver"]["duration"] == 0.3 and s["results"]["options"]["--error-estimate"] is False

@@ -396,13 +396,14 @@ def run_cmd(emit, a: argparse.Namespace) -> None:
         table += "\n\n" + res.error_estimate.table()
     if res.warnings:
         table += "\n\n" + "\n".join(res.warnings)
-    rep = Report({"summary": res.summary(), "stats": res.stats}, table, partial(_write_run, res))
+    rep = Report({"options": _options(a), "summary": res.summary(), "stats": res.stats}, table,
+                 partial(_write_run, res))
     emit(rep, a, sc.to_dict())
 
 
 def _write_run(res, out: Path) -> list[Path]:
-    """The files of `drive run --out`: the time series and the run figure."""
-    return [res.write_csv(Path(out) / "timeseries.csv"), save(run_figure(res), Path(out) / "run.png")]
+    """The files of `drive run --out`: the time series (run.csv, as `mbsuite run --out`) and the run figure."""
+    return [res.write_csv(Path(out) / "run.csv"), save(run_figure(res), Path(out) / "run.png")]
 
 
 def efficiency_cmd(emit, a: argparse.Namespace) -> None:
@@ -410,7 +411,9 @@ def efficiency_cmd(emit, a: argparse.Namespace) -> None:
     _check_options(a, "--loads")
     sc = _scene(a)
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
-    emit(efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate), a, sc.to_dict())
+    rep = efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate)
+    rep.data = {"options": _options(a), **rep.data}
+    emit(rep, a, sc.to_dict())
 
 
 def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
@@ -452,7 +455,8 @@ def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
                                         (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
     ref = cc.load_reference()
     write = partial(_write_coupled_clutches, d, ref["t"], ref["w"], ev_cols, w_cols)
-    emit(Report(d, "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2 + estimates, write), a, None)
+    text = "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2 + estimates
+    emit(Report({"options": _options(a), **d}, text, write), a, scene.to_dict())
 
 
 def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,
@@ -462,6 +466,14 @@ def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_co
     return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
             write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),
             save(fig, Path(out) / "coupled_clutches.png")]
+
+
+def _options(a: argparse.Namespace) -> dict:
+    """The options of a scene command as given (`--loads`, `--engine`, `--duration`, `--timestep`,
+    `--error-estimate`, `--allow-inaccurate`, `--max-steps`; None: not given): with the scene, what reruns it."""
+    return {flag: getattr(a, flag[2:].replace("-", "_")) for flag in (
+        "--loads", "--engine", "--duration", "--timestep", "--error-estimate", "--allow-inaccurate",
+        "--max-steps") if hasattr(a, flag[2:].replace("-", "_"))}
 
 
 def _e(x: float | None) -> str:

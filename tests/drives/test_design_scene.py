@@ -104,3 +104,22 @@ def test_designed_drive_keeps_its_promise(tmp_path):
     cyc = res.stats["cycles"]
     assert cyc["mean_load_speed"] == pytest.approx(300.0, rel=0.03)
     assert 15.0 <= cyc["switching_rate"] <= sc.sections["design"]["derived"]["Sr_max"]
+
+
+def test_design_takes_any_real_number_type():
+    """numpy scalars, 0-d arrays and Fractions give what the same values as floats give; a string, bool or complex
+    is a ParameterError naming the input."""
+    from fractions import Fraction
+
+    from mbsuite.models.drives import design as D
+
+    want = design_scene(DesignInputs(P=200.0, Sr_min=15.0, w_max=400.0, V_m=100.0, tau_c=8.0))
+    got = design_scene(DesignInputs(P=np.float32(200), Sr_min=np.int64(15), w_max=np.array(400.0),
+                                    V_m=Fraction(100), tau_c=np.float64(8)))
+    assert got == want
+    assert D.srmin(np.float32(500), np.int64(50), Fraction(5), np.array(0.1)) == D.srmin(500.0, 50.0, 5.0, 0.1)
+    kp, ki = D.gains(np.float32(0.0023), Fraction(1, 14), np.float64(2.5e-4), np.float32(0.15), np.int64(400))
+    assert type(kp) is float and ki == pytest.approx(0.0023 * 14 / 2, rel=1e-6)
+    for bad in ("200", True, 1 + 2j, np.array([1.0, 2.0])):
+        with pytest.raises(ParameterError, match="P must be a real number"):
+            D.srmin(bad, 1.0, 1.0, 1.0)

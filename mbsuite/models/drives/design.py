@@ -12,8 +12,11 @@ For w_l < V_m the residual extension (5.8) is clamped at x_s = 0 ([DERIVED]; rep
 
 from __future__ import annotations
 
+import decimal
 import math
+import numbers
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq
@@ -21,10 +24,21 @@ from scipy.optimize import brentq
 from ...errors import ParameterError
 
 
-def _pos(name: str, v: float) -> float:
-    if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
-        raise ParameterError(f"{name} must be a positive number, got {v!r}")
+def _real(name: str, v: Any) -> float:
+    """`v` as a float: any real number (int, float, numpy scalar or 0-d array, Fraction, Decimal); a bool, string,
+    complex or array is a ParameterError naming `name`."""
+    if isinstance(v, np.ndarray) and v.ndim == 0:
+        v = v[()]
+    if isinstance(v, bool | np.bool_) or not isinstance(v, numbers.Real | decimal.Decimal):
+        raise ParameterError(f"{name} must be a real number, got {v!r}")
     return float(v)
+
+
+def _pos(name: str, v: Any) -> float:
+    x = _real(name, v)
+    if not (math.isfinite(x) and x > 0):
+        raise ParameterError(f"{name} must be a positive number, got {v!r}")
+    return x
 
 
 def srmin(P: float, w_min: float, w_rip: float, J_l: float) -> float:
@@ -100,9 +114,10 @@ class Design:
 
 def design_point(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, J_s: float) -> Design:
     """One CADJS point: K at (w_min, Sr_min) (5.11), Sr_max at w_max (5.13), x_max (5.9) and tau_c = K x_max (5.10)."""
-    for nm, v in (("P", P), ("Sr_min", Sr_min), ("w_max", w_max), ("V_m", V_m), ("J_s", J_s)):
-        _pos(nm, v)
-    if not (isinstance(w_min, int | float) and math.isfinite(w_min) and w_min >= 0):
+    P, Sr_min, w_max, V_m, J_s = (_pos(nm, v) for nm, v in (("P", P), ("Sr_min", Sr_min), ("w_max", w_max),
+                                                              ("V_m", V_m), ("J_s", J_s)))
+    w_min = _real("w_min", w_min)
+    if not (math.isfinite(w_min) and w_min >= 0):
         raise ParameterError(f"w_min must be a number >= 0, got {w_min!r}")
     if not w_min < w_max:
         raise ParameterError(f"w_min = {w_min:g} rad/s must be below w_max = {w_max:g} rad/s (the load speed range)")
@@ -140,11 +155,9 @@ def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = S
     to (5.20)). The thesis prints no material data. The defaults are not a material: E = 209 GPa is implied by the
     Table 6.3 spring ([DERIVED]) and sigma_uts = 1.465 GPa is a *calibration*, backed out of the recommended volume
     1.58e-4 m^3 for the 100 W design (Sec. 6.3) - so that volume is reproduced by construction, not predicted."""
-    _pos("K", K)
-    _pos("x_max", x_max)
-    _pos("sigma_uts", sigma_uts)
-    _pos("E", E)
-    _pos("U", U)
+    K, x_max, sigma_uts, E, U = (_pos(nm, v) for nm, v in (("K", K), ("x_max", x_max), ("sigma_uts", sigma_uts),
+                                                           ("E", E), ("U", U)))
+    fatigue = _real("fatigue factor", fatigue)
     if not 0 < fatigue <= 1:
         raise ParameterError(f"fatigue factor must be in (0, 1], got {fatigue!r}")
     sf = fatigue * sigma_uts
@@ -159,15 +172,16 @@ def _plant_args(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float)
     _pos("J_l", J_l)
     _pos("t_s", t_s)
     for nm, v in (("B_total", B_total), ("tau_l", tau_l)):
-        if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+        if not (math.isfinite(_real(nm, v)) and v >= 0):
             raise ParameterError(f"{nm} must be a number >= 0, got {v!r}")
-    if not (isinstance(w0, int | float) and math.isfinite(w0) and w0 != 0):
+    if not (math.isfinite(_real("w0", w0)) and w0 != 0):
         raise ParameterError(f"w0 (operating speed) must be a nonzero number, got {w0!r}")
 
 
 def plant_AB(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tuple[float, float]:
     """Eq 5.25: G(z) = A / (z - 1 + B), A = 2/J_l, B = t_s/J_l (2 B_total + tau_l / x0^(1/2)), x0 = w0^2."""
     _plant_args(J_l, t_s, B_total, tau_l, w0)
+    J_l, t_s, B_total, tau_l, w0 = (float(x) for x in (J_l, t_s, B_total, tau_l, w0))
     return 2.0 / J_l, t_s / J_l * (2 * B_total + tau_l / abs(w0))
 
 
@@ -176,6 +190,7 @@ def gains(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tu
     K_I = J_l / (2 t_s) keeping the other pole on the positive real axis. A non-positive K_p (dissipation per cycle
     above the load's kinetic energy: open loop unstable, (5.27)) is an error."""
     _plant_args(J_l, t_s, B_total, tau_l, w0)
+    J_l, t_s, B_total, tau_l, w0 = (float(x) for x in (J_l, t_s, B_total, tau_l, w0))
     kp = J_l / 2 - t_s * (B_total + tau_l / (2 * abs(w0)))
     if kp <= 0:
         raise ParameterError(f"no positive K_p: t_s (B_total + tau_l/(2|w0|)) = {J_l / 2 - kp:.4g} >= J_l/2 = "

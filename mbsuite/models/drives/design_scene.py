@@ -56,11 +56,13 @@ class DesignInputs:
     t_settle: float | None = None  # s: start of the statistics window (default duration / 2)
 
     def __post_init__(self) -> None:
+        # any real number type (numpy scalars, 0-d arrays, Fraction) is stored as the float it holds
         for nm in ("P", "Sr_min", "w_max", "V_m", "duration"):
-            D._pos(nm, getattr(self, nm))
+            object.__setattr__(self, nm, D._pos(nm, getattr(self, nm)))
+        object.__setattr__(self, "w_min", D._real("w_min", self.w_min))
         for nm in ("tau_c", "J_s", "J_l", "w_op", "tau_l", "P_motor", "t_settle"):
             if getattr(self, nm) is not None:
-                D._pos(nm, getattr(self, nm))
+                object.__setattr__(self, nm, D._pos(nm, getattr(self, nm)))
         if (self.tau_c is None) == (self.J_s is None):
             raise ParameterError(f"a design point needs exactly one of tau_c (clutch torque) and J_s (spring-system "
                                  f"inertia); got tau_c = {self.tau_c!r}, J_s = {self.J_s!r}")

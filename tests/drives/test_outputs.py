@@ -88,3 +88,23 @@ def test_drive_run_writes_what_mbsuite_run_writes(tmp_path):
     assert (tmp_path / "a" / "run.csv").read_bytes() == (tmp_path / "b" / "run.csv").read_bytes()
     s = json.loads((tmp_path / "a" / "summary.json").read_text())
     assert s["scene"]["solver"]["duration"] == 0.3 and s["results"]["options"]["--error-estimate"] is False
+
+
+def test_drive_run_study_point_is_the_single_run(tmp_path, capsys):
+    """`drive run --vary params.duty=0.3,0.5` (the sweep's machinery) gives at duty 0.3 what `drive run --set
+    params.duty=0.3` gives (another route: one scene changed on the command line), and writes study.csv/png."""
+    import json
+
+    base = ["drive", "run", "drives/step_up_pwm", "--duration", "0.4"]
+    assert main([*base, "--vary", "params.duty=0.3,0.5", "--workers", "1", "--json", "--out", str(tmp_path)]) == 0
+    study = json.loads(capsys.readouterr().out)
+    assert main([*base, "--set", "params.duty=0.3", "--json"]) == 0
+    one = json.loads(capsys.readouterr().out)
+    (point,) = [p for p in study["points"] if p["values"]["params.duty"] == 0.3]
+    want = one["stats"]["cycles"]["mean_load_speed"]
+    assert point["results"]["stats.cycles.mean_load_speed"] == want
+    other = [p for p in study["points"] if p["values"]["params.duty"] == 0.5][0]
+    assert other["results"]["stats.cycles.mean_load_speed"] != want  # the axis acts
+    assert (tmp_path / "study.csv").stat().st_size > 0 and (tmp_path / "study.png").stat().st_size > 10_000
+    assert main([*base, "--set", "params.t_n=0.03"]) == 2  # PWM reads no dead time: refused, not ignored
+    assert "t_n" in capsys.readouterr().err

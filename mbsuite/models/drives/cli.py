@@ -12,6 +12,7 @@ import numpy as np
 
 from ...analysis.errorestimate import error_estimate
 from ...cli.options import add_error_estimate, add_scene_options
+from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError, SceneError
 from ...health import judge
 from ...limits import Limit
@@ -26,12 +27,20 @@ from .design_scene import BASE_SETS, DesignInputs, design_scene, scene_toml
 from .plots import cadjs_figure, coupled_clutches_figure, loss_label, run_figure
 from .scene_run import sim_result
 
+#: the commands `register` adds (read by the command line's light parser without importing the model)
+CLI_COMMANDS = {"drive": "switched-mode drives: design tools, runs, efficiency, CoupledClutches",
+                "drives": "switched-mode drives (as `mbsuite drive`)"}
+
 #: names and units of the cycle statistics of a drive run (`drive.cycle_stats`)
 CYCLE_QUANTITIES = {"n_cycles": ("energy cycles in the window t >= t_settle", ""),
                     "switching_rate": ("switching rate Sr (energy cycles per second)", "1/s"),
                     "mean_load_speed": ("mean load speed", "rad/s"), "mean_motor_speed": ("mean motor speed", "rad/s"),
                     "max_extension": ("largest spring twist", "rad"),
                     "efficiency": ("efficiency E_out / E_in over t >= t_settle", "1")}
+
+#: the units of a `--vary` study's quantities by their last name (`mbsuite.cli.study`)
+STUDY_UNITS = {**{k: u for k, (_, u) in CYCLE_QUANTITIES.items()}, "input": "J", "output": "J", "stored": "J",
+               "residual": "J", "relative": "1", "duration": "s", "P_in": "W", "P_out": "W"}
 
 #: most time steps of `drive coupled-clutches` (scene runs are guarded by the scene's solver.max_steps)
 MAX_STEPS = DEFAULT_MAX_STEPS
@@ -224,6 +233,7 @@ def register(sub, add_common, emit) -> str:
     q.add_argument("--duration", type=float)
     add_scene_options(q)
     add_error_estimate(q)
+    add_study_options(q)
     add_common(q)
     q.set_defaults(func=partial(run_cmd, emit))
 
@@ -234,6 +244,7 @@ def register(sub, add_common, emit) -> str:
     q.add_argument("--duration", type=float)
     add_scene_options(q)
     add_error_estimate(q)
+    add_study_options(q)
     add_common(q)
     q.set_defaults(func=partial(efficiency_cmd, emit))
 
@@ -371,9 +382,15 @@ def gains_cmd(emit, a: argparse.Namespace) -> None:
 
 
 def run_cmd(emit, a: argparse.Namespace) -> None:
-    """`drive run`: a scene on its path with cycle statistics, energy balance and lock events; health figures judged
-    as by `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
-    sc = _scene(a)
+    """`drive run`: a scene on its path with cycle statistics, energy balance and lock events (`run_of`); with
+    `--vary` a study of them over a grid (`mbsuite.cli.study`)."""
+    a.emit = emit
+    run_or_study(a, _scene(a), f"{__name__}:run_of", units=STUDY_UNITS)
+
+
+def run_of(sc, a: argparse.Namespace) -> Report:
+    """The report of `drive run` on scene `sc` (the command's, or a study point's): health figures judged as by
+    `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
     res = sim_result(sc, *simulate_scene(sc))
     if a.error_estimate:
         res.error_estimate = error_estimate(sc, base=accuracy.values(sc, res))
@@ -396,9 +413,8 @@ def run_cmd(emit, a: argparse.Namespace) -> None:
         table += "\n\n" + res.error_estimate.table()
     if res.warnings:
         table += "\n\n" + "\n".join(res.warnings)
-    rep = Report({"options": _options(a), "summary": res.summary(), "stats": res.stats}, table,
-                 partial(_write_run, res))
-    emit(rep, a, sc.to_dict())
+    summary = {k: v for k, v in res.summary().items() if k not in ("stats", "input", "solver")}  # once, not twice
+    return Report({"options": _options(a), "summary": summary, "stats": res.stats}, table, partial(_write_run, res))
 
 
 def _write_run(res, out: Path) -> list[Path]:
@@ -407,13 +423,18 @@ def _write_run(res, out: Path) -> list[Path]:
 
 
 def efficiency_cmd(emit, a: argparse.Namespace) -> None:
-    """`drive efficiency`: open-loop efficiency over load torques (`analysis.efficiency`)."""
+    """`drive efficiency`: open-loop efficiency over load torques (`efficiency_of`); with `--vary` a study."""
     _check_options(a, "--loads")
-    sc = _scene(a)
+    a.emit = emit
+    run_or_study(a, _scene(a), f"{__name__}:efficiency_of", units=STUDY_UNITS)
+
+
+def efficiency_of(sc, a: argparse.Namespace) -> Report:
+    """The report of `drive efficiency` on scene `sc` (`analysis.efficiency`)."""
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
     rep = efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate)
     rep.data = {"options": _options(a), **rep.data}
-    emit(rep, a, sc.to_dict())
+    return rep
 
 
 def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:

@@ -1,5 +1,5 @@
-"""The generic commands: `list`, `run`, `view`, `workprecision`, `hardcases`, `perturb`. Each reads its options,
-calls the suite's API and hands the result to `emit`; none of them does physics."""
+"""The generic commands: `list`, `run`, `view`, `render`, `workprecision`, `hardcases`, `perturb`. Each reads its
+options, calls the suite's API and hands the result to `emit`; none of them does physics."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import argparse
 import math
 import os
 import sys
+from pathlib import Path
 
 from .. import registry
 from ..errors import MbsuiteError
@@ -14,13 +15,14 @@ from ..results import Report, format_table
 from ..scenes import load_scene
 from .options import MAX_REPEATS, load, scene_of
 from .output import emit, wrap
+from .study import apply_sets
 
-ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view")
+ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view", "render")
 
 
 def analyses(spec: registry.ModelSpec, group: str | None) -> list[str]:
     """The analyses a model offers: the generic hooks it implements, its own command group, the suite's studies."""
-    hooks = {"run": spec.paths or None, "view": spec.mujoco_model}
+    hooks = {"run": spec.paths or None, "view": spec.mujoco_model, "render": spec.mujoco_model}
     out = [a for a in ANALYSES if (hooks[a] if a in hooks else getattr(spec, a)) is not None]
     if spec.paths:
         out += ["sweep", "perturb"]
@@ -57,7 +59,7 @@ def cmd_run(args: argparse.Namespace) -> None:
     """`mbsuite run SCENE`: the scene's time simulation on its path (health judged by `mbsuite.run`)."""
     from .. import run
 
-    scene = load(args)
+    scene = apply_sets(load(args), args.set_values)
     emit(run(scene, error_estimate=args.error_estimate).report(), args, scene.to_dict())
 
 
@@ -73,6 +75,43 @@ def cmd_view(args: argparse.Namespace) -> None:
 
     model, data = scene.spec.mujoco_model(scene)
     mujoco.viewer.launch(model, data)
+
+
+def cmd_render(args: argparse.Namespace) -> None:
+    """`mbsuite render SCENE --out PNG`: the scene's MuJoCo model in its initial state, rendered offscreen (EGL unless
+    MUJOCO_GL says otherwise; no display needed) from its first camera, else MuJoCo's free camera, to a PNG."""
+    os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported: it picks its GL backend once
+    path = Path(args.image)
+    if path.suffix.lower() != ".png":
+        raise MbsuiteError(f"--out {args.image}: give a .png file")
+    for flag, v in (("--width", args.width), ("--height", args.height)):
+        if not 16 <= v <= 8192:
+            raise MbsuiteError(f"{flag} {v} is invalid; valid: integer in [16, 8192] (pixels)")
+    scene = apply_sets(load(args), args.set_values)
+    if scene.spec.mujoco_model is None:
+        raise MbsuiteError(f"model '{scene.model}' has no MuJoCo model to render")
+    import mujoco
+
+    model, data = scene.spec.mujoco_model(scene)
+    mujoco.mj_forward(model, data)
+    model.vis.global_.offwidth = max(model.vis.global_.offwidth, args.width)
+    model.vis.global_.offheight = max(model.vis.global_.offheight, args.height)
+    try:
+        with mujoco.Renderer(model, args.height, args.width) as renderer:
+            renderer.update_scene(data, camera=0 if model.ncam else -1)
+            image = renderer.render()
+    except Exception as exc:  # no GL context: say how to get one
+        raise MbsuiteError(f"offscreen rendering failed ({type(exc).__name__}: {exc}); MUJOCO_GL="
+                           f"{os.environ.get('MUJOCO_GL')!r}: set MUJOCO_GL=egl (GPU or software EGL) or osmesa "
+                           "before mbsuite starts") from exc
+    from matplotlib.image import imsave
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    imsave(path, image)
+    data_out = {"scene": scene.name, "model": scene.model, "image": str(path), "width": args.width,
+                "height": args.height, "camera": model.camera(0).name if model.ncam else "free"}
+    emit(Report(data_out, f"wrote {path} ({args.width} x {args.height}, camera {data_out['camera'] or 0})"), args,
+         None)
 
 
 def print_progress(msg: str) -> None:

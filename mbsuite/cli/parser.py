@@ -18,7 +18,7 @@ from .options import SCENE_HELP, add_error_estimate, add_scene_options, add_swee
 from .output import add_common, emit
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
-GENERIC = ("list", "run", "view", "sweep", "workprecision", "perturb", "hardcases")
+GENERIC = ("list", "run", "view", "render", "sweep", "workprecision", "perturb", "hardcases")
 
 
 def deferred(module: str, name: str) -> Callable:
@@ -109,7 +109,8 @@ def parser_for(argv: list[str]) -> argparse.ArgumentParser:
 
 
 def add_generic_commands(sub: argparse._SubParsersAction) -> None:
-    """`list`, `run`, `view`, `sweep`, `workprecision`, `perturb`, `hardcases`: commands every model's scenes take."""
+    """`list`, `run`, `view`, `render`, `sweep`, `workprecision`, `perturb`, `hardcases`: commands every model's scenes
+    take."""
     p = sub.add_parser("list", help="models, their paths and their shipped scenes")
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_list"))
@@ -120,12 +121,24 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     add_scene_options(p)
     p.add_argument("--engine", metavar="PATH",
                    help="override the scene's path: a key or label of the model's path table (mbsuite list)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
+                   help="change one value of the scene, e.g. params.mh=14 (repeatable; a comma list sets a list)")
     add_error_estimate(p)
     p.set_defaults(func=deferred(".commands", "cmd_run"))
 
     p = sub.add_parser("view", help="open MuJoCo's viewer on a scene's model, its effects active")
     p.add_argument("scene", help=SCENE_HELP)
     p.set_defaults(func=deferred(".commands", "cmd_view"))
+
+    p = sub.add_parser("render", help="render a scene's MuJoCo model offscreen to a PNG (headless: MUJOCO_GL=egl)")
+    p.add_argument("scene", help=SCENE_HELP)
+    p.add_argument("--out", dest="image", metavar="PNG", required=True, help="the image file to write (.png)")
+    p.add_argument("--width", type=int, default=640, help="pixels (default 640)")
+    p.add_argument("--height", type=int, default=480, help="pixels (default 480)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
+                   help="change one value of the scene, e.g. params.mh=14 (repeatable)")
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    p.set_defaults(func=deferred(".commands", "cmd_render"))
 
     p = sub.add_parser("sweep", help="parameter study: run a scene over a grid of inputs/parameters/settings")
     p.add_argument("scene", help=SCENE_HELP)

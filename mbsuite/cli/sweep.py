@@ -27,7 +27,7 @@ def grid_axes(vary: list[str] | None, max_points: int) -> list[tuple[str, str, l
         section, dot, name = key.partition(".")
         if not sep or not dot or section not in SECTIONS:
             raise MbsuiteError(f"--vary {spec!r}: expected SECTION.KEY=VALUES with SECTION in input, params, solver, "
-                               "effects (e.g. input.frequency=1:30:0.5 or params.k_s=1e5,2e5)")
+                               "effects (e.g. input.frequency=1:30:0.5 or params.ks=1e5,2e5)")
         axes.append((section, name, parse_values(vals, max_points=max_points)))
     if not axes:
         raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")

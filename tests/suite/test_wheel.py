@@ -1,5 +1,6 @@
 """The package works outside the checkout: build the wheel from the tracked files, install it into a fresh venv in a
-temporary directory, and there run a short scene of every model and load every shipped model file in both engines.
+temporary directory, and there run a short scene of every model and load every shipped model file in both engines,
+and (slow) every command of the command line, each with small arguments (`COMMANDS`, which names every command).
 
 The fresh venv gets mbsuite from the wheel only (`pip install --no-deps`); its third-party dependencies are made
 visible from the test's own environment through a `.pth` file (after the venv's own packages), so the test needs no
@@ -8,6 +9,7 @@ network and checks exactly what the wheel carries (model files, scenes, C source
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import shutil
@@ -54,8 +56,83 @@ def _tracked_copy(dest: Path) -> Path:
     return dest
 
 
-@pytest.mark.skipif(shutil.which("git") is None or not (ROOT / ".git").exists(), reason="needs the git checkout")
-def test_wheel_installs_and_runs_every_model_outside_the_checkout(tmp_path):
+NEEDS_GIT = pytest.mark.skipif(shutil.which("git") is None or not (ROOT / ".git").exists(),
+                               reason="needs the git checkout")
+
+# every command of the command line with small arguments: (argv, the exit status it must give without a display)
+COMMANDS = [
+    (["list", "--json"], 0),
+    (["run", "iftomm/fourbar", "--json"], 0),
+    (["view", "pantograph"], 2),  # no display here: the one-line message that points to offscreen rendering
+    (["render", "iftomm/fourbar", "--out", "fourbar.png", "--width", "64", "--height", "48"], 0),
+    (["sweep", "iftomm/fourbar", "--vary", "solver.duration=0.2,0.3", "--workers", "1", "--json"], 0),
+    (["workprecision", "drives/coupled_clutches", "--quick", "--repeats", "1", "--json"], 0),
+    (["perturb", "iftomm/fourbar", "--duration", "0.2", "--eps", "1e-9", "--draws", "1", "--json"], 0),
+    (["hardcases", "--json"], 0),
+    (["catenary", "--json"], 0),
+    (["coupler", "jacobian", "--json"], 0),
+    (["coupler", "fpp", "--n", "24", "--json"], 0),
+    (["coupler", "criteria", "--quick", "--json"], 0),
+    (["coupler", "dynamics", "--json"], 0),
+    (["drive", "design", "tables", "--json"], 0),
+    (["drive", "design", "srmin", "--P", "500", "--wmin", "100", "--wrip", "10", "--Jl", "0.1", "--json"], 0),
+    (["drive", "design", "cadjs", "--P", "200", "--srmin", "15", "--wmax", "400", "--vm", "100", "--tau-c", "8",
+      "--json"], 0),
+    (["drive", "design", "springsz", "--K", "100", "--xmax", "0.5", "--json"], 0),
+    (["drive", "design", "gains", "--Jl", "0.1", "--ts", "0.5", "--taul", "1", "--w0", "300", "--P", "500", "--json"],
+     0),
+    (["drive", "run", "drives/coupled_clutches", "--json"], 0),
+    (["drive", "efficiency", "drives/step_up_efficiency", "--loads", "0.1", "--duration", "0.5", "--json"], 0),
+    (["drive", "coupled-clutches", "--json"], 0),
+    (["pantograph", "equilibrium", "--json"], 0),
+    (["pantograph", "modes", "--json"], 0),
+    (["pantograph", "freqresp", "--methods", "linear", "--f-min", "1", "--f-max", "3", "--df", "1", "--json"], 0),
+    (["equilibrium", "pantograph", "--json"], 0),
+    (["modes", "pantograph", "--json"], 0),
+    (["freqresp", "pantograph", "--methods", "linear", "--f-min", "1", "--f-max", "3", "--df", "1", "--json"], 0),
+]
+
+PROBE_CLI = r"""
+import contextlib, io, json, sys
+from mbsuite.cli import main
+out = []
+for argv in json.loads(sys.argv[1]):
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        code = main(argv)
+    out.append({"argv": argv, "code": code, "err": err.getvalue()[-500:]})
+print(json.dumps(out))
+"""
+
+
+def _leaves(parser: argparse.ArgumentParser, prefix: tuple[str, ...] = ()) -> set[tuple[str, ...]]:
+    """Every command of a parser as the words that name it (`("coupler", "fpp")`)."""
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not subs:
+        return {prefix}
+    out: set[tuple[str, ...]] = set()
+    seen: set[int] = set()
+    for name, sub in subs[0].choices.items():
+        if id(sub) not in seen:  # an alias is the same parser
+            seen.add(id(sub))
+            out |= _leaves(sub, (*prefix, name))
+    return out
+
+
+def test_the_wheel_commands_name_every_command():
+    """`COMMANDS` (what the wheel test runs) holds every command the command line has: a new command is run too."""
+    from mbsuite.cli.parser import build_parser
+
+    leaves = _leaves(build_parser())
+    named = {leaf for leaf in leaves if any(tuple(argv[:len(leaf)]) == leaf for argv, _ in COMMANDS)}
+    assert named == leaves, sorted(leaves - named)
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> tuple[Path, Path, Path, dict]:
+    """The wheel built from the tracked files and installed into a fresh venv: (python, site-packages, a working
+    directory outside the checkout, the environment to run in)."""
+    tmp_path = tmp_path_factory.mktemp("wheel")
     src = _tracked_copy(tmp_path / "src")
     build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "-w", str(tmp_path / "dist")],
                            capture_output=True, text=True, timeout=600)
@@ -80,6 +157,13 @@ def test_wheel_installs_and_runs_every_model_outside_the_checkout(tmp_path):
     work = tmp_path / "elsewhere"
     work.mkdir()
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "MBSUITE_MODELS_DIR")}
+    return py, site, work, env
+
+
+@NEEDS_GIT
+def test_wheel_installs_and_runs_every_model_outside_the_checkout(installed):
+    py, site, work, env = installed
+    env_dir = py.parent.parent
     run = subprocess.run([str(py), "-c", PROBE], cwd=work, capture_output=True, text=True, timeout=900, env=env)
     assert run.returncode == 0, run.stderr[-3000:]
     out = json.loads(run.stdout.strip().splitlines()[-1])
@@ -94,3 +178,19 @@ def test_wheel_installs_and_runs_every_model_outside_the_checkout(tmp_path):
     cli = subprocess.run([str(env_dir / "bin" / "python"), "-m", "mbsuite.cli", "run", "iftomm/fourbar", "--json"],
                          cwd=work, capture_output=True, text=True, timeout=300, env=env)
     assert cli.returncode == 0 and json.loads(cli.stdout)["signals"], cli.stderr[-2000:]
+
+
+@NEEDS_GIT
+@pytest.mark.slow
+def test_wheel_runs_every_command_outside_the_checkout(installed):
+    """Every command of the command line, from the installed wheel, in a directory outside the checkout: each exits
+    as it must (0, or 2 with its one-line message for `view` without a display), none with an internal error."""
+    py, _site, work, env = installed
+    env = {k: v for k, v in env.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    run = subprocess.run([str(py), "-c", PROBE_CLI, json.dumps([argv for argv, _ in COMMANDS])], cwd=work,
+                         capture_output=True, text=True, timeout=1800, env=env)
+    assert run.returncode == 0, run.stderr[-3000:]
+    results = json.loads(run.stdout.strip().splitlines()[-1])
+    bad = [(r["argv"], r["code"], r["err"]) for r, (_, code) in zip(results, COMMANDS, strict=True)
+           if r["code"] != code or "internal error" in r["err"]]
+    assert not bad, bad

@@ -117,7 +117,7 @@ def design_scene(inp: DesignInputs, name: str = "") -> dict[str, Any]:
                              f"{inp.base!r}: choose a larger clutch torque tau_c or spring-system inertia J_s")
     params = {"J_s": v["J_s"], "K": v["K"], "tau_c1": v["tau_c"], "tau_c2": v["tau_c"], "spring_max": v["x_max"],
               "J_l": v["J_l"], "tau_l": v["tau_l"], "Kp": v["Kp"], "Ki": v["Ki"], "tau_0": v["tau_0"],
-              "tau_slope": v["tau_slope"], "ref": v["w_op"]}
+              "tau_slope": v["tau_slope"]}
     desc = (f"{inp.P:g} W step-up/step-down drive designed by CADJS (Sr_min {inp.Sr_min:g} /s, load speed "
             f"{inp.w_min:g}-{inp.w_max:g} rad/s, motor {inp.V_m:g} rad/s), closed loop at {v['w_op']:g} rad/s")
     return {

@@ -70,7 +70,7 @@ def cmd_view(args: argparse.Namespace) -> None:
         raise MbsuiteError(f"model '{scene.model}' has no MuJoCo model to view")
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or sys.platform == "darwin"):
         raise MbsuiteError("mbsuite view needs a display (no DISPLAY or WAYLAND_DISPLAY is set); on a headless "
-                           "machine render offscreen instead (MUJOCO_GL=egl, mujoco.Renderer)")
+                           f"machine render offscreen instead: mbsuite render {args.scene} --out scene.png")
     import mujoco.viewer
 
     model, data = scene.spec.mujoco_model(scene)

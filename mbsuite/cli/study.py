@@ -6,7 +6,9 @@ number the analysis returns against the axes: a table, `study.csv`, `study.png` 
     mbsuite modes pantograph --vary params.mh=10:16:1          # how the modes move with the head mass
 
 A command takes part by naming its report function, `fn(scene, args) -> Report` at module level (`"module:name"`,
-so a point pickles to any executor), and calling `run_or_study`."""
+so a point pickles to any executor), and calling `run_or_study`. A command that reads no scene (its inputs are its
+flags, e.g. `mbsuite coupler jacobian --gamma ...`) varies its options instead: `--vary option.gamma=0.25,0.3`
+(the option's name as the command's flag, dashes as underscores); `fn` then gets `scene=None`."""
 
 from __future__ import annotations
 
@@ -27,17 +29,24 @@ SECTIONS = ("input", "params", "solver", "effects")
 MAX_LIST = 16  # a list of numbers longer than this is a curve or a time series, not a quantity of the study
 
 
-def add_study_options(p: argparse.ArgumentParser) -> None:
-    """`--set` and `--vary`, plus the sweep's `--executor/--scheduler/--store/--max-points` and `--workers` where
-    the command does not have them yet."""
+def add_study_options(p: argparse.ArgumentParser, scene: bool = True) -> None:
+    """`--set` and `--vary` (`scene=False`: a command without a scene varies its options: `--vary option.NAME=...`),
+    plus the sweep's `--executor/--scheduler/--store/--max-points` and `--workers` where the command does not have
+    them yet."""
     from .options import add_sweep_options
 
-    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
-                   help="change one value of the scene (SECTION: input, params, solver, effects or a model's own "
-                        "section; a comma list sets a list), e.g. params.mh=14 (repeatable)")
-    p.add_argument("--vary", action="append", metavar="SECTION.KEY=VALUES",
-                   help="a study axis: comma list or start:stop:step, e.g. params.mh=10:16:1 (repeatable: the grid "
-                        "is the product); the analysis runs at every point")
+    if scene:
+        p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
+                       help="change one value of the scene (SECTION: input, params, solver, effects or a model's own "
+                            "section; a comma list sets a list), e.g. params.mh=14 (repeatable)")
+        p.add_argument("--vary", action="append", metavar="SECTION.KEY=VALUES",
+                       help="a study axis: comma list or start:stop:step, e.g. params.mh=10:16:1 (repeatable: the "
+                            "grid is the product); the analysis runs at every point")
+    else:
+        p.add_argument("--vary", action="append", metavar="option.NAME=VALUES",
+                       help="a study axis over one of this command's options (its flag's name, dashes as "
+                            "underscores): comma list or start:stop:step, e.g. option.gamma=0.25:0.35:0.05 "
+                            "(repeatable: the grid is the product); the analysis runs at every point")
     if "--executor" not in p._option_string_actions:
         add_sweep_options(p)
     if "--workers" not in p._option_string_actions:
@@ -49,8 +58,9 @@ def split_key(text: str, flag: str, sections: tuple[str, ...]) -> tuple[str, str
     key, sep, value = text.partition("=")
     section, dot, name = key.strip().partition(".")
     if not sep or not dot or not name or section not in sections:
-        raise MbsuiteError(f"{flag} {text!r}: expected SECTION.KEY=VALUE with SECTION in {', '.join(sections)} "
-                           "(e.g. params.mh=14)")
+        example = "params.mh=14" if "params" in sections else "option.gamma=0.3"
+        raise MbsuiteError(f"{flag} {text!r}: expected SECTION.KEY={'VALUE' if flag == '--set' else 'VALUES'} with "
+                           f"SECTION in {', '.join(sections)} (e.g. {example})")
     return section, name, value
 
 
@@ -86,16 +96,21 @@ def flatten(data: Any, prefix: str = "") -> dict[str, float]:
     return out
 
 
-def study_point(target: str, options: dict[str, Any], job: tuple[dict, dict]) -> dict[str, float]:
+def study_point(target: str, options: dict[str, Any], job: tuple[dict | None, dict]) -> dict[str, float]:
     """One point of a study: the command's report function `target` ("module:name") on the scene `job = (scene_dict,
-    sections)` with the command's options, its data's numbers flattened. Module-level, so it pickles to any
-    executor."""
+    sections)` (None: a command without a scene) with the command's options (`sections["option"]` overriding them),
+    its data's numbers flattened. Module-level, so it pickles to any executor."""
     from ..results import to_jsonable
     from ..scenes import scene_from_dict
 
     module, _, name = target.partition(":")
     scene_d, sections = job
-    scene = scene_from_dict(scene_d).replace(origin="on the command line (--vary)", **sections)
+    sections = dict(sections)
+    options = {**options, **sections.pop("option", {})}
+    scene = None
+    if scene_d is not None:
+        scene = scene_from_dict(scene_d)
+        scene = scene.replace(origin="on the command line (--vary)", **sections) if sections else scene
     report = getattr(importlib.import_module(module), name)(scene, argparse.Namespace(**options))
     return flatten({k: v for k, v in to_jsonable(report.data).items() if k != "scene"})  # the scene: the axes
 
@@ -108,40 +123,60 @@ def point_options(args: argparse.Namespace) -> dict[str, Any]:
             if k not in drop and (v is None or isinstance(v, str | int | float | bool | list))}
 
 
-def run_or_study(args: argparse.Namespace, scene: Scene, target: str, *, units: dict[str, str] | None = None,
+def run_or_study(args: argparse.Namespace, scene: Scene | None, target: str, *, units: dict[str, str] | None = None,
                  parallel_inside: bool = False) -> None:
-    """Emit the command's report for `scene` (with `--set` applied) or, with `--vary`, the study over the grid.
-    `units`: the SI unit of a quantity by its last name (`f_n` -> Hz). `parallel_inside`: the analysis runs its own
-    workers, so the study's points run one after another."""
+    """Emit the command's report for `scene` (with `--set` applied; None: a command without a scene) or, with
+    `--vary`, the study over the grid. `units`: the SI unit of a quantity by its last name (`f_n` -> Hz).
+    `parallel_inside`: the analysis runs its own workers, so the study's points run one after another."""
     from .output import emit
 
-    scene = apply_sets(scene, getattr(args, "set_values", None))
-    module, _, name = target.partition(":")
+    if scene is not None:
+        scene = apply_sets(scene, getattr(args, "set_values", None))
+    out = getattr(args, "emit", None) or emit
+    scene_d = scene.to_dict() if scene is not None else None
     if not getattr(args, "vary", None):
-        (getattr(args, "emit", None) or emit)(getattr(importlib.import_module(module), name)(scene, args), args,
-                                              scene.to_dict())
+        module, _, name = target.partition(":")
+        out(getattr(importlib.import_module(module), name)(scene, args), args, scene_d)
         return
-    (getattr(args, "emit", None) or emit)(study(args, scene, target, units=units or {},
-                                                parallel_inside=parallel_inside), args, scene.to_dict())
+    out(study(args, scene, target, units=units or {}, parallel_inside=parallel_inside), args, scene_d)
 
 
-def study(args: argparse.Namespace, scene: Scene, target: str, *, units: dict[str, str],
+def study_axes(args: argparse.Namespace, scene: Scene | None, max_points: int) -> list[tuple[str, str, list]]:
+    """(section, key, values) of each `--vary`: scene sections, or `option` (a command without a scene: one of its
+    options by name); the grid's size checked before it is built."""
+    from ..analysis.sweep import check_grid, parse_values
+
+    sections = SECTIONS if scene is not None else ("option",)
+    meta = {"command", "executor", "scheduler", "max_points", "workers", "max_n"}
+    options = {k for k in point_options(args) if k not in meta and not k.endswith("_command")}
+    axes = []
+    for text in args.vary:
+        section, name, values = split_key(text, "--vary", sections)
+        if section == "option" and name not in options:
+            raise MbsuiteError(f"--vary {text!r}: this command has no option {name!r}; valid: {sorted(options)}")
+        axes.append((section, name, parse_values(values, max_points=max_points)))
+    check_grid([len(a[2]) for a in axes], max_points=max_points, what="--vary grid")
+    return axes
+
+
+def study(args: argparse.Namespace, scene: Scene | None, target: str, *, units: dict[str, str],
           parallel_inside: bool = False) -> Report:
-    """Run `target` at every point of the `--vary` grid (every point validated before anything runs) and report."""
+    """Run `target` at every point of the `--vary` grid (every scene point validated before anything runs) and
+    report."""
     from ..analysis.sweep import run_sweep
     from .options import check_workers, sweep_options
-    from .sweep import grid_axes
 
     options = sweep_options(args)
-    axes = grid_axes(args.vary, options.max_points)
+    axes = study_axes(args, scene, options.max_points)
     combos = list(itertools.product(*[a[2] for a in axes]))
     points = []
     for combo in combos:
         sections: dict = {}
         for (section, name, _), v in zip(axes, combo, strict=True):
             sections.setdefault(section, {})[name] = v
-        scene.replace(origin="on the command line (--vary)", **sections)  # validate every point first
-        points.append((scene.to_dict(), sections))
+        if scene is not None:
+            scene.replace(origin="on the command line (--vary)", **sections)  # validate every point first
+        points.append((scene.to_dict() if scene is not None else None, sections))
     workers = 1 if parallel_inside else check_workers(getattr(args, "workers", 0) or 0)
     fn = functools.partial(study_point, target, point_options(args))
     results = run_sweep(fn, points, workers=workers, desc="study", options=options,
@@ -154,14 +189,15 @@ def unit_of(quantity: str, units: dict[str, str]) -> str:
     return units.get(quantity.rsplit(".", 1)[-1].split("[")[0], "")
 
 
-def study_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
+def study_report(scene: Scene | None, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
                  units: dict[str, str], what: str) -> Report:
     """One row per point and quantity (the axes, the quantity, its unit, its value); the data: axes, units, points."""
     from ..results import Report, format_table
     from .sweep import axis_unit
 
     head = [f"{s}.{n}" for s, n, _ in axes]
-    axis_units = {h: axis_unit(scene, s, n) for h, (s, n, _) in zip(head, axes, strict=True)}
+    axis_units = {h: axis_unit(scene, s, n) if scene is not None else units.get(n, "")
+                  for h, (s, n, _) in zip(head, axes, strict=True)}
     quantities = list(dict.fromkeys(q for r in results for q in r))
     rows = [[*combo, q, unit_of(q, units), r[q]] for combo, r in zip(combos, results, strict=True)
             for q in quantities if q in r]
@@ -192,11 +228,15 @@ def write_study(out: Path, *, head: list[str], axis_units: dict[str, str], combo
 
 def plot_study(head: list[str], axis_units: dict[str, str], combos: list[tuple], results: list[dict],
                quantities: list[str], units: dict[str, str], what: str):
-    """The quantities that change over the study against the first axis, one panel per kind of quantity (its last
-    name: every `f_n` in one panel), one line per quantity and combination of the other axes (at most 6 panels)."""
+    """The quantities that change over the study (not those that only repeat an axis' value) against the first
+    axis, one panel per kind of quantity (its last name: every `f_n` in one panel), one line per quantity and
+    combination of the other axes (at most 6 panels)."""
     from ..plotting import figure
 
-    changing = [q for q in quantities if len({r.get(q) for r in results}) > 1] or quantities[:1]
+    def echo(q: str) -> bool:  # a quantity that only repeats an axis' value (the input, reported back)
+        return any(all(r.get(q) == c[i] for r, c in zip(results, combos, strict=True)) for i in range(len(head)))
+
+    changing = [q for q in quantities if len({r.get(q) for r in results}) > 1 and not echo(q)] or quantities[:1]
     kinds: dict[str, list[str]] = {}
     for q in changing:
         kinds.setdefault(q.rsplit(".", 1)[-1].split("[")[0], []).append(q)

@@ -70,3 +70,18 @@ def test_bad_set_or_vary_is_one_line_naming_it(argv, words, capsys):
     err = capsys.readouterr().err
     assert err.startswith("mbsuite: error:") and err.count("\n") == 1
     assert all(w in err for w in words), err
+
+
+def test_a_command_without_a_scene_varies_its_options(capsys):
+    """`mbsuite coupler jacobian --vary option.gamma=...`: each point is the single command with `--gamma` at that
+    value; an option the command does not have is named with the valid ones."""
+    assert main(["coupler", "jacobian", "--vary", "option.gamma=0.25,0.3", "--workers", "1", "--json"]) == 0
+    data = _json(capsys)
+    assert data["axes"] == {"option.gamma": [0.25, 0.3]} and data["units"]["option.gamma"] == "rad"
+    for point in data["points"]:
+        assert main(["coupler", "jacobian", "--gamma", str(point["values"]["option.gamma"]), "--json"]) == 0
+        single = _json(capsys)
+        assert [point["results"][f"singular_values[{i}]"] for i in range(4)] == single["singular_values"]
+    assert main(["coupler", "jacobian", "--vary", "option.nosuch=1"]) == 2
+    err = capsys.readouterr().err
+    assert "no option 'nosuch'" in err and "'gamma'" in err

@@ -53,12 +53,17 @@ def _geometry_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--R", type=_finite("--R"), default=d.R, help=f"joint-circle radius (default {d.R:g})")
 
 
+#: units of the geometry options (a --vary option.NAME study's axes)
+OPTION_UNITS = {"gamma": "rad", "phi_a": "rad", "alpha_bx": "rad", "alpha_bz": "rad"}
+
+
 def _params(args: argparse.Namespace) -> CouplerParams:
     return CouplerParams(gamma=args.gamma, e_y=args.ey, R=args.R)
 
 
-def cmd_jacobian(args: argparse.Namespace, emit) -> None:
-    """`mbsuite coupler jacobian`: the single coupler's Jacobian report, singularity warnings stated in it."""
+def jacobian_of(scene: None, args: argparse.Namespace) -> Report:
+    """The single coupler's Jacobian report at the command's geometry, singularity warnings stated in it (the
+    command's, or a point of its --vary study)."""
     p = _params(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", analysis.SingularityWarning)
@@ -68,7 +73,13 @@ def cmd_jacobian(args: argparse.Namespace, emit) -> None:
         rep.data["warnings"] = msgs
         rep.table = "".join(textwrap.fill("WARNING: " + m, 100, subsequent_indent="  ") + "\n"
                             for m in msgs) + rep.table
-    emit(rep, args, None)
+    return rep
+
+
+def cmd_jacobian(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler jacobian`: the single coupler's Jacobian report (or a --vary option.NAME study of it)."""
+    args.emit = emit
+    run_or_study(args, None, f"{__name__}:jacobian_of", units=OPTION_UNITS)
 
 
 #: default size guard of `coupler fpp`: samples per revolution (about 0.2 ms each; 1e5 take ~20 s); --max-n raises it
@@ -91,12 +102,18 @@ def _count(name: str) -> partial:
     return partial(_count_value, name)
 
 
-def cmd_fpp(args: argparse.Namespace, emit) -> None:
-    """`mbsuite coupler fpp`: the single coupler's pose over one revolution (size-guarded sample count)."""
+def fpp_of(scene: None, args: argparse.Namespace) -> Report:
+    """The single coupler's pose over one revolution at the command's geometry (size-guarded sample count)."""
     if not 3 <= args.n <= args.max_n:
         raise ParameterError(f"--n = {args.n} is invalid; valid: integer in [3, {args.max_n}] (the size guard "
                              f"--max-n, default {FPP_MAX_N}; each sample is one FPP solve, ~0.2 ms)")
-    emit(analysis.fpp_report(_params(args), args.alpha_bx, args.alpha_bz, args.n, args.engine), args, None)
+    return analysis.fpp_report(_params(args), args.alpha_bx, args.alpha_bz, args.n, args.engine)
+
+
+def cmd_fpp(args: argparse.Namespace, emit) -> None:
+    """`mbsuite coupler fpp`: the single coupler's pose over one revolution (or a --vary option.NAME study)."""
+    args.emit = emit
+    run_or_study(args, None, f"{__name__}:fpp_of", units=OPTION_UNITS)
 
 
 def cmd_criteria(args: argparse.Namespace, emit) -> None:
@@ -205,6 +222,7 @@ def register(sub, add_common, emit) -> str:
     p.add_argument("--alpha-bx", type=_finite("--alpha-bx"), default=0.0, help="inclination about x [rad]")
     p.add_argument("--alpha-bz", type=_finite("--alpha-bz"), default=0.0, help="inclination about z [rad]")
     p.add_argument("--engine", choices=["reference", "pinocchio"], default="reference")
+    add_study_options(p, scene=False)
     add_common(p)
     p.set_defaults(func=partial(cmd_jacobian, emit=emit))
 
@@ -217,6 +235,7 @@ def register(sub, add_common, emit) -> str:
                    help=f"size guard: the largest --n accepted (default {FPP_MAX_N})")
     p.add_argument("--engine", choices=["reference", "pinocchio"], default="reference",
                    help="pinocchio: also solve with the URDF model and report the difference")
+    add_study_options(p, scene=False)
     add_common(p)
     p.set_defaults(func=partial(cmd_fpp, emit=emit))
 

@@ -87,9 +87,17 @@ def _scene(args: argparse.Namespace) -> Scene:
     return scene
 
 
+# the units of the numbers a passage reports, by their names (a --vary study's table, CSV and figure)
+UNITS = {"Fm": "N", "sigma": "N", "stat_max": "N", "stat_min": "N", "max": "N", "min": "N",
+         "static_contact_force": "N", "uplift_mm": "mm", "loss_pct": "%", "speed_kmh": "km/h", "speed": "km/h",
+         "cw_wave_speed_kmh": "km/h", "cw_wave_speed_ms": "m/s", "speed_ratio": "1", "doppler_factor": "1",
+         "element_length": "m", "timestep": "s", "build_s": "s", "cpu_s": "s", "integrate_s": "s",
+         "statistics_s": "s", "total_s": "s", "us_per_step": "us"}
+
+
 def cmd_catenary(args: argparse.Namespace) -> None:
     """One passage (or a train's, with `[train]`) of the scene, and its report (or a --vary study of it)."""
-    run_or_study(args, _scene(args), f"{__name__}:catenary_of", parallel_inside=bool(args.error_estimate))
+    run_or_study(args, _scene(args), f"{__name__}:catenary_of", units=UNITS, parallel_inside=bool(args.error_estimate))
 
 
 def catenary_of(scene: Scene, args: argparse.Namespace) -> Report:

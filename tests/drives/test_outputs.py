@@ -108,3 +108,17 @@ def test_drive_run_study_point_is_the_single_run(tmp_path, capsys):
     assert (tmp_path / "study.csv").stat().st_size > 0 and (tmp_path / "study.png").stat().st_size > 10_000
     assert main([*base, "--set", "params.t_n=0.03"]) == 2  # PWM reads no dead time: refused, not ignored
     assert "t_n" in capsys.readouterr().err
+
+
+def test_drive_efficiency_point_is_the_run_at_that_load(capsys):
+    """`drive efficiency --loads 0.1` (without --error-estimate: once an internal error) gives at 0.1 N m the
+    efficiency and load speed of `drive run --set params.tau_l=0.1` over the same window (another route: one run)."""
+    import json
+
+    base = ["drives/susd_100w_efficiency", "--duration", "0.3", "--json"]
+    assert main(["drive", "efficiency", base[0], "--loads", "0.1", *base[1:]]) == 0
+    (pt,) = json.loads(capsys.readouterr().out)["points"]
+    assert main(["drive", "run", base[0], "--set", "params.tau_l=0.1", *base[1:]]) == 0
+    cyc = json.loads(capsys.readouterr().out)["stats"]["cycles"]
+    assert pt["tau_l"] == 0.1 and pt["load_speed"] == pytest.approx(cyc["mean_load_speed"], rel=1e-12)
+    assert pt["efficiency"] == pytest.approx(cyc["efficiency"], rel=1e-9)

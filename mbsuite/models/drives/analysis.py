@@ -159,7 +159,7 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
     from .plots import loss_label
 
     table += "\n" + textwrap.fill("; ".join(f"{LOSS_SHORT.get(k, k)} = {loss_label(k)}" for k in labels), 100)
-    for p, est in zip(pts, ests, strict=True):
+    for p, est in zip(pts if error_estimate else [], ests, strict=True):
         p["error_estimate"] = est.to_dict()
         table += f"\n\ntau_l = {p['tau_l']:g} N m: " + est.table()
 
@@ -174,7 +174,7 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
 
     data: dict[str, Any] = {"scene": scene.name, "points": pts}
     warned = []
-    for p, est in zip(pts, ests, strict=True):  # an estimate past its tolerance: AccuracyError naming the point
+    for p, est in zip(pts if error_estimate else [], ests, strict=True):  # past its tolerance: AccuracyError
         warned += judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
                         what=f"drives efficiency {scene.name} at tau_l = {p['tau_l']:g} N m")
     if warned:

@@ -77,7 +77,8 @@ def test_readme_lists_every_parameter():
 
 def test_drive_run_writes_what_mbsuite_run_writes(tmp_path):
     """`drive run --out` and `mbsuite run --out` name the same data alike (run.csv, one writer): the same scene gives
-    the same file byte for byte; the drive command's summary.json holds the scene as run and its options."""
+    the same file byte for byte; the drive command's summary.json holds the scene as run and its options, and
+    `drive run summary.json` reruns it."""
     import json
 
     scene = tmp_path / "short.toml"
@@ -88,6 +89,9 @@ def test_drive_run_writes_what_mbsuite_run_writes(tmp_path):
     assert (tmp_path / "a" / "run.csv").read_bytes() == (tmp_path / "b" / "run.csv").read_bytes()
     s = json.loads((tmp_path / "a" / "summary.json").read_text())
     assert s["scene"]["solver"]["duration"] == 0.3 and s["results"]["options"]["--error-estimate"] is False
+    # the summary reruns the command: the same file again
+    assert main(["drive", "run", str(tmp_path / "a" / "summary.json"), "--out", str(tmp_path / "c")]) == 0
+    assert (tmp_path / "c" / "run.csv").read_bytes() == (tmp_path / "a" / "run.csv").read_bytes()
 
 
 def test_drive_run_study_point_is_the_single_run(tmp_path, capsys):

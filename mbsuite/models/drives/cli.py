@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ...analysis.errorestimate import error_estimate
-from ...cli.options import add_error_estimate, add_scene_options
+from ...cli.options import SCENE_HELP, add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError, SceneError
 from ...health import judge
@@ -228,7 +228,7 @@ def register(sub, add_common, emit) -> str:
 
     # -- run / efficiency ----------------------------------------------------------------------------------------
     q = dsub.add_parser("run", help="simulate a drive scene: cycle statistics, energy balance, lock events")
-    q.add_argument("scene", help="scene TOML, or drives/<scene>")
+    q.add_argument("scene", help=SCENE_HELP)
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
     add_scene_options(q)
@@ -238,7 +238,7 @@ def register(sub, add_common, emit) -> str:
     q.set_defaults(func=partial(run_cmd, emit))
 
     q = dsub.add_parser("efficiency", help="open-loop efficiency vs steady load speed over load torques")
-    q.add_argument("scene")
+    q.add_argument("scene", help=SCENE_HELP)
     q.add_argument("--loads", type=_floats("--loads"), default=None, help="comma list of load torques (N m)")
     q.add_argument("--engine", choices=["reference", "mujoco"])
     q.add_argument("--duration", type=float)
@@ -508,7 +508,7 @@ def _nan(x: float | None) -> float:
 
 def _scene(a: argparse.Namespace):
     _check_options(a, "--duration")
-    sc = load_scene(a.scene)
+    sc = scene_of(a.scene)  # a TOML, model/scene, or the summary.json of an earlier run (the scene it ran)
     if sc.model != "drives":
         raise SceneError(f"scene {a.scene!r} is a '{sc.model}' scene, not a drives scene")
     upd = {}

@@ -143,3 +143,21 @@ def test_unused_parameters_change_nothing(combo):
         finally:
             scene_run.check_scene = orig
         assert np.array_equal(res.w, ref.w) and np.array_equal(res.q, ref.q), k
+
+
+@pytest.mark.parametrize("key", ["J_m", "J_s", "J_l"])
+def test_rotor_inertia_floor(key):
+    """Below the declared floor 1e-9 kg m^2 a rotor inertia is refused naming it (once MuJoCo's singular-inertia
+    warnings); at the floor the MuJoCo model is built with it (diag(M) holds it: `MujocoRotorSim`'s own check)."""
+    from mbsuite.errors import ParameterError
+    from mbsuite.models.drives.mujoco import MujocoRotorSim
+    from mbsuite.paths import mjcf_path
+
+    sc = load_scene("drives/step_up_pwm")
+    with pytest.raises(ParameterError, match=rf"{key} = 5e-10\b.* is invalid; valid: \[1e-09, 1000\]"):
+        sc.replace(params={key: 5e-10})
+    run = setup(sc.replace(params={key: 1e-9}))
+    sim = MujocoRotorSim(run.system, mjcf_path(run.mjcf), timestep=1e-4)
+    i = ["J_m", "J_s", "J_l"].index(key)
+    assert run.system.J[i] == 1e-9
+    assert sim.m.body_inertia[sim.m.jnt_bodyid[sim.jnt[i]]][2] == 1e-9

@@ -69,6 +69,9 @@ PARAM_SETS: dict[str, dict[str, float]] = {
 }
 
 
+#: the least rotor inertia [kg m^2]: far below any drive of this kind, far above MuJoCo's mjMINVAL (1e-15), which a
+#: rotor's inertia must exceed (the same floor as the coupler's)
+J_FLOOR = 1e-9
 BIG = 1e6  # generous upper ends: far above any drive of this kind, low enough to catch unit slips (mm for m, ...)
 
 
@@ -92,16 +95,16 @@ class DriveParams:
     tau_0: float | None = _p(0.0, 1e4, "N m", "stall torque of the straight-line motor (App. J)", lo_open=True)
     tau_slope: float | None = _p(-1e3, 0.0, "N m s/rad", "torque-speed slope of the straight-line motor (<= 0: a "
                                  "torque rising with speed runs away)")
-    J_m: float | None = _p(0.0, 1e3, "kg m^2", "motor inertia", lo_open=True)
+    J_m: float | None = _p(J_FLOOR, 1e3, "kg m^2", "motor inertia")
     J_add: float | None = _p(0.0, 1e3, "kg m^2", "added motor inertia (Sec. 4.2.4: 1.42e-3; Sec. 6.2: 1.6e-3)")
     C_m: float | None = _p(0.0, 1e3, "N m", "motor bearing Coulomb torque")
     B_m: float | None = _p(0.0, 1e3, "N m s/rad", "motor bearing viscous coefficient")
     # spring system and load
     K: float | None = _p(0.0, BIG, "N m/rad", "torsion spring rate", lo_open=True)
-    J_s: float | None = _p(0.0, 1e3, "kg m^2", "spring-system inertia", lo_open=True)
+    J_s: float | None = _p(J_FLOOR, 1e3, "kg m^2", "spring-system inertia")
     C_s: float | None = _p(0.0, 1e3, "N m", "spring bearing Coulomb torque")
     B_s: float | None = _p(0.0, 1e3, "N m s/rad", "spring viscous coefficient")
-    J_l: float | None = _p(0.0, 1e3, "kg m^2", "load inertia", lo_open=True)
+    J_l: float | None = _p(J_FLOOR, 1e3, "kg m^2", "load inertia")
     C_l: float | None = _p(0.0, 1e3, "N m", "load bearing Coulomb torque")
     B_l: float | None = _p(0.0, 1e3, "N m s/rad", "load bearing viscous coefficient")
     tau_l: float | None = _p(0.0, 1e4, "N m", "Coulomb load torque (useful output)")

@@ -59,8 +59,10 @@ def plot_freqresp(freqs: np.ndarray, curves: Mapping[str, Mapping[str, np.ndarra
 
 
 def plot_time_histories(runs: Mapping[float, object], window: float = 1.0) -> Figure:
-    """Figs 5-1..5-6 as separate panels: one column per forcing frequency (`runs`: frequency -> SimResult with y_w,
-    HD, F2, F1), one row per signal, each the deviation from its mean over the last `window` seconds (mm)."""
+    """The simulated counterparts of the thesis' Figs 5-1..5-6 as separate panels: one column per forcing frequency
+    (`runs`: frequency -> SimResult with y_w, HD, F2, F1), one row per signal, each the deviation from its mean over
+    the last `window` seconds (mm). The thesis' own curves are not drawn: the suite holds no digitised values of
+    them (its resonances are compared in the frequency response, Fig 5-7)."""
     names = ("y_w", "HD", "F2", "F1")
     freqs = sorted(runs)
     fig, axes = figure(len(names), len(freqs), size=(2.6 * len(freqs) + 1.0, 8.0), sharex=True, squeeze=False)
@@ -79,7 +81,8 @@ def plot_time_histories(runs: Mapping[float, object], window: float = 1.0) -> Fi
                 ax.set_ylabel(f"{'IN' if name == 'y_w' else name} - mean [mm]")
             if row == len(names) - 1:
                 ax.set_xlabel("time in the last second [s]")
-    fig.suptitle("Simulated time responses (MuJoCo), as in the thesis' Figs 5-1..5-6: deviations from the mean",
+    fig.suptitle("Simulated time responses (MuJoCo) at the forcing frequencies of the thesis' Figs 5-1..5-6, "
+                 "deviations from the mean (the thesis' curves are not overlaid: no digitised values ship)",
                  fontsize=10)
     fig.text(0.5, 0.005, SYMBOLS, ha="center", va="bottom", fontsize=8, wrap=True)
     fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))

@@ -90,16 +90,17 @@ class Limit:
         kind = "integer in " if self.kind is int else ""
         return f"{kind}{left}{lo}, {hi}{right}" + (f" {self.unit}" if self.unit else "")
 
-    def check(self, name: str, value: Any, error: type[Exception] = ParameterError) -> Any:
-        """Return `value` (as float/int/str) if valid, else raise `error` naming `name`, the value and the range."""
-        bad = f"{name} = {value!r} is invalid; valid: {self.describe()}"
+    def check(self, name: str, value: Any, error: type[Exception] = ParameterError, where: str = "") -> Any:
+        """Return `value` (as float/int/str) if valid, else raise `error` naming `name`, the value, where it came from
+        (`where`, a phrase with a leading space) and the range."""
+        bad = f"{name} = {value!r}{where} is invalid; valid: {self.describe()}"
         if self.kind is str or (self.choices is not None and all(isinstance(c, str) for c in self.choices)):
             if not isinstance(value, str) or (self.choices is not None and value not in self.choices):
                 raise error(bad)
             return value
         number = real(value)
         if number is None:
-            raise error(f"{name} = {value!r} is not a number; valid: {self.describe()}")
+            raise error(f"{name} = {value!r}{where} is not a number; valid: {self.describe()}")
         value = number
         if not math.isfinite(value):
             raise error(bad)

@@ -9,14 +9,16 @@ loader validates against the spec and the CLI dispatches through the hooks, so a
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import pkgutil
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from .errors import SceneError
+from .limits import Limit
 from .solver import SolverSettings
 
 
@@ -39,6 +41,34 @@ class Effect:
         return value
 
 
+def _matches(value: Any, choices: tuple[Any, ...]) -> bool:
+    """True if the effect value `value` is one of `choices` (bools by identity, as `Effect.check`)."""
+    return any((value is c) if isinstance(c, bool) else (value == c and not isinstance(value, bool)) for c in choices)
+
+
+@dataclass(frozen=True)
+class Uses:
+    """When a parameter, input key or model section takes part in a run (a row of `ModelSpec.uses`): under the listed
+    effect values (effect -> the values that use it; all listed effects must hold) and on the listed paths (empty:
+    every path). A scene that sets a key its configuration does not use is an error naming the key and the reason,
+    so that no input is silently ignored."""
+
+    effects: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
+    engines: tuple[str, ...] = ()
+
+    def unused_because(self, effects: Mapping[str, Any], engine: str | None) -> str | None:
+        """Why a scene with these effects on this path does not use the key (None: it does; `engine` None: the
+        effects alone are judged)."""
+        for name, values in self.effects.items():
+            if not _matches(effects[name], values):
+                shown = [v if not isinstance(v, bool) else str(v).lower() for v in values]
+                value = str(effects[name]).lower() if isinstance(effects[name], bool) else repr(effects[name])
+                return f"effects.{name} = {value} (it is used with {name} = {' or '.join(map(str, shown))})"
+        if engine is not None and self.engines and engine not in self.engines:
+            return f"solver.engine = {engine!r} (it is used on the {' and '.join(self.engines)} path only)"
+        return None
+
+
 @dataclass(frozen=True)
 class RunPath:
     """One way to run a model's time simulation: a row of the model's path table (like scipy's `METHODS`).
@@ -46,11 +76,13 @@ class RunPath:
     `run(scene) -> SimResult` takes a validated scene whose `solver.engine` is this path's key; it neither tests the
     engine again nor judges health (`mbsuite.run` picks the path and judges the result, once). `label` says what the
     path is (`equations`, `kinematic`, `pinocchio`, `fe`, `mujoco`, ...; a scene may write it in `solver.engine`),
-    `what` says it in one line for `mbsuite list`."""
+    `what` says it in one line for `mbsuite list`. `lacks`: effect -> the values this path does not model (a scene
+    asking for one of them on this path is an error naming it, never a run of something else)."""
 
     run: Callable[..., Any]
     label: str
     what: str
+    lacks: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -74,6 +106,11 @@ class ModelSpec:
       drive through its `static / trial / commit` protocol (None: the model is not a pantograph).
     - `mujoco_model(scene) -> (MjModel, MjData)`: the MuJoCo model of exactly the scene's effects, in its initial state
       (what `mbsuite view` shows; None: the model has no MuJoCo model).
+    - `uses`: `"params.KEY"`, `"input.KEY"` or a section name -> `Uses`, the configurations (effect values, paths)
+      that use it; a key not listed is used by every configuration. Setting an unused key is an error naming it and
+      why (an input key only when it differs from its declared default): against the effects when the scene is
+      built, against the path (and the path's `lacks`) when a path runs it, so a scene may carry one path's
+      settings while another path's run is asked for on the way.
     - `accuracy`: the model's accuracy declaration (`mbsuite.accuracy.AccuracySpec`: headline outputs with the
       tolerances the defaults meet, their values from a result, how a run is refined for `--error-estimate`).
     - `file_checks`: model-file stem -> `check(path, engine, model)`, handed to the engines' loaders for a file of
@@ -102,8 +139,13 @@ class ModelSpec:
     mujoco_model: Callable[..., Any] | None = None
     file_checks: Mapping[str, Callable[..., None]] = field(default_factory=dict)
     accuracy: Any = None
+    uses: Mapping[str, Uses] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        self._check_uses()
+        if any(u.engines for u in self.uses.values()) or any(p.lacks for p in self.paths.values()):
+            object.__setattr__(self, "paths", {k: dataclasses.replace(p, run=self._checked(k, p.run))
+                                               for k, p in self.paths.items()})
         labels = [p.label for p in self.paths.values()]
         clash = [p.label for k, p in self.paths.items() if p.label in self.paths and p.label != k]
         if len(set(labels)) != len(labels) or clash:
@@ -111,6 +153,79 @@ class ModelSpec:
         if self.paths and self.solver.engine not in self.paths:
             raise ValueError(f"model '{self.name}': default engine {self.solver.engine!r} is not one of its paths "
                              f"{list(self.paths)}")
+
+    def _check_uses(self) -> None:
+        """Every `uses` row and `lacks` entry names a real key, effect value and path (a typo would switch the check
+        off silently)."""
+        keys = {*(f"params.{f.name}" for f in dataclasses.fields(self.params_cls)),
+                *(f"input.{k}" for decl in self.inputs.values() for k in decl), *self.sections}
+        rows = [(f"uses[{k!r}]", u.effects) for k, u in self.uses.items()]
+        rows += [(f"paths[{k!r}].lacks", p.lacks) for k, p in self.paths.items()]
+        for key, use in self.uses.items():
+            if key not in keys:
+                raise ValueError(f"model '{self.name}': uses names {key!r}, not a parameter, input key or section")
+            if set(use.engines) - set(self.paths):
+                raise ValueError(f"model '{self.name}': uses[{key!r}] names unknown paths {use.engines}")
+        for where, effects in rows:
+            for name, values in effects.items():
+                if name not in self.effects or not all(_matches(v, self.effects[name].choices) for v in values):
+                    raise ValueError(f"model '{self.name}': {where} names effect values {name} = {values} that are "
+                                     "not declared")
+
+    def _checked(self, key: str, run: Callable[..., Any]) -> Callable[..., Any]:
+        """`run` of path `key`, first refusing a scene that sets what this path does not use (`used_keys`)."""
+
+        @functools.wraps(run)
+        def checked(scene: Any, *args: Any, **kwargs: Any) -> Any:
+            self.check_used(scene, key)
+            return run(scene, *args, **kwargs)
+
+        return checked
+
+    def check_used(self, scene: Any, engine: str) -> None:
+        """Refuse to run `scene` on path `engine` if it sets a key that path does not use, or asks for an effect value
+        the path does not model (`uses`, `RunPath.lacks`; every path's run calls this first)."""
+        src = f" in {scene.source}" if scene.source else " in the scene"
+        self.refuse_unused(scene.effects, engine, scene.params, scene.input, scene.input, scene.sections,
+                           lambda section=None, key=None: src)
+
+    def refuse_unused(self, effects: Mapping[str, Any], engine: str | None, params: Mapping[str, Any],
+                      given: Mapping[str, Any], inp: Mapping[str, Any], sections: Mapping[str, Any],
+                      where: Callable[..., str]) -> None:
+        """No input silently ignored: a parameter, input key (`given`, the scene's own; away from its declared
+        default) or model section that the effects (and path `engine`; None: the effects only) do not use (`uses`), or
+        an effect value the path does not model, is a SceneError naming each such key, where it came from
+        (`where(section, key)`, a phrase with a leading space) and why."""
+        decls = self.inputs.get(inp.get("type"), {}) if self.inputs else {}
+        inputs = [k for k in given if k != "type" and not (
+            isinstance(decls.get(k), Limit) and decls[k].has_default and inp.get(k) == decls[k].default)]
+        unused = self.unused(effects, engine, [*(f"params.{k}" for k in params), *(f"input.{k}" for k in inputs),
+                                               *sections])
+        if not unused:
+            return
+        shown = []
+        for key, why in unused.items():
+            section, _, name = key.partition(".")
+            value = {"params": params, "input": inp, "effects": effects}.get(section, {}).get(name)
+            what = f"[{key}]" if not name else f"{key} = {value!r}"
+            shown.append(f"{what}{where(section, name or None)}: {why}")
+        on = f"on the {engine} path" if engine else "with these effects"
+        raise SceneError(f"not used by this scene {on} (model '{self.name}'), so it would be silently ignored: "
+                         f"{'; '.join(shown)}. Remove it, or change the effects or path so that it takes part")
+
+    def unused(self, effects: Mapping[str, Any], engine: str | None, keys: Iterable[str]) -> dict[str, str]:
+        """Of `keys` (`"params.KEY"`, `"input.KEY"`, section names) those this configuration does not use, with why;
+        and `"effects.NAME"` for an effect value the path `engine` does not model (`engine` None: judge the effects
+        only)."""
+        out = {k: why for k in keys if k in self.uses
+               and (why := self.uses[k].unused_because(effects, engine)) is not None}
+        path = self.paths.get(engine) if engine is not None else None
+        for name, values in (path.lacks if path else {}).items():
+            if _matches(effects[name], values):
+                able = [k for k, p in self.paths.items() if not _matches(effects[name], p.lacks.get(name, ()))]
+                out[f"effects.{name}"] = (f"the {engine} path does not model {name} = {effects[name]!r} (paths that "
+                                          f"do: {able})")
+        return out
 
     @property
     def engines(self) -> tuple[str, ...]:

@@ -201,7 +201,7 @@ def _param_value(spec: ModelSpec, key: str, value: Any, where: str) -> Any:
         raise SceneError(f"parameter {key} = {value!r}{where} must be a single value (SI units), not a "
                          f"{'list' if isinstance(value, list) else 'table'}")
     if lim is not None:
-        return lim.check(f"{spec.name} parameter {key}{where}", value, ParameterError)
+        return lim.check(f"{spec.name} parameter {key}", value, ParameterError, where)
     if isinstance(value, str) or real(value) is None:
         raise SceneError(f"parameter {key} = {value!r}{where} must be a number (SI units)")
     if not math.isfinite(real(value)):
@@ -281,7 +281,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
             if not isinstance(decl, Limit):
                 continue
             if key in inp:
-                inp[key] = decl.check(f"input.{key}{where('input', key)}", inp[key], SceneError)
+                inp[key] = decl.check(f"input.{key}", inp[key], SceneError, where('input', key))
             elif decl.has_default:
                 inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
             if decl.kind is float and decl.choices is None and isinstance(inp.get(key), float):
@@ -321,6 +321,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
         solver_in["engine"] = spec.path_key(solver_in["engine"])  # a path's label ("equations") names its key
     solver = dataclasses.replace(spec.solver, **solver_in)
     solver = solver.check(spec.engines, lambda key=None: where("solver", key))
+    spec.refuse_unused(effects, None, params, data.get("input") or {}, inp, extra, where)
 
     scene = Scene(
         model=spec.name,

@@ -57,7 +57,7 @@ class SolverSettings:
         if not isinstance(self.allow_inaccurate, bool):
             raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r}{w('allow_inaccurate')} must be "
                              "true or false")
-        s = dataclasses.replace(self, **{name: lim.check(f"solver.{name}{w(name)}", getattr(self, name), SceneError)
+        s = dataclasses.replace(self, **{name: lim.check(f"solver.{name}", getattr(self, name), SceneError, w(name))
                                          for name, lim in SOLVER_LIMITS.items()})
         if s.t_settle >= s.duration:
             raise SceneError(

@@ -35,24 +35,31 @@ def test_a_value_below_the_floor_is_refused_by_name_and_the_floor_builds(model, 
     lim = limit_of(get_model(model).params_cls, key)
     assert lim.lo is not None and lim.lo > 0 and not lim.lo_open, f"{model}.{key} declares no positive floor"
     sc = mbsuite.load_scene(model)
+    if key == "massless_factor":
+        sc = sc.replace(effects={"link_inertia": "massless"})  # the effect that uses it
     for bad in (lim.lo / 10, 1e-12, 0.0):
-        with pytest.raises(mbsuite.ParameterError, match=rf"{key} set in Python \(Scene\.replace\) = .* is invalid"):
+        with pytest.raises(mbsuite.ParameterError, match=rf"{key} = .* set in Python \(Scene\.replace\) is invalid"):
             sc.replace(params={key: bad})
     spec = sc.spec
     if spec.mujoco_model is not None:
         # the partners of the checks across fields: A + B >= C of shaft b, the massless link's inertia
-        extra = {"i_shaft_b_trans": {"i_shaft_b_axial": lim.lo}, "m_link": {"massless_factor": 1.0}}.get(key, {})
+        extra = {"i_shaft_b_trans": {"i_shaft_b_axial": lim.lo}}.get(key, {})
         spec.mujoco_model(sc.replace(params={key: lim.lo, **extra}))  # MuJoCo accepts the floor
 
 
-@pytest.mark.parametrize("effect", ["real", "massless"])
-def test_the_coupler_link_inertia_floor_across_parameters(effect):
-    """The massless link's axial inertia m_link massless_factor r^2 / 2 (hand-computed below) is refused below 1e-12
-    kg m^2 naming all three; at 1.0e-12 MuJoCo builds it (both link_inertia effects)."""
-    sc = mbsuite.load_scene("coupler").replace(effects={"link_inertia": effect})
-    with pytest.raises(mbsuite.ParameterError, match=r"m_link = 1e-06 kg, massless_factor = 1\.0, link_radius = "
-                                                     r"0\.001 m .* = 5e-13 kg m\^2"):
-        sc.replace(params={"m_link": 1e-6, "massless_factor": 1.0, "link_radius": 1e-3})
-    sc.spec.mujoco_model(sc.replace(params={"m_link": 1e-6, "massless_factor": 1.0, "link_radius": 2e-3 ** 0.5}))
+def test_the_coupler_link_inertia_floor_across_parameters():
+    """A link's axial inertia m r^2 / 2 (hand-computed in the patterns) below 1e-12 kg m^2 is refused naming the
+    parameters: the real link when the scene is built, the massless link (m = m_link massless_factor) when MuJoCo's
+    model is built; at 1e-12 MuJoCo builds both. Shaft b's principal inertias must satisfy A + B >= C."""
+    sc = mbsuite.load_scene("coupler")
+    with pytest.raises(mbsuite.ParameterError, match=r"m_link = 1e-06 kg, link_radius = 0\.001 m give the real link "
+                                                     r"an axial inertia .* = 5e-13 kg m\^2"):
+        sc.replace(params={"m_link": 1e-6, "link_radius": 1e-3})
+    sc.spec.mujoco_model(sc.replace(params={"m_link": 1e-6, "link_radius": 2e-6 ** 0.5}))
+    ml = sc.replace(effects={"link_inertia": "massless"})
+    with pytest.raises(mbsuite.ParameterError, match=r"m_link = 1\.0 kg, massless_factor = 1e-06, link_radius = 0\.001"
+                                                     r" m give the massless link an axial inertia .* = 5e-13 kg m\^2"):
+        ml.spec.mujoco_model(ml.replace(params={"m_link": 1.0, "massless_factor": 1e-6, "link_radius": 1e-3}))
+    ml.spec.mujoco_model(ml.replace(params={"m_link": 1.0, "massless_factor": 1e-6, "link_radius": 2e-6 ** 0.5}))
     with pytest.raises(mbsuite.ParameterError, match=r"i_shaft_b_axial = 20\.0 kg m\^2 > 2 i_shaft_b_trans"):
         sc.replace(params={"i_shaft_b_trans": 9.0})

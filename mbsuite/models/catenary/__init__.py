@@ -9,13 +9,21 @@ from pathlib import Path
 
 from ...accuracy import AccuracySpec
 from ...limits import Limit
-from ...registry import Effect, ModelSpec, RunPath
+from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
 from . import accuracy, mujoco, reference
 from .config import validate_train_section
-from .pantographs import PANTOGRAPHS, validate_section
+from .pantographs import PANTOGRAPH_MODELS, PANTOGRAPHS, TWO_MASS, validate_section
 from .params import CatenaryParams
 from .quality import validate_section as validate_quality
+
+#: the 2-mass reference pantograph's parameters are read only when it runs; a registry pantograph takes its own from the
+#: [pantograph] section (measured: a 10 % change of each moves no output under the Eppinger pantograph;
+#: `tests/suite/test_unused_input.py`)
+USES = {
+    **{f"params.{k}": Uses(effects={"pantograph": (TWO_MASS,)}) for k in ("m1", "k1", "c1", "m2", "k2", "c2", "F0")},
+    "pantograph": Uses(effects={"pantograph": tuple(PANTOGRAPH_MODELS)}),
+}
 
 SPEC = ModelSpec(
     name="catenary",
@@ -50,4 +58,5 @@ SPEC = ModelSpec(
     sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train_section},
     cases="mbsuite.models.catenary.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
+    uses=USES,
 )

@@ -138,8 +138,9 @@ def build(p: CouplerParams, effects: dict, inp: dict[str, float], timestep: floa
             f"solver.timestep = {timestep:g} s is too large for the dry-friction constraints: MuJoCo needs "
             f"solref_friction_timeconst ({tf:g} s) >= 2 timestep and would silently stiffen it; use timestep <= "
             f"{tf / 2:g} s, raise params.solref_friction_timeconst or leave it unset (2 timesteps)")
-    spec = mjspec_variant(p, "double")
     massless = effects["link_inertia"] == "massless"
+    p.link_floor(massless)  # by name, before MuJoCo's own message (which names no parameter)
+    spec = mjspec_variant(p, "double")
     scale = p.massless_factor if massless else 1.0
     it, ia = link_inertia(p, p.m_link * scale)
     for k in range(8):

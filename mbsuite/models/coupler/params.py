@@ -20,7 +20,8 @@ GAMMAS_PAPER = (0.11, 0.297, 0.391)  # the paper's Sect. 3.1 and 3.4
 #: inertia is below mjMINVAL = 1e-15 ("mass and inertia of moving bodies must be larger than mjMINVAL"), which names
 #: no parameter; these floors (the pantograph's) refuse such values by name, well above it
 MASS_MIN, INERTIA_MIN = 1e-6, 1e-9
-#: the smallest principal inertia of an SS link (axial, m r^2 / 2; in the massless limit the mass is scaled too)
+#: the smallest principal inertia of an SS link (axial, m r^2 / 2; in the massless limit the mass is scaled too:
+#: `link_floor`, checked where the effect is known)
 LINK_INERTIA_MIN = 1e-12
 
 
@@ -79,17 +80,23 @@ class CouplerParams:
         if self.l_b <= 2.0 * self.link_radius:
             raise ParameterError(f"coupler parameter l_b = {self.l_b!r} m is too short for link_radius = "
                                  f"{self.link_radius!r} m (need l_b > 2 link_radius)")
-        ia = self.m_link * self.massless_factor * self.link_radius ** 2 / 2
-        if ia < LINK_INERTIA_MIN:
-            raise ParameterError(
-                f"coupler parameters m_link = {self.m_link!r} kg, massless_factor = {self.massless_factor!r}, "
-                f"link_radius = {self.link_radius!r} m give the massless link an axial inertia m_link massless_factor "
-                f"link_radius^2 / 2 = {ia:.3g} kg m^2 below {LINK_INERTIA_MIN:g} (a body MuJoCo cannot move): raise "
-                "one of them")
+        self.link_floor(massless=False)
         if self.i_shaft_b_axial > 2.0 * self.i_shaft_b_trans:
             raise ParameterError(
                 f"coupler parameters i_shaft_b_axial = {self.i_shaft_b_axial!r} kg m^2 > 2 i_shaft_b_trans = "
                 f"{2.0 * self.i_shaft_b_trans!r} kg m^2: no rigid body has these principal inertias (A + B >= C)")
+
+    def link_floor(self, massless: bool) -> None:
+        """Refuse, naming the parameters, an SS link whose axial inertia m r^2 / 2 (m = m_link, times massless_factor
+        in the massless limit) is below LINK_INERTIA_MIN: a body MuJoCo cannot move."""
+        factor, scaled = (self.massless_factor, " massless_factor") if massless else (1.0, "")
+        ia = self.m_link * factor * self.link_radius ** 2 / 2
+        if ia < LINK_INERTIA_MIN:
+            named = f", massless_factor = {self.massless_factor!r}" if massless else ""
+            raise ParameterError(
+                f"coupler parameters m_link = {self.m_link!r} kg{named}, link_radius = {self.link_radius!r} m give "
+                f"the {'massless' if massless else 'real'} link an axial inertia m_link{scaled} link_radius^2 / 2 = "
+                f"{ia:.3g} kg m^2 below {LINK_INERTIA_MIN:g} (a body MuJoCo cannot move): raise one of them")
 
     @property
     def l0(self) -> float:

@@ -1,5 +1,5 @@
-"""Command line: `mbsuite list | run | view | sweep | workprecision | perturb | hardcases` plus each model's command
-group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
+"""Command line: `mbsuite list | run | view | render | sweep | workprecision | perturb | hardcases` plus each model's
+command group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
 
 Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the
 header), PNG plots and `summary.json` (versions + scene). A model package adds its own commands by defining

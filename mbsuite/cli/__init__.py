@@ -2,8 +2,11 @@
 command group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
 
 Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the
-header), PNG plots and `summary.json` (versions + scene). A model package adds its own commands by defining
-`register(sub, add_common, emit) -> str` in its `cli` module (returning its group's command name).
+header), PNG plots and `summary.json` (versions, the checkout's commit, the command, the scene as run). A model
+package adds its own commands by defining `register(sub, add_common, emit) -> str` in its `cli` module (returning
+its group's command name) and declaring there `CLI_COMMANDS = {name: help}`, the top-level commands it adds, which
+the parser reads without importing the model (so `mbsuite --version`, `--help` and the generic commands start at
+once).
 
 Every command that reads a scene also takes a `summary.json` an earlier command wrote (the scene it ran), and the
 model analyses take `--set SECTION.KEY=VALUE` and `--vary SECTION.KEY=VALUES` (a parameter study of the analysis).

@@ -80,6 +80,7 @@ def cmd_view(args: argparse.Namespace) -> None:
 def cmd_render(args: argparse.Namespace) -> None:
     """`mbsuite render SCENE --out PNG`: the scene's MuJoCo model in its initial state, rendered offscreen (EGL unless
     MUJOCO_GL says otherwise; no display needed) from its first camera, else MuJoCo's free camera, to a PNG."""
+    late = "mujoco" in sys.modules and "MUJOCO_GL" not in os.environ  # its GL backend was chosen already
     os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported: it picks its GL backend once
     path = Path(args.image)
     if path.suffix.lower() != ".png":
@@ -101,9 +102,10 @@ def cmd_render(args: argparse.Namespace) -> None:
             renderer.update_scene(data, camera=0 if model.ncam else -1)
             image = renderer.render()
     except Exception as exc:  # no GL context: say how to get one
-        raise MbsuiteError(f"offscreen rendering failed ({type(exc).__name__}: {exc}); MUJOCO_GL="
-                           f"{os.environ.get('MUJOCO_GL')!r}: set MUJOCO_GL=egl (GPU or software EGL) or osmesa "
-                           "before mbsuite starts") from exc
+        why = ("mujoco was imported in this process before MUJOCO_GL was set, so it chose its default (windowed) "
+               "backend" if late else f"MUJOCO_GL={os.environ.get('MUJOCO_GL')!r}")
+        raise MbsuiteError(f"offscreen rendering failed ({type(exc).__name__}: {exc}); {why}: set MUJOCO_GL=egl "
+                           "(GPU or software EGL) or osmesa before mbsuite or mujoco is imported") from exc
     from matplotlib.image import imsave
 
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -186,7 +186,8 @@ def test_wheel_runs_every_command_outside_the_checkout(installed):
     """Every command of the command line, from the installed wheel, in a directory outside the checkout: each exits
     as it must (0, or 2 with its one-line message for `view` without a display), none with an internal error."""
     py, _site, work, env = installed
-    env = {k: v for k, v in env.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    # headless, as a server runs it: no display, offscreen GL chosen before the first command imports mujoco
+    env = {**{k: v for k, v in env.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}, "MUJOCO_GL": "egl"}
     run = subprocess.run([str(py), "-c", PROBE_CLI, json.dumps([argv for argv, _ in COMMANDS])], cwd=work,
                          capture_output=True, text=True, timeout=1800, env=env)
     assert run.returncode == 0, run.stderr[-3000:]

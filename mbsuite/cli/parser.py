@@ -145,6 +145,8 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--vary", action="append", metavar="SECTION.KEY=VALUES",
                    help="a grid axis: comma list or start:stop:step, e.g. input.frequency=1:30:0.5 (repeatable: "
                         "the grid is the product)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
+                   help="change one value of the scene at every point, e.g. params.mh=14 (repeatable)")
     p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
     p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
     add_error_estimate(p)

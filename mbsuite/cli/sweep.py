@@ -36,8 +36,11 @@ def grid_axes(vary: list[str] | None, max_points: int) -> list[tuple[str, str, l
 
 
 def cmd_sweep(args: argparse.Namespace) -> None:
-    """Run the scene at every point of the grid, tabulate the chosen signals, emit the report."""
-    scene = load(args)
+    """Run the scene (with `--set` applied) at every point of the grid, tabulate the chosen signals, emit the
+    report."""
+    from .study import apply_sets
+
+    scene = apply_sets(load(args), getattr(args, "set_values", None))
     check_workers(args.workers)
     options = sweep_options(args)
     axes = grid_axes(args.vary, options.max_points)

@@ -85,3 +85,12 @@ def test_a_command_without_a_scene_varies_its_options(capsys):
     assert main(["coupler", "jacobian", "--vary", "option.nosuch=1"]) == 2
     err = capsys.readouterr().err
     assert "no option 'nosuch'" in err and "'gamma'" in err
+
+
+def test_sweep_set_applies_at_every_point(capsys):
+    """`mbsuite sweep --set solver.duration=0.2 --vary solver.timestep=...`: every point runs 0.2 s, so its step
+    count is duration / timestep (hand computation)."""
+    assert main(["sweep", "iftomm/fourbar", "--set", "solver.duration=0.2", "--vary", "solver.timestep=1e-3,5e-4",
+                 "--workers", "1", "--json"]) == 0
+    data = _json(capsys)
+    assert [p["stats"]["steps"] for p in data["points"]] == [round(0.2 / 1e-3), round(0.2 / 5e-4)]

@@ -38,7 +38,7 @@ test-slow: $(STAMP)  ## long studies only
 	$(BIN)/python -m pytest -q -m slow
 
 test-lowest: $(LOW_STAMP)  ## default suite at the lowest versions pyproject.toml allows, in .venv-lowest
-	$(LOW_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|matplotlib|distributed|tqdm|mujoco|pin|pytest|hypothesis)=='
+	$(LOW_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|matplotlib|distributed|tqdm|mujoco|pin|pytest|hypothesis|pandas)=='
 	$(LOW_VENV)/bin/python -m pytest -q
 
 lock:  ## constraints/tested.txt <- the versions installed in .venv (after `make test` passed there)

@@ -90,3 +90,58 @@ def test_uses_declarations_name_real_keys_and_values():
         ModelSpec(**{**kw, "uses": {"params.penalti": Uses(engines=("reference",))}})
     with pytest.raises(ValueError, match="not declared"):
         ModelSpec(**{**kw, "uses": {"params.penalty": Uses(effects={"mechanism": ("fourbars",)})}})
+
+
+# --- the declarations measured: every key the configuration uses moves an output ----------------------------------
+SHORT = {"pantograph": {"solver": {"duration": 0.4, "t_settle": 0.0}},
+         "coupler": {"solver": {"duration": 0.5, "t_settle": 0.0}},
+         "iftomm": {"solver": {"duration": 1.0}},
+         "catenary": {"params": {"n_spans": 3, "x_end": 170.0, "window_start": 60.0, "window_end": 120.0}}}
+#: the coupler's reference path is the rigid kinematic limit of any scene (its `what`): not narrowed by `uses`
+EXEMPT_PATHS = {("coupler", "reference")}
+
+
+def _fingerprint(res) -> list[np.ndarray]:
+    stats = [float(v) for _, v in sorted(res.stats.items()) if isinstance(v, int | float)]
+    return [np.asarray(v, float).ravel() for v in res.signals.values()] + [np.array(stats)]
+
+
+def _moves(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
+    return len(a) != len(b) or any(x.shape != y.shape or not np.allclose(x, y, rtol=1e-9, atol=1e-12, equal_nan=True)
+                                   for x, y in zip(a, b, strict=True))
+
+
+SLOW_CASES = [(m, label, eff, e) for m, label, eff in CASES for e in get_model(m).engines
+              if (m, e) not in EXEMPT_PATHS]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model,label,effects,engine", SLOW_CASES,
+                         ids=[f"{m}-{lab}-{e}" for m, lab, _, e in SLOW_CASES])
+def test_every_key_that_moves_nothing_is_declared_unused(model, label, effects, engine):
+    """Each parameter this configuration accepts, changed by 10 % (or -10 % where +10 % leaves its range), moves
+    some output or statistic of a short run; the keys that move nothing are exactly the ones `uses` refuses."""
+    spec = get_model(model)
+    try:
+        short = {**SHORT[model], "solver": {**SHORT[model].get("solver", {}), "engine": engine,
+                                            "allow_inaccurate": True}}  # a comparison of runs, not a result
+        sc = mbsuite.load_scene(model).replace(effects=effects, **short)
+        spec.check_used(sc, engine)
+    except SceneError:
+        pytest.skip("this path does not model these effects (refused by name)")
+    base = _fingerprint(mbsuite.run(sc))
+    still = []
+    for f in dataclasses.fields(spec.params_cls):
+        v = getattr(sc.build_params(), f.name)
+        if f"params.{f.name}" in spec.unused(sc.effects, engine, [f"params.{f.name}"]) or v is None \
+                or isinstance(v, list) or f.name in SHORT[model].get("params", {}):
+            continue
+        for c in ([v * 1.1, v * 0.9] if v else [0.1, 1.0]) if not isinstance(v, int) else [v + 1, v - 1]:
+            try:
+                s2 = sc.replace(params={f.name: c})
+            except mbsuite.MbsuiteError:
+                continue
+            if not _moves(base, _fingerprint(mbsuite.run(s2))):
+                still.append(f.name)
+            break
+    assert still == [], f"{model} {label} on {engine}: {still} move no output but are not declared unused"

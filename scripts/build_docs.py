@@ -29,7 +29,7 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
      ["freqresp.png"], "Response amplitude and phase of F1, F2, HD and y_d per unit ram amplitude, from the "
      "linearisation about the mean ram height and from MuJoCo time simulations, with the thesis' resonances."),
     ("Pantograph time history", "mbsuite run pantograph", ["run.png"],
-     "The lab scene's signals over time, one panel per unit."),
+     "The lab scene's signals over time, one panel per group of signals of one unit and comparable scale."),
     ("EN 50318 passage", "mbsuite catenary catenary/en50318 --speed 250 --quality",
      ["force_uplift_reference2mass_250kmh.png", "quality_reference2mass_250kmh.png"],
      "Contact force, contact-wire height and uplift along the section; the current-collection quality criteria."),
@@ -40,6 +40,24 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
      ["efficiency.png"], "Efficiency and loss breakdown of the step-up drive against load speed."),
     ("Work-precision", "mbsuite workprecision drives/coupled_clutches --quick --repeats 1", ["workprecision.png"],
      "Error against wall time for every engine and setting; each point labelled with its step or tolerance."),
+    ("Two pantographs on one train", "mbsuite catenary catenary/en50318_two_pantographs --speed 300 --quality",
+     ["train_force_300kmh.png", "quality_train_300kmh.png"],
+     "Both pantographs' contact forces along the section 200 m apart at 300 km/h; their quality criteria."),
+    ("A parameter study of an analysis", "mbsuite modes pantograph --vary params.mh=10:16:2", ["study.png"],
+     "The pantograph's natural frequencies against its head mass (`--vary` on modes, freqresp, equilibrium, "
+     "catenary and the coupler and drive commands)."),
+    ("A sweep of time runs", "mbsuite sweep pantograph --vary input.frequency=2,4,6", ["sweep.png"],
+     "Each output signal's range over the swept values."),
+    ("Coupler dynamics", "mbsuite coupler dynamics coupler/double_lateral", ["run.png"],
+     "Input torque, coupler-angle error, closure residual and link forces of the double coupler on MuJoCo."),
+    ("Coupler revolution", "mbsuite coupler fpp", ["fpp_single.png"],
+     "The single coupler's pose over a revolution of its input (the forward position problem by continuation)."),
+    ("Drive run", "mbsuite drive run drives/step_up_pwm", ["run.png"],
+     "Speeds, spring twist, energies and clutch/brake commands of the PWM-switched step-up drive."),
+    ("Coupled clutches against the Modelica reference", "mbsuite drive coupled-clutches", ["coupled_clutches.png"],
+     "The Modelica Standard Library's CoupledClutches example on both paths against its reference result."),
+    ("Drive design tables", "mbsuite drive design tables", ["design_tables.png"],
+     "The thesis' Chapter 5 design tables recomputed."),
 ]
 
 
@@ -71,15 +89,20 @@ def _figures(out: Path) -> None:
             hits = sorted(d.rglob(f))
             if not hits:
                 raise SystemExit(f"gallery: {cmd!r} wrote no {f} into {d}")
-            shutil.copy2(hits[0], dest / f)
+            shutil.copy2(hits[0], dest / _name(i, f))
+
+
+def _name(i: int, f: str) -> str:
+    """A gallery figure's file: its command's index and the name the command gave it (several write `run.png`)."""
+    return f"{i:02d}_{f}"
 
 
 def _gallery_page() -> None:
     lines = ["# Gallery", "", "Every figure below is written by the command above it (`--out DIR`); the same "
              "directory also holds the CSV files (SI units in the header) and `summary.json`.", ""]
-    for title, cmd, files, what in GALLERY:
+    for i, (title, cmd, files, what) in enumerate(GALLERY):
         lines += [f"## {title}", "", f"```\n{cmd} --out DIR\n```", "", what, ""]
-        lines += [f"![{title}](gallery/{f})" for f in files] + [""]
+        lines += [f"![{title}](gallery/{_name(i, f)})" for f in files] + [""]
     (DOCS / "gallery.md").write_text("\n".join(lines))
 
 
@@ -91,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
     _gallery_page()
     if not args.no_figures:
         _figures(ROOT / "out" / "docs-figures")
-    missing = [f for _, _, files, _ in GALLERY for f in files if not (DOCS / "gallery" / f).is_file()]
+    missing = [_name(i, f) for i, (_, _, files, _) in enumerate(GALLERY) for f in files
+               if not (DOCS / "gallery" / _name(i, f)).is_file()]
     if missing:
         print(f"gallery figures missing: {missing}; run without --no-figures", file=sys.stderr)
         return 2

@@ -121,9 +121,9 @@ def test_dynamics_command_json_and_csv(tmp_path, capsys):
     assert main(["coupler", "dynamics", str(scene), "--json", "--out", str(tmp_path / "o")]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["stats"]["warnings"] == {} and d["stats"]["closure_residual_max"] < 2e-4
-    header = (tmp_path / "o" / "timeseries.csv").read_text().splitlines()[0]
+    header = (tmp_path / "o" / "run.csv").read_text().splitlines()[0]
     assert "torque_in [N m]" in header and "link_force_8 [N]" in header
-    assert (tmp_path / "o" / "timeseries.png").stat().st_size > 10_000
+    assert (tmp_path / "o" / "run.png").stat().st_size > 10_000
 
 
 def test_dynamics_table_has_units_and_fits(tmp_path, capsys):

@@ -172,7 +172,7 @@ def write_dynamics(res, out: Path) -> list[Path]:
     from ...plotting import save
     from .plots import dynamics_figure
 
-    return [res.write_csv(out / "timeseries.csv"), save(dynamics_figure(res), out / "timeseries.png")]
+    return [res.write_csv(out / "run.csv"), save(dynamics_figure(res), out / "run.png")]
 
 
 def _dynamics_scene(args: argparse.Namespace) -> Scene:

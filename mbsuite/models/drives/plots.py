@@ -106,7 +106,8 @@ _RUN_PANELS: tuple[tuple[tuple[str, ...], str, dict[str, str]], ...] = (
 def run_figure(res: Any) -> Figure:
     """Time histories of a drive run (`mbsuite.results.SimResult` of a step-up or step-up/step-down scene): the three
     speeds, the spring twist, the cumulative energies and the clutch/brake commands (after their delays). Other
-    mechanisms (the Modelica examples) get `SimResult.plot()`, one panel per unit."""
+    mechanisms (the Modelica examples) get `SimResult.plot()` (`SimResult.panels`: signals of one unit and comparable
+    scale share a panel)."""
     panels = [(ks, lab, names) for ks, lab, names in _RUN_PANELS if any(k in res.signals for k in ks)]
     if not any("w_load" in ks for ks, _, _ in panels):
         return res.plot()

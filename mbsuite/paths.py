@@ -5,6 +5,7 @@ inside the package (`mbsuite/_modelfiles/`). `models_root()` looks, in order, in
 holding `mjcf/` and `models_urdf/`), in the installed package, and next to the package (an editable install).
 
     >>> import mujoco, mbsuite
+    >>> _ = mbsuite.native.load()            # the model files' effects are mbsuite's engine plugins
     >>> model = mujoco.MjModel.from_xml_path(str(mbsuite.model_file("pantograph")))        # mjcf/pantograph.xml
     >>> urdf = mbsuite.model_file("coupler_double", "urdf")                                 # models_urdf/...urdf
 """

@@ -106,3 +106,21 @@ def test_model_readme_lists_every_parameter_and_input(name):
     keys = sorted({k for keys in spec.inputs.values() for k in keys})
     missing = [n for n in [*fields, *keys] if f"`{n}`" not in text and f"| {n} |" not in text]
     assert not missing, f"{name} README does not list: {missing}"
+
+
+def _docstring_example_modules() -> list[str]:
+    """Every mbsuite module whose docstrings hold a `>>>` example."""
+    root = Path(mbsuite.__file__).parent
+    return sorted(".".join(f.relative_to(root.parent).with_suffix("").parts).removesuffix(".__init__")
+                  for f in root.rglob("*.py") if ">>> " in f.read_text())
+
+
+@pytest.mark.parametrize("module", _docstring_example_modules())
+def test_docstring_examples_run(module):
+    """Every `>>>` example in a docstring runs (doctest: no exception, and printed output as written)."""
+    import doctest
+    import importlib
+
+    res = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
+                          verbose=False, report=True)
+    assert res.attempted > 0 and res.failed == 0, f"{module}: {res.failed} of {res.attempted} examples failed"

@@ -2,9 +2,9 @@
 
 One documented call makes MuJoCo know mbsuite's plugins, in any script or viewer session:
 
-    >>> import mbsuite.native                  # the same module as mbsuite.engines.native
-    >>> mbsuite.native.load()                  # compiles once (cached), registers the plugins with MuJoCo
-    >>> m = mujoco.MjModel.from_xml_path(str(mbsuite.paths.mjcf_path("pantograph")))
+    >>> import mujoco, mbsuite.native          # the same module as mbsuite.engines.native
+    >>> _ = mbsuite.native.load()              # compiles once (cached), registers the plugins with MuJoCo
+    >>> m = mujoco.MjModel.from_xml_path(str(mbsuite.model_file("pantograph")))
 
 The sources are `core.c` here and every model package's `native/*.c`. They are compiled with the system
 C compiler (`cc`, or `$CC`) against the headers that the installed mujoco wheel ships (`mujoco/include`), linked to

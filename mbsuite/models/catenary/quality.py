@@ -156,52 +156,67 @@ def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path) -> Path:
     return save(figure(assessments), path)
 
 
-#: short axis labels of the criteria (the table's labels are longer)
-_SHORT = {"mean_force": "mean force\nFm", "sigma": "std. dev.\nσ", "stat_min": "stat. min.\nFm − 3σ",
-          "contact_loss": "contact\nloss", "arcing_nq": "arcing\nNQ", "uplift": "uplift at\nsteady arm"}
+#: each criterion's panel title and unit (the table's labels are longer)
+_PANELS = {"mean_force": ("mean force Fm", "N"), "sigma": ("standard deviation σ", "N"),
+           "stat_min": ("statistical minimum Fm − 3σ", "N"), "contact_loss": ("contact loss", "%"),
+           "arcing_nq": ("arcing NQ", "%"), "uplift": ("uplift at the steady arms", "mm")}
 
 
 def figure(assessments: list[tuple[str, dict[str, Any]]]) -> MplFigure:
-    """The target band Fm(v) with each pantograph's Fm ± σ at its speed (left), and each criterion's value over its
-    limit with the verdict (right; for Fm − 3σ the ratio is 1 − (Fm − 3σ − floor) / Fm, so that above 1 fails)."""
+    """The target band Fm(v) with each pantograph's Fm ± σ at its speed (left), and one panel per criterion in its
+    own unit (right): each pantograph's value as a marker (green: pass, red: fail; a zero is drawn like any other
+    value) against the criterion's limit drawn as a line (σ ≤ r Fm: each pantograph's own limit as a short line at
+    its marker; Fm: the band between the two target curves; Fm − 3σ: the floor, passing above it)."""
     import numpy as np
 
     from ...plotting import figure as new_figure
 
-    fig, (ax, bx) = new_figure(1, 2, size=(12, 4.8))
+    fig, _ = new_figure(1, 1, size=(14, 5.2))
+    fig.clear()
+    grid = fig.add_gridspec(2, 4, width_ratios=(2.2, 1, 1, 1))
+    ax = fig.add_subplot(grid[:, 0])
+    panels = {k: fig.add_subplot(grid[i // 3, 1 + i % 3]) for i, k in enumerate(CRITERIA)}
     c = QualityCriteria(**assessments[0][1]["criteria"])
     v = np.linspace(0.0, max(400.0, max(q["speed_kmh"] for _, q in assessments)), 200)
     ax.fill_between(v, c.fm_a * v**2 + c.fm_b_lower, c.fm_a * v**2 + c.fm_b, color="0.85",
                     label=f"target band ({c.system}): Fm = {c.fm_a:g} v² + [{c.fm_b_lower:g}, {c.fm_b:g}] N, "
                           "v in km/h")
-    names = list(CRITERIA)
-    width = 0.8 / len(assessments)
-    hatches = ("", "//", "..", "xx")
+    x = np.arange(len(assessments))
     for i, (name, q) in enumerate(assessments):
         r = q["rows"]
         ax.errorbar([q["speed_kmh"] + 4 * (i - (len(assessments) - 1) / 2)], [r["mean_force"]["value"]],
                     yerr=[r["sigma"]["value"]], fmt="o", capsize=4,
                     label=f"{name}: Fm ± σ ({'pass' if q['pass'] else 'FAIL'})")
-        ratios = []
-        for k in names:
-            row = r[k]
-            if k == "mean_force":
-                ratios.append(row["value"] / row["high"])
-            elif k == "stat_min":
-                ratios.append(1.0 - (row["value"] - row["low"]) / max(r["mean_force"]["value"], 1e-9))
-            else:
-                ratios.append(row["value"] / row["high"] if row["high"] > 0 else (0.0 if row["value"] <= 0 else 2.0))
-        colors = ["tab:green" if r[k]["pass"] else "tab:red" for k in names]
-        bx.bar(np.arange(len(names)) + i * width, ratios, width, color=colors, edgecolor="k",
-               hatch=hatches[i % len(hatches)], label=name)
-    bx.axhline(1.0, color="k", lw=1)
-    bx.set_xticks(np.arange(len(names)) + 0.4 - width / 2, [_SHORT[k] for k in names], fontsize=8)
-    bx.set_ylabel("value / limit [-] (green: pass, red: fail)")
-    bx.set_title(f"current-collection criteria ({c.system}) at {assessments[0][1]['speed_kmh']:g} km/h", fontsize=10)
+    for k, px in panels.items():
+        title, unit = _PANELS[k]
+        rows = [q["rows"][k] for _, q in assessments]
+        vals = [row["value"] for row in rows]
+        if k == "mean_force":
+            px.axhspan(rows[0]["low"], rows[0]["high"], color="0.85", label="target band")
+        elif k == "stat_min":
+            px.axhline(rows[0]["low"], color="k", lw=1.2, label=f"floor {rows[0]['low']:g} {unit}")
+        elif k == "sigma":
+            for xi, row in zip(x, rows, strict=True):
+                px.hlines(row["high"], xi - 0.35, xi + 0.35, color="k", lw=1.2,
+                          label=f"limit {c.sigma_ratio_max:g} Fm" if xi == 0 else None)
+        else:
+            px.axhline(rows[0]["high"], color="k", lw=1.2, label=f"limit {rows[0]['high']:g} {unit}")
+        px.scatter(x, vals, s=40, zorder=3, c=["tab:green" if row["pass"] else "tab:red" for row in rows],
+                   edgecolors="k")
+        px.set_xticks(x, [name for name, _ in assessments], fontsize=7, rotation=20)
+        px.set_xlim(-0.6, len(assessments) - 0.4)
+        px.set_title(f"{title} [{unit}]", fontsize=9)
+        px.legend(fontsize=6, loc="best")
+        px.grid(True, lw=0.3, axis="y")
+        lo = min(0.0, *vals, *(row.get("low", 0.0) for row in rows))
+        hi = max(*vals, *(row.get("high", row.get("low", 0.0)) for row in rows))
+        pad = 0.12 * (hi - lo) if hi > lo else 1.0
+        px.set_ylim(lo - pad, hi + pad)
     ax.set_xlabel("train speed v [km/h]")
     ax.set_ylabel("mean contact force Fm [N]")
     ax.set_title("mean contact force Fm ± standard deviation σ vs the target band", fontsize=10)
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7, loc="upper left")
-    bx.legend(fontsize=7, title="bars (hatch)", title_fontsize=7)
+    fig.suptitle(f"current-collection criteria ({c.system}) at {assessments[0][1]['speed_kmh']:g} km/h "
+                 "(green: pass, red: fail)", fontsize=10)
     return fig

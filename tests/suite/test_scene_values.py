@@ -82,6 +82,15 @@ def test_any_sequence_of_numbers_is_a_list_valued_parameter(seq):
     assert all(type(x) is float for x in cat.params["dropper_positions"])
 
 
+def test_the_catenary_parameters_take_an_array_of_droppers_directly():
+    from mbsuite.models.catenary.params import CatenaryParams
+
+    p = CatenaryParams(dropper_positions=np.array([5, 30, 55], dtype=np.int32))
+    assert p.dropper_positions == [5.0, 30.0, 55.0] and all(type(x) is float for x in p.dropper_positions)
+    with pytest.raises(ParameterError, match="must be a list of numbers"):
+        CatenaryParams(dropper_positions="5, 30")
+
+
 def test_a_string_where_a_list_is_meant_is_an_error_never_a_list_of_characters():
     cat = mbsuite.load_scene("catenary")
     with pytest.raises(SceneError, match=r"dropper_positions = '5, 30' set in Python .* is a string, but a list"):

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass, field
 
 from ...errors import ParameterError
-from ...limits import check_fields, param
+from ...limits import check_fields, param, real
 
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
 #: dt 2e-4 s, 250 km/h: 7.3e7; 0.125 m at 5e-5 s: 1.2e9)
@@ -77,8 +77,12 @@ class CatenaryParams:
         if not self.f_damp2 > self.f_damp1:
             raise ParameterError(f"f_damp2 ({self.f_damp2}) must be above f_damp1 ({self.f_damp1})")
         dp = self.dropper_positions
-        if not isinstance(dp, list | tuple) or any(isinstance(x, bool) or not isinstance(x, int | float) for x in dp):
+        if hasattr(dp, "tolist") and not isinstance(dp, str):  # a numpy array: its numbers
+            dp = dp.tolist()
+        if not isinstance(dp, list | tuple) or any(real(x) is None for x in dp):
             raise ParameterError(f"dropper_positions must be a list of numbers (m from the support), got {dp!r}")
+        dp = [float(real(x)) for x in dp]
+        object.__setattr__(self, "dropper_positions", dp)
         for i, x in enumerate(dp):
             if not (math.isfinite(x) and 0.0 < x < self.span_length):
                 raise ParameterError(

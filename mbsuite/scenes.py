@@ -7,7 +7,7 @@ description = "Eppinger's lab test: ram attached, linear cylinder"
 [effects]            # only what the scene asks for is built; omitted effects take the model's defaults
 cylinder = "linear"
 [params]             # overrides of the model's parameter dataclass (SI units)
-k_s = 180000.0
+ks = 180000.0
 [input]
 type = "sine"
 amplitude = 1.85e-3

@@ -326,6 +326,7 @@ def _fuzz(tmp_path: Path, capsys, ref: str, duration: float, draws: int) -> None
     shipped |= {("input", k): scene.input.get(k, lim.default if lim.has_default else None)
                 for sec, k, lim in decl if sec == "input"}
     cands = [(sec, k, v) for sec, k, lim in decl if sec != "solver"
+             and not scene.spec.unused(scene.effects, scene.solver.engine, [f"{sec}.{k}"])  # refused: not read here
              and (v := _near(lim, shipped.get((sec, k)), rng)) is not None]
     for i in rng.choice(len(cands), size=min(draws, len(cands)), replace=False) if cands else []:
         section, key, value = cands[i]

@@ -108,6 +108,29 @@ def test_model_readme_lists_every_parameter_and_input(name):
     assert not missing, f"{name} README does not list: {missing}"
 
 
+@pytest.mark.parametrize("name", ["pantograph", "coupler", "drives", "catenary", "iftomm"])
+def test_model_readme_parameter_ranges_are_the_declared_ones(name):
+    """Each row `| `param` | default | valid | ...` of a model README's parameter table states the range the loader
+    enforces (`Limit.describe()` of the parameter's declaration), so the README cannot drift from the code."""
+    import dataclasses
+
+    from mbsuite.limits import limit_of
+
+    spec = mbsuite.get_model(name)
+    text = (ROOT / "mbsuite" / "models" / name / "README.md").read_text()
+    wrong = []
+    for f in dataclasses.fields(spec.params_cls):
+        lim = limit_of(spec.params_cls, f.name)
+        rows = [ln for ln in text.splitlines() if ln.startswith(f"| `{f.name}` |")]
+        if lim is None or not rows:
+            continue
+        cells = [c.strip() for c in rows[0].strip("|").split("|")]
+        core = lim.describe().removesuffix(f" {lim.unit}" if lim.unit else "")  # a table may give units apart
+        if len(cells) < 3 or not cells[2].startswith(core):
+            wrong.append(f"{f.name}: README {cells[2] if len(cells) > 2 else '?'!r}, declared {lim.describe()!r}")
+    assert not wrong, f"{name} README parameter ranges differ from the declarations: {wrong}"
+
+
 def _docstring_example_modules() -> list[str]:
     """Every mbsuite module whose docstrings hold a `>>>` example."""
     root = Path(mbsuite.__file__).parent

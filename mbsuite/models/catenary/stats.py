@@ -12,7 +12,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
 
 from ...errors import SolverError
 from .params import CatenaryParams
@@ -33,6 +32,8 @@ LOSS_CLASSES = (("short_lt_5ms", 0.0, 0.005), ("damaging_5_20ms", 0.005, 0.020),
 
 def lowpass(force: np.ndarray, dt: float, cutoff: float, order: int) -> np.ndarray:
     """Zero-phase Butterworth low-pass (forwards and backwards) of a uniformly sampled force."""
+    from scipy.signal import butter, sosfiltfilt  # here: scipy.signal costs ~0.5 s to import, the model list needs none
+
     fs = 1.0 / dt
     if not cutoff < fs / 2:
         raise SolverError(f"filter cut-off {cutoff} Hz is not below the Nyquist frequency {fs / 2} Hz of the record")

@@ -193,7 +193,6 @@ def study_report(scene: Scene | None, axes: list[tuple[str, str, list]], combos:
                  units: dict[str, str], what: str) -> Report:
     """One row per point and quantity (the axes, the quantity, its unit, its value); the data: axes, units, points."""
     from ..results import Report, format_table
-    from .sweep import axis_unit
 
     head = [f"{s}.{n}" for s, n, _ in axes]
     axis_units = {h: axis_unit(scene, s, n) if scene is not None else units.get(n, "")
@@ -263,3 +262,21 @@ def plot_study(head: list[str], axis_units: dict[str, str], combos: list[tuple],
     axs[-1, 0].set_xlabel(f"{head[0]} [{axis_units[head[0]]}]" if axis_units[head[0]] else head[0])
     fig.suptitle(f"{what} against {head[0]}", fontsize=9)
     return fig
+
+
+def axis_unit(scene, section: str, name: str) -> str:
+    """The SI unit of a swept key, from its declaration (parameter field, input key or solver setting)."""
+    from ..limits import limit_of
+    from ..solver import SOLVER_LIMITS
+
+    lim = None
+    if section == "params":
+        try:
+            lim = limit_of(scene.spec.params_cls, name)
+        except (KeyError, TypeError):
+            lim = None
+    elif section == "input":
+        lim = (scene.spec.inputs.get(scene.input.get("type"), {}) or {}).get(name)
+    elif section == "solver":
+        lim = SOLVER_LIMITS.get(name)
+    return getattr(lim, "unit", "") or ""

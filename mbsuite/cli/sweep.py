@@ -100,6 +100,8 @@ def judge_points(scene: Scene, axes: list[tuple[str, str, list]], combos: list[t
 def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
                  signals_arg: str | None) -> Report:
     """The table (one row per point and signal), the data (axes, units, points) and the CSV/PNG writer."""
+    from .study import axis_unit  # study imports this module's neighbours; the unit lookup lives there
+
     signals = [x for x in (signals_arg.split(",") if signals_arg else []) if x] or \
         sorted(results[0]["signals"]) if results else []
     head = [f"{s}.{n}" for s, n, _ in axes]
@@ -147,24 +149,6 @@ def write_sweep(out: Path, *, head: list[str], units: dict, combos: list, result
     csv_cols = [(k, units[k] if k in units else sig_units.get(k.rsplit("_", 1)[0], ""), v) for k, v in cols.items()]
     return [write_csv(Path(out) / "sweep.csv", csv_cols),
             save(plot_sweep(head, units, combos, results, signals, sig_units), Path(out) / "sweep.png")]
-
-
-def axis_unit(scene, section: str, name: str) -> str:
-    """The SI unit of a swept key, from its declaration (parameter field, input key or solver setting)."""
-    from ..limits import limit_of
-    from ..solver import SOLVER_LIMITS
-
-    lim = None
-    if section == "params":
-        try:
-            lim = limit_of(scene.spec.params_cls, name)
-        except (KeyError, TypeError):
-            lim = None
-    elif section == "input":
-        lim = (scene.spec.inputs.get(scene.input.get("type"), {}) or {}).get(name)
-    elif section == "solver":
-        lim = SOLVER_LIMITS.get(name)
-    return getattr(lim, "unit", "") or ""
 
 
 def plot_sweep(head: list[str], units: dict, combos: list, results: list, signals: list[str], sig_units: dict):

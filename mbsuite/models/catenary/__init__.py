@@ -8,10 +8,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...accuracy import AccuracySpec
+from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
-from . import accuracy, mujoco, reference
+from . import accuracy
 from .config import validate_train_section
 from .pantographs import PANTOGRAPH_MODELS, PANTOGRAPHS, TWO_MASS, validate_section
 from .params import CatenaryParams
@@ -48,10 +49,12 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="en50318",
     paths={
-        "reference": RunPath(reference.run, "fe", "FE catenary (compiled core) + the pantographs' hand-derived "
+        "reference": RunPath(Deferred("mbsuite.models.catenary.reference:run"), "fe",
+                             "FE catenary (compiled core) + the pantographs' hand-derived "
                              "equations (2-mass: the wire's trapezoidal rule, exact; Eppinger: its ODE by RK4 per "
                              "catenary step, secant-coupled)"),
-        "mujoco": RunPath(mujoco.run, "fe+mujoco", "FE catenary (compiled core) + the Eppinger pantograph on MuJoCo, "
+        "mujoco": RunPath(Deferred("mbsuite.models.catenary.mujoco:run"), "fe+mujoco",
+                          "FE catenary (compiled core) + the Eppinger pantograph on MuJoCo, "
                           "one MuJoCo step per catenary step, secant-coupled (no 2-mass pantograph alone)"),
     },
     solver=SolverSettings(engine="reference", timestep=1e-4, duration=6.1),

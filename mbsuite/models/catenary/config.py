@@ -18,7 +18,6 @@ from ...errors import ParameterError, SceneError
 from ...health import Figure, judge
 from .pantographs import PANTOGRAPHS, TWO_MASS, Pantograph
 from .params import CatenaryParams
-from .passage import steps_to_cover
 
 #: length of a pantograph head along the track (m): two contact points closer than this would share one head
 HEAD_WIDTH = 0.5
@@ -67,6 +66,8 @@ def passage_size(p: CatenaryParams, speed_ms: float, dt: float) -> tuple[int, in
     """(FE elements, time steps) of a passage, computed from the parameters without building anything: each wire
     has at least ceil(length / element_length) elements (key points only add some), the pantograph moves
     x_end - x_start at speed_ms in steps of dt."""
+    from .passage import steps_to_cover  # here: the passage module imports the FE (scipy.sparse)
+
     per_wire = math.ceil(p.length / p.element_length)
     steps = steps_to_cover(p.x_end - p.x_start, speed_ms, dt)
     return 2 * per_wire, steps

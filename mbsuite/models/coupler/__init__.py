@@ -10,12 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...accuracy import AccuracySpec
+from ...deferred import Deferred
 from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
 from . import accuracy
-from .mujoco import run_mujoco, view_model
 from .params import CouplerParams
-from .reference import run_reference
 from .scenario import INPUTS, OUTPUTS
 
 
@@ -51,16 +50,16 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).resolve().parent / "scenes",
     default_scene="double_lateral",
     paths={
-        "mujoco": RunPath(run=run_mujoco, label="mujoco",
+        "mujoco": RunPath(run=Deferred("mbsuite.models.coupler.mujoco:run_mujoco"), label="mujoco",
                           what="MuJoCo: the double coupler's dynamics (S joints as balls, SS links closed by soft "
                                "equalities)"),
-        "reference": RunPath(run=run_reference, label="kinematic",
+        "reference": RunPath(run=Deferred("mbsuite.models.coupler.reference:run_reference"), label="kinematic",
                              what="the kinematic solution (hand-derived FPP of the rigid mechanism, Maniowski & "
                                   "Czauderna; torque from the power balance)"),
     },
     cases="mbsuite.models.coupler.cases",
     solver=SolverSettings(integrator="implicitfast", timestep=5e-4, duration=2.0, t_settle=0.5, sample_dt=2e-3),
-    mujoco_model=view_model,
+    mujoco_model=Deferred("mbsuite.models.coupler.mujoco:view_model"),
     file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,

@@ -12,10 +12,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...accuracy import AccuracySpec
+from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
 from ...solver import SolverSettings
-from . import accuracy, design_scene, equations, mujoco
+from . import accuracy
 from .params import PARAM_SETS, DriveParams
 from .scene_run import SIGNALS
 
@@ -55,13 +56,13 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="step_up_pwm",
     paths={
-        "reference": RunPath(run=equations.run, label="equations",
+        "reference": RunPath(run=Deferred("mbsuite.models.drives.equations:run"), label="equations",
                              what="hand-derived equations (Oldaker Ch. 3), event-exact stick/slip (scipy DOP853 "
                                   "between events)"),
-        "mujoco": RunPath(run=mujoco.run, label="mujoco",
+        "mujoco": RunPath(run=Deferred("mbsuite.models.drives.mujoco:run"), label="mujoco",
                           what="MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
     },
-    sections={"design": design_scene.validate_section},
+    sections={"design": Deferred("mbsuite.models.drives.design_scene:validate_section")},
     cases="mbsuite.models.drives.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),

@@ -6,11 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...accuracy import AccuracySpec
+from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
-from . import accuracy, mujoco, pinocchio
-from .modelfiles import check_model_file
+from . import accuracy
 from .outputs import OUTPUTS
 from .params import IftommParams
 
@@ -34,15 +34,18 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="fourbar",
     paths={
-        "mujoco": RunPath(mujoco.run, "mujoco", "MuJoCo: the mechanism with its closures as equality constraints"),
-        "reference": RunPath(pinocchio.run, "pinocchio", "Pinocchio: M(q), h(q, v) of the same file, closures by a "
-                                                         "penalty formulation (four-bar on its branch), scipy ODE"),
+        "mujoco": RunPath(Deferred("mbsuite.models.iftomm.mujoco:run"), "mujoco",
+                          "MuJoCo: the mechanism with its closures as equality constraints"),
+        "reference": RunPath(Deferred("mbsuite.models.iftomm.pinocchio:run"), "pinocchio",
+                             "Pinocchio: M(q), h(q, v) of the same file, closures by a "
+                             "penalty formulation (four-bar on its branch), scipy ODE"),
     },
     cases="mbsuite.models.iftomm.cases",
     solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="DOP853", rtol=1e-8, atol=1e-10,
                           duration=10.0, sample_dt=1e-2),
-    mujoco_model=mujoco.view_model,
-    file_checks={"iftomm_fourbar": check_model_file, "iftomm_bricard": check_model_file},
+    mujoco_model=Deferred("mbsuite.models.iftomm.mujoco:view_model"),
+    file_checks={"iftomm_fourbar": Deferred("mbsuite.models.iftomm.modelfiles:check_model_file"),
+                 "iftomm_bricard": Deferred("mbsuite.models.iftomm.modelfiles:check_model_file")},
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
 )

@@ -3,13 +3,17 @@ health figures (closure residual and energy drift, with the bounds of each path)
 
 from __future__ import annotations
 
-import mujoco
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...health import Figure
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from .geometry import BAR, Trajectory
+
+if TYPE_CHECKING:
+    import mujoco
 
 OUTPUTS = {"input_angle": "rad", "input_rate": "rad/s", "branch_angle": "rad", "energy": "J", "energy_drift": "J",
            "closure_residual": "m"}
@@ -31,6 +35,8 @@ def branch_angle(mechanism: str, q: np.ndarray) -> np.ndarray:
 def energy_scale(m: mujoco.MjModel, v0: np.ndarray, gravity: float) -> float:
     """The energy the motion can exchange [J]: the initial kinetic energy (joint rates `v0`) plus m g L for every
     moving bar (the most potential energy a bar of length L can trade), independent of the potential's datum."""
+    import mujoco  # here: listing the models imports no engine
+
     d = mujoco.MjData(m)
     d.qvel[:] = v0
     mujoco.mj_forward(m, d)

@@ -10,18 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...accuracy import AccuracySpec
+from ...deferred import Deferred
 from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
 from . import accuracy
-from .freqresp import freqresp as freqresp_report
-from .freqresp import validate_section as validate_freqresp
 from .inputs import INPUTS
-from .mujoco import run_mujoco, view_model
 from .outputs import UNITS
 from .params import PantographParams
-from .reference import run_reference
-from .reports import equilibrium_report, modes_report
-from .under_wire import make as under_wire
 
 #: the corrected orifice / ideal-gas cylinder's parameters (Eqs 3.15-3.22): only the nonlinear cylinder reads them
 GAS = ("Ao", "V0", "R_gas", "gamma", "cd", "Pa", "T", "r_laminar")
@@ -58,21 +53,21 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="lab",
     paths={
-        "mujoco": RunPath(run=run_mujoco, label="mujoco",
+        "mujoco": RunPath(run=Deferred("mbsuite.models.pantograph.mujoco:run_mujoco"), label="mujoco",
                           what="MuJoCo: the MJCF of the scene's effects, cylinder and elbow as engine plugins, the "
                                "native core's loop",
                           lacks={"coulomb": ("smooth",)}),  # frictionloss only: c tanh(w/omega_s) is the reference's
-        "reference": RunPath(run=run_reference, label="equations",
+        "reference": RunPath(run=Deferred("mbsuite.models.pantograph.reference:run_reference"), label="equations",
                              what="hand-derived equations (numpy/scipy, Eppinger Ch. 3), event-exact stick/slip"),
     },
-    equilibrium=equilibrium_report,
-    modes=modes_report,
-    freqresp=freqresp_report,
-    under_wire=under_wire,
-    mujoco_model=view_model,
+    equilibrium=Deferred("mbsuite.models.pantograph.reports:equilibrium_report"),
+    modes=Deferred("mbsuite.models.pantograph.reports:modes_report"),
+    freqresp=Deferred("mbsuite.models.pantograph.freqresp:freqresp"),
+    under_wire=Deferred("mbsuite.models.pantograph.under_wire:make"),
+    mujoco_model=Deferred("mbsuite.models.pantograph.mujoco:view_model"),
     cases="mbsuite.models.pantograph.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
-    sections={"freqresp": validate_freqresp},
+    sections={"freqresp": Deferred("mbsuite.models.pantograph.freqresp:validate_section")},
     uses=USES,
     # defaults chosen from scripts/pantograph_workprecision.py: RK4 at 1e-3 s reaches 3e-5 relative physics error
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import SceneError
 from ...limits import Limit
 from ...scenes import Scene
-from .equations import PantographConfig, PantographODE
 from .params import PantographParams
+
+if TYPE_CHECKING:
+    from .equations import PantographConfig, PantographODE
 
 _INITIAL = Limit(kind=str, choices=("equilibrium", "fortran"), default="equilibrium",
                  doc="'equilibrium' (static equilibrium at y_w(0)) or 'fortran' (the thesis' start: no equilibrium)")
@@ -40,6 +43,8 @@ INPUTS: dict[str, dict[str, Limit]] = {
 
 def config_of(scene: Scene) -> PantographConfig:
     """The scene's effects as a `PantographConfig`."""
+    from .equations import PantographConfig  # here: the equations import scipy.optimize; listing models needs none
+
     return PantographConfig(**dict(scene.effects))
 
 

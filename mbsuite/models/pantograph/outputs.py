@@ -8,10 +8,14 @@ ram input y_w; the contact force ks (y_d - y_w) (clipped at 0 for the unilateral
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .elbow import theta_e_array
-from .equations import PantographODE
+
+if TYPE_CHECKING:
+    from .equations import PantographODE
 
 UNITS = {
     "F1": "m", "F2": "m", "HD": "m", "y_d": "m", "y_w": "m", "theta1": "rad", "theta2": "rad", "thetah": "rad",

@@ -22,7 +22,7 @@ from mbsuite.models.drives.config import (
     used_params,
 )
 from mbsuite.models.drives.params import PARAM_SETS, DriveParams
-from mbsuite.models.drives.scene_run import setup
+from mbsuite.models.drives.scene_run import setup as run_setup  # a module-level `setup` is pytest's xunit hook
 from mbsuite.scenes import load_scene, scene_from_dict
 
 ALL = [f.name for f in dataclasses.fields(DriveParams)]
@@ -66,7 +66,7 @@ def test_every_configuration_reads_what_it_uses_and_refuses_the_rest(combo):
     if combo[5]:
         given["J_add"] = 1.42e-3
     sc = _scene(*combo, given)
-    setup(sc)  # every read parameter given: no error
+    run_setup(sc)  # every read parameter given: no error
     unused = [k for k in ALL if k not in used]
     assert unused
     for k in unused:
@@ -76,7 +76,7 @@ def test_every_configuration_reads_what_it_uses_and_refuses_the_rest(combo):
         with pytest.raises(SceneError, match=needle):
             check_scene(one, one.build_params().resolved(BASE[combo[0]]))
     with pytest.raises(SceneError, match=r"parameter\(s\) "):  # and through the run's set-up
-        setup(_scene(*combo, {**given, unused[0]: SAMPLE[unused[0]]}))
+        run_setup(_scene(*combo, {**given, unused[0]: SAMPLE[unused[0]]}))
 
 
 def test_refused_effects():
@@ -85,18 +85,18 @@ def test_refused_effects():
                         ({"anti_windup": False}, "anti_windup = false"),
                         ({"controller": "energy_packet"}, "controller = 'energy_packet'")):
         with pytest.raises(SceneError, match=needle):
-            setup(sc.replace(effects=upd))
+            run_setup(sc.replace(effects=upd))
     with pytest.raises(SceneError, match="clutch_matching"):
-        setup(load_scene("drives/susd_500w_open").replace(effects={"clutch_matching": True}))
+        run_setup(load_scene("drives/susd_500w_open").replace(effects={"clutch_matching": True}))
     with pytest.raises(SceneError, match="input.value"):
-        setup(sc.replace(input={"value": 100.0}))
+        run_setup(sc.replace(input={"value": 100.0}))
     cc = load_scene("drives/coupled_clutches")
     for k, v in MODELICA_EFFECTS.items():
         other = {"param_set": "table_4_2", "controller": "pwm"}.get(k, not v)
         with pytest.raises(SceneError, match=k):
-            setup(cc.replace(effects={k: other}))
+            run_setup(cc.replace(effects={k: other}))
     with pytest.raises(SceneError, match=r"\['J_m'\]"):
-        setup(cc.replace(params={"J_m": 2.0}))
+        run_setup(cc.replace(params={"J_m": 2.0}))
 
 
 @pytest.mark.parametrize("ps", sorted(SET_MECHANISMS))
@@ -117,9 +117,9 @@ def test_another_mechanisms_set_is_refused_by_name():
     sc = load_scene("drives/step_up_pwm").replace(effects={"param_set": "example_500w"}, params={"tau_b": 2.0})
     with pytest.raises(SceneError, match=r"parameter set 'example_500w' .* lacks \['tau_c', 'twist_tol'\] needed by "
                                          r"mechanism 'step_up'"):
-        setup(sc)
+        run_setup(sc)
     # giving what it lacks makes it a step-up drive (duty and t_l are the scene's already)
-    setup(sc.replace(params={"tau_c": 20.0, "twist_tol": 0.5}))
+    run_setup(sc.replace(params={"tau_c": 20.0, "twist_tol": 0.5}))
 
 
 @pytest.mark.slow
@@ -156,7 +156,7 @@ def test_rotor_inertia_floor(key):
     sc = load_scene("drives/step_up_pwm")
     with pytest.raises(ParameterError, match=rf"{key} = 5e-10\b.* is invalid; valid: \[1e-09, 1000\]"):
         sc.replace(params={key: 5e-10})
-    run = setup(sc.replace(params={key: 1e-9}))
+    run = run_setup(sc.replace(params={key: 1e-9}))
     sim = MujocoRotorSim(run.system, mjcf_path(run.mjcf), timestep=1e-4)
     i = ["J_m", "J_s", "J_l"].index(key)
     assert run.system.J[i] == 1e-9

@@ -21,13 +21,11 @@ SECTIONS = ("input", "params", "solver", "effects")
 
 def grid_axes(vary: list[str] | None, max_points: int) -> list[tuple[str, str, list]]:
     """(section, key, values) of each `--vary SECTION.KEY=VALUES`, the grid's size checked before it is built."""
+    from .study import split_key
+
     axes = []
     for spec in vary or []:
-        key, sep, vals = spec.partition("=")
-        section, dot, name = key.partition(".")
-        if not sep or not dot or section not in SECTIONS:
-            raise MbsuiteError(f"--vary {spec!r}: expected SECTION.KEY=VALUES with SECTION in input, params, solver, "
-                               "effects (e.g. input.frequency=1:30:0.5 or params.ks=1e5,2e5)")
+        section, name, vals = split_key(spec, "--vary", SECTIONS)
         axes.append((section, name, parse_values(vals, max_points=max_points)))
     if not axes:
         raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")

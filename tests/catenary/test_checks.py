@@ -23,10 +23,12 @@ SHORT = {"n_spans": 2, "element_length": 0.5, "x_end": 100.0, "window_start": 40
 
 
 def test_every_scalar_parameter_declares_its_range():
-    assert undeclared(CatenaryParams) == ["dropper_positions"]  # a list: checked by code (inside the span, sorted)
+    # a list checked by code (inside the span, sorted) and a `Line` (checked by its own dataclasses)
+    assert undeclared(CatenaryParams) == ["dropper_positions", "line"]
 
 
-@pytest.mark.parametrize("name", [f.name for f in dataclasses.fields(CatenaryParams) if f.name != "dropper_positions"])
+@pytest.mark.parametrize("name", [f.name for f in dataclasses.fields(CatenaryParams)
+                                  if f.name not in ("dropper_positions", "line")])
 def test_nan_inf_and_out_of_range_parameters_raise_naming_the_field(name):
     lim = limit_of(CatenaryParams, name)
     bad = [math.nan, math.inf, -math.inf, True]

@@ -64,13 +64,16 @@ def speed_regime(p: CatenaryParams, speed_ms: float) -> dict[str, Any]:
 
 def passage_size(p: CatenaryParams, speed_ms: float, dt: float) -> tuple[int, int]:
     """(FE elements, time steps) of a passage, computed from the parameters without building anything: each wire
-    has at least ceil(length / element_length) elements (key points only add some), the pantograph moves
+    has at least ceil(its length / element_length) elements (key points only add some), the pantograph moves
     x_end - x_start at speed_ms in steps of dt."""
     from .passage import steps_to_cover  # here: the passage module imports the FE (scipy.sparse)
 
-    per_wire = math.ceil(p.length / p.element_length)
+    if p.line is not None:
+        elements = sum(math.ceil((w.x1 - w.x0) / p.element_length) for w in p.line.wires)
+    else:
+        elements = 2 * math.ceil(p.length / p.element_length)
     steps = steps_to_cover(p.x_end - p.x_start, speed_ms, dt)
-    return 2 * per_wire, steps
+    return elements, steps
 
 
 def check_size(p: CatenaryParams, speed_ms: float, dt: float, max_steps: float | None = None) -> None:
@@ -92,7 +95,7 @@ def wave_courant(p: CatenaryParams, dt: float) -> Figure:
     """Health figure of the FE wave resolution: c dt / element_length, the elements a wire wave (c = the faster
     wire's sqrt(T/rho)) crosses per step; bound 1. The mesh resolves waves one element long; a longer step skips
     them (the trapezoidal rule stays stable but distorts them), and so does the pantograph, slower than the wave."""
-    c = max(p.cw_wave_speed, p.mw_wave_speed)
+    c = p.max_wave_speed
     dt_max = p.element_length / c
     return Figure("wave_courant", float(c * dt / p.element_length), 1.0, "",
                   f"FE elements a wire wave (sqrt(T/rho) = {c:.1f} m/s) crosses per solver.timestep",
@@ -108,7 +111,7 @@ def check_timestep(p: CatenaryParams, dt: float) -> None:
     valid range and why; the accuracy bound (`wave_courant`) is `check_wave_resolution`'s."""
     if not (isinstance(dt, int | float) and not isinstance(dt, bool) and math.isfinite(dt) and dt > 0):
         raise ParameterError(f"solver.timestep (--timestep) must be a positive number of seconds, got {dt!r}")
-    c = max(p.cw_wave_speed, p.mw_wave_speed)
+    c = p.max_wave_speed
     nyquist, courant = 1.0 / (2.0 * p.filter_cutoff), p.element_length / c
     if not dt < nyquist:
         raise ParameterError(
@@ -160,7 +163,7 @@ def check_train(p: CatenaryParams, spacings: Sequence[float], head_width: float 
         raise ParameterError(
             f"spacings {list(spacings)} m: the leading pantograph would be at x = {lead_end:g} m, outside the "
             f"catenary [0, {p.length:g}] m, when the last one reaches x_end = {p.x_end:g} m; valid: total spacing "
-            f"<= {p.length - p.x_end:g} m (or lengthen the line: n_spans)")
+            f"<= {p.length - p.x_end:g} m (or lengthen the line)")
     return offsets
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from ...errors import ParameterError
 from ...limits import check_fields, param, real
+from .line import Line
 
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
 #: dt 2e-4 s, 250 km/h: 7.3e7; 0.125 m at 5e-5 s: 1.2e9)
@@ -71,9 +72,15 @@ class CatenaryParams:
     # --- size guard -------------------------------------------------------------------------------------------
     max_element_steps: float = param(MAX_ELEMENT_STEPS, lo=1.0, hi=1e15, unit="-",
                                      doc="size guard: FE elements x time steps a passage may take")
+    # --- the line ------------------------------------------------------------------------------------------------
+    #: a line of its own (`line.Line`: a scene's [line] section, `lines.py`, `linefile.py`); None: the simple line of
+    #: the fields above (n_spans ... k_messenger_support, the EN 50318:2002 line by default)
+    line: Line | None = None
 
     def __post_init__(self) -> None:
         check_fields(self, "catenary parameter")
+        if self.line is not None and not isinstance(self.line, Line):
+            raise ParameterError(f"line must be a mbsuite.models.catenary.line.Line, got {type(self.line).__name__}")
         if not self.f_damp2 > self.f_damp1:
             raise ParameterError(f"f_damp2 ({self.f_damp2}) must be above f_damp1 ({self.f_damp1})")
         dp = self.dropper_positions
@@ -94,13 +101,13 @@ class CatenaryParams:
                     f"dropper_positions must be strictly increasing; dropper_positions[{i}] = {dp[i]!r} "
                     f"<= dropper_positions[{i - 1}] = {dp[i - 1]!r}"
                 )
-        if self.element_length > self.span_length:
+        if self.line is None and self.element_length > self.span_length:
             raise ParameterError(f"element_length ({self.element_length}) must not exceed span_length")
         L = self.length
         if not 0.0 <= self.x_start < self.x_end <= L:
             raise ParameterError(
                 f"params.x_start = {self.x_start} m, params.x_end = {self.x_end} m: the pantograph run must satisfy "
-                f"0 <= x_start < x_end <= {L:g} m (n_spans x span_length)"
+                f"0 <= x_start < x_end <= {L:g} m (the line's length)"
             )
         if not self.x_start <= self.window_start < self.window_end <= self.x_end:
             if not self.window_start < self.window_end:
@@ -117,18 +124,27 @@ class CatenaryParams:
 
     @property
     def length(self) -> float:
-        """Total catenary length (m)."""
-        return self.n_spans * self.span_length
+        """Total catenary length (m): the line's, else n_spans x span_length."""
+        return self.line.length if self.line is not None else self.n_spans * self.span_length
 
     @property
     def cw_wave_speed(self) -> float:
         """Transverse wave speed of the contact wire sqrt(T/rho) (m/s)."""
+        if self.line is not None:
+            return self.line.contact.wave_speed
         return math.sqrt(self.cw_tension / self.cw_mass)
 
     @property
     def mw_wave_speed(self) -> float:
         """Messenger-wire transverse wave speed sqrt(T_mw / rho_mw) (m/s)."""
         return math.sqrt(self.mw_tension / self.mw_mass)
+
+    @property
+    def max_wave_speed(self) -> float:
+        """The fastest wire's transverse wave speed (m/s): what the FE time step must resolve."""
+        if self.line is not None:
+            return self.line.wave_speed
+        return max(self.cw_wave_speed, self.mw_wave_speed)
 
     def rayleigh(self) -> tuple[float, float]:
         """(alpha, beta) of C = alpha M + beta K giving ratio zeta at f_damp1 and f_damp2."""

@@ -1,0 +1,326 @@
+"""A catenary line (one tension section) as data: wires, supports, droppers, clamps, point masses, presag and a
+contact-wire irregularity. `fe.assemble` meshes and solves any `Line`; `lines.py` builds the shipped ones (the
+EN 50318 simple line, its stitched variant, a compound line) and `linefile.py` reads one from TOML/CSV.
+
+Conventions (SI units, x along the track from the first pinned end, heights up):
+- a `Wire` is a tensioned Euler-Bernoulli beam over [x0, x1]; its ends are pinned (w = 0) or free (held by whatever
+  springs act there, e.g. a stitch wire's clamps). Exactly one wire has role "contact" and it spans the whole line;
+  its tension is uniform (one tension section); other wires may carry `tension_segments` (x_a, x_b, T) that override
+  the wire's tension between x_a and x_b (a messenger between the clamps of a stitch wire).
+- a `Support` at x holds ground springs `k` (N/m) on named wires (steady arm on the contact wire, messenger support)
+  and point masses `m` (kg: clamps, steady arm) on named wires; the contact wire is held at its design height at every
+  support in the static state (its reaction is the steady arm's pre-load).
+- a `Dropper` at x joins `upper` to `lower` (w displacements): stiffness k, law "slack" (tension only) or "linear"
+  (bilateral; "" = the scene's `droppers` effect), its body's mass lumped half on each end, clamp masses on each wire.
+  In the static state the lower wire is held at its design height at the dropper (the dropper length is whatever that
+  needs); the dropper's static tension is the hold's reaction.
+- a `Clamp` at x is a bilateral spring k between the w displacements of wires a and b (rotations independent).
+- `Presag`: the contact wire's design height between consecutive supports a, b: z(x) = -4 s (x - a)(b - x) / (b - a)
+  with s = ratio (mid-span presag / span length; 0: level).
+- `Irregularity`: a height profile r(x) of the contact wire (m) on a uniform grid, piecewise linear, 0 outside; it
+  enters the contact gap (y_wire = N . (w0 + u) + r), the wire-height signal and the pantograph's static state.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import ParameterError
+from ...limits import check_fields, param, real
+
+WIRE_ROLES = ("contact", "messenger", "stitch", "auxiliary", "other")
+END_KINDS = ("pinned", "free")
+DROPPER_LAWS = ("", "slack", "linear")
+#: most wires at one position: the compiled core's node blocks hold at most 8 DOFs (w, theta per wire)
+MAX_WIRES_AT_A_NODE = 4
+
+
+def _number(what: str, v, lo: float | None = None, lo_open: bool = False) -> float:
+    x = real(v)
+    if x is None or not math.isfinite(x):
+        raise ParameterError(f"{what} = {v!r} must be a finite number")
+    if lo is not None and (x <= lo if lo_open else x < lo):
+        raise ParameterError(f"{what} = {v!r} must be {'>' if lo_open else '>='} {lo:g}")
+    return float(x)
+
+
+@dataclass(frozen=True)
+class Wire:
+    """A tensioned wire over [x0, x1] (module docstring)."""
+
+    name: str
+    role: str = param("other", kind=str, choices=WIRE_ROLES, doc="contact, messenger, stitch, auxiliary or other")
+    mass: float = param(1.0, lo=0.0, hi=100.0, unit="kg/m", doc="mass per length (0 only for a massless tie)")
+    tension: float = param(1e4, lo=0.0, hi=1e6, unit="N", doc="tension (0: a bending beam alone)")
+    EI: float = param(0.0, lo=0.0, hi=1e6, unit="N m^2", doc="bending stiffness")
+    x0: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="start of the wire")
+    x1: float = param(1.0, lo=0.0, lo_open=True, hi=1e6, unit="m", doc="end of the wire")
+    ends: tuple[str, str] = ("pinned", "pinned")
+    #: (x_a, x_b, T): tension T (N) between x_a and x_b instead of `tension`
+    tension_segments: tuple[tuple[float, float, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ParameterError(f"wire name {self.name!r} must be a non-empty string")
+        check_fields(self, f"wire {self.name!r}")
+        if not self.x1 > self.x0:
+            raise ParameterError(f"wire {self.name!r}: x1 = {self.x1} m must lie beyond x0 = {self.x0} m")
+        ends = tuple(self.ends)
+        if len(ends) != 2 or any(e not in END_KINDS for e in ends):
+            raise ParameterError(f"wire {self.name!r}: ends = {self.ends!r} must be two of {list(END_KINDS)}")
+        object.__setattr__(self, "ends", ends)
+        segs = []
+        for i, s in enumerate(self.tension_segments):
+            if len(s) != 3:
+                raise ParameterError(f"wire {self.name!r}: tension_segments[{i}] = {s!r} must be [x_a, x_b, T]")
+            a, b, T = (_number(f"wire {self.name!r} tension_segments[{i}]", v) for v in s)
+            if not (self.x0 <= a < b <= self.x1) or T < 0:
+                raise ParameterError(f"wire {self.name!r}: tension_segments[{i}] = {list(s)} must satisfy "
+                                     f"x0 <= x_a < x_b <= x1 ([{self.x0}, {self.x1}] m) and T >= 0")
+            segs.append((a, b, T))
+        segs.sort()
+        for (a0, b0, _), (a1, _, _) in zip(segs, segs[1:], strict=False):
+            if a1 < b0:
+                raise ParameterError(f"wire {self.name!r}: tension segments [{a0}, {b0}] and one from {a1} m overlap")
+        object.__setattr__(self, "tension_segments", tuple(segs))
+
+    def tension_at(self, xm: np.ndarray) -> np.ndarray:
+        """Tension (N) at positions xm (element midpoints)."""
+        T = np.full(np.shape(xm), self.tension, dtype=float)
+        for a, b, t in self.tension_segments:
+            T[(xm > a) & (xm < b)] = t
+        return T
+
+    @property
+    def wave_speed(self) -> float:
+        """Largest transverse wave speed sqrt(T/rho) of the wire (m/s; inf for a massless wire)."""
+        T = max([self.tension] + [s[2] for s in self.tension_segments])
+        return math.sqrt(T / self.mass) if self.mass > 0 else math.inf
+
+
+@dataclass(frozen=True)
+class Support:
+    """A support at x: ground springs `k` and point masses `m` on named wires."""
+
+    x: float
+    k: dict[str, float] = field(default_factory=dict)
+    m: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", _number("support x", self.x, lo=0.0))
+        for what in ("k", "m"):
+            d = getattr(self, what)
+            if not isinstance(d, dict):
+                raise ParameterError(f"support at x = {self.x} m: {what} must map wire names to numbers, got {d!r}")
+            object.__setattr__(self, what, {str(w): _number(f"support at x = {self.x} m {what}_{w}", v, lo=0.0)
+                                            for w, v in d.items()})
+
+
+@dataclass(frozen=True)
+class Dropper:
+    """A dropper at x from `upper` to `lower` (module docstring)."""
+
+    x: float
+    upper: str
+    lower: str
+    k: float = param(1e5, lo=0.0, lo_open=True, hi=1e12, unit="N/m", doc="axial stiffness")
+    law: str = param("", kind=str, choices=DROPPER_LAWS, doc="slack, linear or '' (the scene's droppers effect)")
+    mass: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="dropper body mass (half on each end)")
+    clamp_upper: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="clamp mass on the upper wire")
+    clamp_lower: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="clamp mass on the lower wire")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", _number("dropper x", self.x, lo=0.0))
+        check_fields(self, f"dropper at x = {self.x} m")
+        if self.upper == self.lower:
+            raise ParameterError(f"dropper at x = {self.x} m joins wire {self.upper!r} to itself")
+
+
+@dataclass(frozen=True)
+class Clamp:
+    """A bilateral spring k between wires a and b at x."""
+
+    x: float
+    a: str
+    b: str
+    k: float = param(1e7, lo=0.0, lo_open=True, hi=1e15, unit="N/m", doc="clamp stiffness")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", _number("clamp x", self.x, lo=0.0))
+        check_fields(self, f"clamp at x = {self.x} m")
+        if self.a == self.b:
+            raise ParameterError(f"clamp at x = {self.x} m joins wire {self.a!r} to itself")
+
+
+@dataclass(frozen=True)
+class PointMass:
+    """A point mass m on `wire` at x (a registration clamp, an electrical connector)."""
+
+    x: float
+    wire: str
+    m: float = param(0.0, lo=0.0, hi=1e3, unit="kg", doc="mass")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", _number("point mass x", self.x, lo=0.0))
+        check_fields(self, f"point mass at x = {self.x} m")
+
+
+@dataclass(frozen=True)
+class Irregularity:
+    """The contact wire's height irregularity r(x) = r[i] at x0 + i dx, piecewise linear between, 0 outside."""
+
+    x0: float
+    dx: float
+    r: np.ndarray
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        r = np.asarray(self.r, dtype=float)
+        if r.ndim != 1 or r.size < 2 or not np.all(np.isfinite(r)):
+            raise ParameterError(f"irregularity {self.source}: the profile must be >= 2 finite heights, got {r.size}")
+        _number("irregularity x0", self.x0)
+        if not (real(self.dx) is not None and self.dx > 0):
+            raise ParameterError(f"irregularity {self.source}: dx = {self.dx!r} must be a positive number of metres")
+        object.__setattr__(self, "r", r)
+
+    def __call__(self, x: np.ndarray | float) -> np.ndarray:
+        """r(x) (m)."""
+        g = self.x0 + self.dx * np.arange(self.r.size)
+        return np.interp(x, g, self.r, left=0.0, right=0.0)
+
+    def slope(self, x: np.ndarray | float) -> np.ndarray:
+        """dr/dx on the interval holding x (0 outside the grid)."""
+        i = np.floor((np.asarray(x, float) - self.x0) / self.dx).astype(int)
+        ok = (i >= 0) & (i < self.r.size - 1)
+        j = np.clip(i, 0, self.r.size - 2)
+        return np.where(ok, (self.r[j + 1] - self.r[j]) / self.dx, 0.0)
+
+    def __eq__(self, other: object) -> bool:
+        return (isinstance(other, Irregularity) and (self.x0, self.dx) == (other.x0, other.dx)
+                and np.array_equal(self.r, other.r))
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True)
+class Line:
+    """One tension section (module docstring). `supports` sorted by x; the first and last wire ends define the
+    line's extent [0, length]."""
+
+    wires: tuple[Wire, ...]
+    supports: tuple[Support, ...]
+    droppers: tuple[Dropper, ...] = ()
+    clamps: tuple[Clamp, ...] = ()
+    masses: tuple[PointMass, ...] = ()
+    presag: float = 0.0
+    irregularity: Irregularity | None = None
+    name: str = "line"
+
+    def __post_init__(self) -> None:
+        for what in ("wires", "supports", "droppers", "clamps", "masses"):
+            object.__setattr__(self, what, tuple(getattr(self, what)))
+        names = [w.name for w in self.wires]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ParameterError(f"line {self.name!r}: wire name(s) {dup} appear more than once")
+        contact = [w for w in self.wires if w.role == "contact"]
+        if len(contact) != 1:
+            raise ParameterError(f"line {self.name!r} needs exactly one wire with role 'contact', has {len(contact)}")
+        cw = contact[0]
+        if cw.x0 != 0.0 or any(w.x0 < 0 or w.x1 > cw.x1 for w in self.wires):
+            raise ParameterError(f"line {self.name!r}: the contact wire must start at x = 0 and every wire lie on it "
+                                 f"([0, {cw.x1}] m)")
+        if cw.tension_segments:
+            raise ParameterError(f"line {self.name!r}: the contact wire's tension must be uniform (one tension "
+                                 "section); tension_segments are for the other wires")
+        if not cw.tension > 0 or not cw.mass > 0:
+            raise ParameterError(f"line {self.name!r}: the contact wire needs a positive mass and tension")
+        # the contact wire first (the FE's DOF order)
+        object.__setattr__(self, "wires", (cw, *[w for w in self.wires if w is not cw]))
+        wires = {w.name: w for w in self.wires}
+
+        def on(wire: str, x: float, what: str) -> None:
+            w = wires.get(wire)
+            if w is None:
+                raise ParameterError(f"line {self.name!r}: {what} names wire {wire!r}; wires: {list(wires)}")
+            if not w.x0 - 1e-9 <= x <= w.x1 + 1e-9:
+                raise ParameterError(f"line {self.name!r}: {what} at x = {x} m lies off wire {wire!r} "
+                                     f"[{w.x0}, {w.x1}] m")
+
+        sup = tuple(sorted(self.supports, key=lambda s: s.x))
+        if len(sup) < 2:
+            raise ParameterError(f"line {self.name!r} needs at least two supports, has {len(sup)}")
+        for a, b in zip(sup, sup[1:], strict=False):
+            if not b.x > a.x:
+                raise ParameterError(f"line {self.name!r}: two supports at x = {a.x} m")
+        object.__setattr__(self, "supports", sup)
+        for s in sup:
+            on(cw.name, s.x, "a support")
+            for w in (*s.k, *s.m):
+                on(w, s.x, f"support at x = {s.x} m")
+        for d in self.droppers:
+            on(d.upper, d.x, f"dropper at x = {d.x} m (upper)")
+            on(d.lower, d.x, f"dropper at x = {d.x} m (lower)")
+        for c in self.clamps:
+            on(c.a, c.x, f"clamp at x = {c.x} m")
+            on(c.b, c.x, f"clamp at x = {c.x} m")
+        for m in self.masses:
+            on(m.wire, m.x, f"point mass at x = {m.x} m")
+        p = real(self.presag)
+        if p is None or not (0.0 <= p < 0.05):
+            raise ParameterError(f"line {self.name!r}: presag = {self.presag!r} (mid-span presag / span length) must "
+                                 "lie in [0, 0.05)")
+        object.__setattr__(self, "presag", float(p))
+        if self.irregularity is not None and not isinstance(self.irregularity, Irregularity):
+            raise ParameterError(f"line {self.name!r}: irregularity must be an Irregularity, got "
+                                 f"{type(self.irregularity).__name__}")
+        for x in self.key_points():
+            n = sum(w.x0 <= x <= w.x1 for w in self.wires)
+            if n > MAX_WIRES_AT_A_NODE:
+                raise ParameterError(f"line {self.name!r}: {n} wires at x = {x} m; at most {MAX_WIRES_AT_A_NODE}")
+
+    @property
+    def contact(self) -> Wire:
+        """The contact wire (always `wires[0]`)."""
+        return self.wires[0]
+
+    @property
+    def length(self) -> float:
+        """Length of the line (m): the contact wire's."""
+        return self.contact.x1
+
+    def wire(self, name: str) -> Wire:
+        """The wire called `name`."""
+        for w in self.wires:
+            if w.name == name:
+                return w
+        raise ParameterError(f"line {self.name!r} has no wire {name!r}; wires: {[w.name for w in self.wires]}")
+
+    def key_points(self) -> np.ndarray:
+        """Every position that must be a node (supports, droppers, clamps, masses, wire ends and tension changes),
+        sorted, equal to 1e-9 m merged."""
+        xs = [s.x for s in self.supports] + [d.x for d in self.droppers] + [c.x for c in self.clamps]
+        xs += [m.x for m in self.masses]
+        for w in self.wires:
+            xs += [w.x0, w.x1] + [v for s in w.tension_segments for v in s[:2]]
+        k = np.unique(np.round(np.asarray(xs, float), 9))
+        return k
+
+    def design_height(self, x: np.ndarray) -> np.ndarray:
+        """The contact wire's design height z(x) (m): the parabolic presag between consecutive supports."""
+        x = np.asarray(x, float)
+        if self.presag == 0.0:
+            return np.zeros_like(x)
+        sx = np.array([s.x for s in self.supports])
+        i = np.clip(np.searchsorted(sx, x, side="right") - 1, 0, sx.size - 2)
+        a, b = sx[i], sx[i + 1]
+        inside = (x >= sx[0]) & (x <= sx[-1])
+        return np.where(inside, -4.0 * self.presag * (x - a) * (b - x) / (b - a), 0.0)
+
+    @property
+    def wave_speed(self) -> float:
+        """The fastest wire's transverse wave speed (m/s)."""
+        return max(w.wave_speed for w in self.wires)

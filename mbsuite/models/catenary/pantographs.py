@@ -22,12 +22,15 @@ are the only contract. The scene's `pantograph` effect names a `PantographKind`:
 section it takes and its `UnderWire` factory. `reference2mass` is the catenary's own (`TwoMassPantograph`, its
 parameters m1 ... F0 the catenary's); every other name is a pantograph model of the registry (`PANTOGRAPH_MODELS`),
 found by `mbsuite.registry.get_model(name).under_wire` with the `[pantograph]` section of the scene (its own `effects`
-and `params`, validated against that model's spec). The catenary imports no pantograph model.
+and `params`, validated against that model's spec). `lumped` and `transfer` are the catenary's linear pantographs
+(`linear_pantographs.py`: an n-stage lumped one and a state-space model of a receptance), their parameters in the
+`[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step, but they run on the Python
+stages of the coupled step (`trial / commit`), not in the compiled loop. The catenary imports no pantograph model.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 from typing import Any, Protocol, runtime_checkable
@@ -36,13 +39,18 @@ import numpy as np
 
 from ...errors import SceneError
 from ...registry import ModelSpec, get_model
+from . import linear_pantographs as linear
 
 #: the catenary's own pantograph, the EN 50318 2-mass reference (parameters m1 ... F0 among the catenary's)
 TWO_MASS = "reference2mass"
 #: the `pantograph` effect's values that name a registry model (value -> model name)
 PANTOGRAPH_MODELS = {"eppinger": "pantograph"}
+#: the catenary's linear pantographs, their parameters in the `[pantograph]` section (`linear_pantographs.py`)
+LINEAR = (linear.LUMPED, linear.TRANSFER)
 #: every value of the `pantograph` effect
-PANTOGRAPHS = (TWO_MASS, *PANTOGRAPH_MODELS)
+PANTOGRAPHS = (TWO_MASS, *PANTOGRAPH_MODELS, *LINEAR)
+#: the values of the `pantograph` effect that read the scene's `[pantograph]` section
+SECTION_PANTOGRAPHS = (*PANTOGRAPH_MODELS, *LINEAR)
 #: keys of the scene's `[pantograph]` section
 SECTION_KEYS = ("effects", "params")
 
@@ -182,15 +190,19 @@ class TwoMassPantograph:
 @dataclass(frozen=True)
 class PantographKind:
     """A value of the scene's `pantograph` effect: the engine paths its pantograph has, its factory, and the registry
-    model whose declaration validates the `[pantograph]` section (None: the catenary's own, which takes none)."""
+    model whose declaration validates the `[pantograph]` section (None: the catenary's own); `check` validates the
+    section of a catenary pantograph that takes one (the linear ones)."""
 
     name: str
     engines: tuple[str, ...]
     make: UnderWire
     spec: ModelSpec | None = None
+    check: Callable[[Any], dict[str, dict[str, Any]]] | None = None
 
     def section(self, value: Any) -> dict[str, dict[str, Any]]:
         """The `[pantograph]` section validated for this pantograph (SceneError naming the bad key or value)."""
+        if self.check is not None:
+            return self.check(value)
         if self.spec is None:
             value = value or {}
             if value.get("effects") or value.get("params"):
@@ -206,10 +218,24 @@ def _two_mass(p, params: Mapping[str, Any], effects: Mapping[str, Any], engine: 
     return TwoMassPantograph(p.m1, p.k1, p.c1, p.m2, p.k2, p.c2, p.F0)
 
 
+def _linear_section(name: str, value: Any) -> dict[str, dict[str, Any]]:
+    """The `[pantograph]` section of the linear pantograph `name`, validated (its parameters built once)."""
+    linear.params_of(name, value if value else None)
+    return {"effects": {}, "params": dict(value["params"])}
+
+
+def _linear(name: str, params: Mapping[str, Any], effects: Mapping[str, Any], engine: str,
+            timestep: float) -> linear.LinearPantograph:
+    """`UnderWire` of a linear pantograph: its parameters from the `[pantograph]` section's `params`."""
+    return linear.make(name, {"params": params})
+
+
 def kind(name: str, p) -> PantographKind:
     """The kind of pantograph the `pantograph` effect's value `name` names, under a catenary of parameters `p`."""
     if name == TWO_MASS:
         return PantographKind(TWO_MASS, ("reference",), partial(_two_mass, p))
+    if name in LINEAR:
+        return PantographKind(name, ("reference",), partial(_linear, name), check=partial(_linear_section, name))
     if name not in PANTOGRAPH_MODELS:
         raise SceneError(f"unknown pantograph {name!r}; valid: {list(PANTOGRAPHS)}")
     spec = _model_spec(name)
@@ -257,7 +283,13 @@ def validate_section(value: Any) -> dict[str, dict[str, Any]]:
     """Validator of the scene's `[pantograph]` section (`ModelSpec.sections`): `effects` and `params` of a registry
     pantograph, checked against that model's spec (unknown keys are errors listing the valid ones). The section does
     not see the scene's `pantograph` effect: it must be valid for one of the registry pantographs, and `build` checks
-    it again against the one the scene names."""
+    it again against the one the scene names. A section whose `params` hold the keys of a linear pantograph
+    (`m, k, c, F0` or `A, B, C, F0`) is validated as that one's."""
+    params = value.get("params") if isinstance(value, Mapping) else None
+    if isinstance(params, Mapping):
+        for name in LINEAR:
+            if set(params) & (set(linear.KINDS[name][0]) - {"F0"}):
+                return _linear_section(name, value)
     first = None
     for name in PANTOGRAPH_MODELS:
         try:

@@ -1,5 +1,6 @@
-"""`mbsuite pantograph equilibrium | modes | freqresp [SCENE]`: the pantograph's analyses (its SPEC hooks) and their
-options. `mbsuite equilibrium | modes | freqresp SCENE` with the same options are aliases of these commands."""
+"""`mbsuite pantograph equilibrium | modes | freqresp | fit-lumped [SCENE]`: the pantograph's analyses (its SPEC hooks,
+and the lumped and transfer-function fit of `lumped_study.py`) and their options. `mbsuite equilibrium | modes |
+freqresp SCENE` with the same options are aliases of the first three."""
 
 from __future__ import annotations
 
@@ -24,10 +25,14 @@ COMMANDS = {
     "equilibrium": "static equilibrium of a scene (every path)",
     "modes": "linearised natural frequencies and damping ratios",
     "freqresp": "frequency response (linearisation, reference and MuJoCo time simulations)",
+    "fit-lumped": "2- or 3-stage lumped and transfer-function pantographs fitted to the linearised driving-point "
+                  "receptance; their parameters as catenary scenes",
 }
+#: the group's commands without a top-level alias
+GROUP_ONLY = ("fit-lumped",)
 # the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
 CLI_COMMANDS = {
-    "pantograph": "the pantograph's analyses: equilibrium, modes, frequency response",
+    "pantograph": "the pantograph's analyses: equilibrium, modes, frequency response, lumped fit",
     "equilibrium": "static equilibrium of a scene (every path) (as `mbsuite pantograph equilibrium`)",
     "modes": "linearised natural frequencies and damping ratios (as `mbsuite pantograph modes`)",
     "freqresp": "frequency response (linearisation, reference and MuJoCo time simulations) (as `mbsuite pantograph "
@@ -43,6 +48,8 @@ def register(sub: argparse._SubParsersAction, add_common, emit) -> str:
         p = gs.add_parser(name, help=helptext)
         p.add_argument("scene", nargs="?", default=MODEL, help=SCENE_HELP + " (default: the pantograph's)")
         _add_options(p, name, add_common, emit)
+        if name in GROUP_ONLY:
+            continue
         p = sub.add_parser(name, help=CLI_COMMANDS[name])
         p.add_argument("scene", help=SCENE_HELP)
         _add_options(p, name, add_common, emit)
@@ -51,6 +58,8 @@ def register(sub: argparse._SubParsersAction, add_common, emit) -> str:
 
 def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> None:
     add_common(p)
+    if name == "fit-lumped":
+        _add_fit_options(p)
     if name != "freqresp":
         add_scene_options(p)
     if name == "modes":
@@ -68,6 +77,57 @@ def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> Non
         add_sweep_options(p)
     add_study_options(p)
     p.set_defaults(func=COMMAND_FUNCS[name], emit=emit)
+
+
+def _add_fit_options(p: argparse.ArgumentParser) -> None:
+    from .lumped_fit import BAND, DF, ORDER, STARTS
+
+    p.add_argument("--stages", type=int, default=2, help="stages of the lumped pantograph (1 to 6; default 2)")
+    p.add_argument("--band", default=f"{BAND[0]:g}:{BAND[1]:g}", metavar="LO:HI",
+                   help=f"fitted band (Hz; default {BAND[0]:g}:{BAND[1]:g})")
+    p.add_argument("--df", type=float, default=DF, help=f"frequency spacing of the band (Hz; default {DF:g})")
+    p.add_argument("--height", type=float, default=None,
+                   help="working (ram/wire) height above the base pivot (m) to linearise at (default: params.y_op)")
+    p.add_argument("--order", type=int, default=ORDER,
+                   help=f"order of the transfer function (denominator degree, 2 to 16; default {ORDER})")
+    p.add_argument("--starts", type=int, default=STARTS,
+                   help=f"starts of the lumped fit's multi-start (default {STARTS})")
+    p.add_argument("--seed", type=int, default=0, help="seed of the starts (default 0)")
+
+
+def fit_args(args: argparse.Namespace) -> dict:
+    """`--stages/--band/--df/--height/--order/--starts/--seed` as `lumped_study.fit_report`'s keyword arguments,
+    each checked (MbsuiteError naming the flag)."""
+    lo, sep, hi = str(args.band).partition(":")
+    try:
+        band = (float(lo), float(hi))
+    except ValueError:
+        band = None
+    if not sep or band is None:
+        raise MbsuiteError(f"--band {args.band!r}: give LO:HI in Hz, e.g. 0:20")
+    if not 1 <= args.stages <= 6:
+        raise MbsuiteError(f"--stages {args.stages}: 1 to 6")
+    if not 2 <= args.order <= 16:
+        raise MbsuiteError(f"--order {args.order}: 2 to 16")
+    if not 1 <= args.starts <= 1000:
+        raise MbsuiteError(f"--starts {args.starts}: 1 to 1000")
+    return {"stages": args.stages, "band": band, "df": args.df, "height": args.height, "order": args.order,
+            "starts": args.starts, "seed": args.seed}
+
+
+def fit_lumped_of(scene: Scene, args: argparse.Namespace):
+    """The lumped and transfer-function fit of `scene` (`lumped_study.fit_report`)."""
+    from .lumped_study import fit_report
+
+    return fit_report(scene, **fit_args(args))
+
+
+def cmd_fit_lumped(args: argparse.Namespace) -> None:
+    """The lumped and transfer-function pantographs fitted to the scene's driving-point receptance."""
+    scene = load(args)
+    if scene.model != MODEL:
+        raise MbsuiteError(f"`mbsuite {MODEL} fit-lumped` takes a {MODEL} scene, not a '{scene.model}' one")
+    run_or_study(args, scene, f"{__name__}:fit_lumped_of", units=UNITS)
 
 
 def _scene(args: argparse.Namespace, hook: str) -> Scene:
@@ -130,4 +190,5 @@ def cmd_freqresp(args: argparse.Namespace) -> None:
     run_or_study(args, _scene(args, "freqresp"), f"{__name__}:freqresp_of", units=UNITS, parallel_inside=True)
 
 
-COMMAND_FUNCS = {"equilibrium": cmd_equilibrium, "modes": cmd_modes, "freqresp": cmd_freqresp}
+COMMAND_FUNCS = {"equilibrium": cmd_equilibrium, "modes": cmd_modes, "freqresp": cmd_freqresp,
+                 "fit-lumped": cmd_fit_lumped}

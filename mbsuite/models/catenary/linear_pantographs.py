@@ -1,0 +1,347 @@
+"""Linear pantographs under the wire: the n-stage lumped pantograph and the transfer-function pantograph.
+
+Both are one linear state-space model of the head (`LinearPantograph`), x' = A x + b0 F0 - B f, head = c x, with f
+the contact force (N, >= 0 pushes the head down) entering where it acts (B: the response to an upward force on the
+head), F0 the static uplift entering through b0. Integrated with the wire's own trapezoidal rule,
+
+    (I - h A) x1 = (I + h A) x0 + h (2 b0 F0 - B (f0 + f1)),   h = dt / 2,
+
+the head at t + dt is exactly affine in the end-of-step force f1 (`affine_map`), as the 2-mass reference pantograph's
+(whose Newmark average-acceleration scheme is this rule on its first-order form: the same numbers to rounding).
+
+- `LumpedParams`: stage 1 is the head (the contact point), stage i hangs on stage i + 1 through k_i, c_i and the last
+  stage on the base through k_n, c_n (k_n may be 0); the static uplift F0 acts on the last stage, every spring
+  unstretched at zero displacement (k_n is referenced to the undisturbed contact wire level, as the reference's k2).
+  Two stages with the reference's m1 ... F0 are the EN 50318 2-mass pantograph.
+- `TransferParams`: a strictly proper state-space model (A, B, C) of the head's receptance G(s) = head displacement
+  per upward force on the head, m/N (a fitted or measured frequency response); the static uplift F0 is the contact
+  force at the working height against a rigid wire and enters with B (the model's zero state is that equilibrium).
+
+Parameters come from the scene's `[pantograph]` section, `params` only (`section`): `m`, `k`, `c` (lists, kg, N/m,
+N s/m) and `F0` (N) of a lumped pantograph; `A`, `B`, `C` (lists; A square, in 1/s) and `F0` of a transfer-function
+one. `mbsuite pantograph fit-lumped` writes both from the Eppinger model's linearised receptance.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import ParameterError, SceneError, SolverError
+
+#: the `pantograph` effect's values of the linear pantographs
+LUMPED, TRANSFER = "lumped", "transfer"
+#: the keys of `[pantograph] params` each takes
+LUMPED_KEYS, TRANSFER_KEYS = ("m", "k", "c", "F0"), ("A", "B", "C", "F0")
+#: the largest state a transfer-function pantograph may have (its step solves an n x n system once per time step)
+MAX_STATES = 40
+#: the largest number of stages of a lumped pantograph
+MAX_STAGES = 20
+
+
+def _number(v: Any, what: str) -> float:
+    """A finite real number (numpy scalars and 0-d arrays accepted), else ParameterError naming `what`."""
+    if isinstance(v, bool | str) or not isinstance(v, int | float | np.number | np.ndarray) or np.ndim(v) != 0:
+        raise ParameterError(f"{what} must be a number, got {v!r}")
+    x = float(v)
+    if not math.isfinite(x):
+        raise ParameterError(f"{what} must be finite, got {v!r}")
+    return x
+
+
+def _ndim(v: Any) -> int:
+    try:
+        return int(np.ndim(v))
+    except ValueError:  # a ragged list
+        return -1
+
+
+def _vector(v: Any, what: str) -> tuple[float, ...]:
+    """A list of finite real numbers, else ParameterError naming `what`."""
+    if isinstance(v, str | bytes | Mapping) or not isinstance(v, Sequence | np.ndarray) or _ndim(v) != 1:
+        raise ParameterError(f"{what} must be a list of numbers, got {v!r}")
+    return tuple(_number(x, f"{what}[{i}]") for i, x in enumerate(v))
+
+
+def chain_receptance(m: Sequence[float], k: Sequence[float], c: Sequence[float], freqs: np.ndarray) -> np.ndarray:
+    """The head's receptance G(j 2 pi f) (m/N) of the chain m, k, c (stage 1 the head, unchecked): the continued
+    fraction of the dynamic stiffness seen from the head, S_n = m_n s^2 + c_n s + k_n, S_i = m_i s^2 + z_i S_{i+1} /
+    (z_i + S_{i+1}) with z_i = k_i + c_i s, G = 1 / S_1."""
+    s = 2j * np.pi * np.asarray(freqs, float)
+    S = m[-1] * s * s + k[-1] + c[-1] * s
+    for i in range(len(m) - 2, -1, -1):
+        z = k[i] + c[i] * s
+        S = m[i] * s * s + z * S / (z + S)
+    return 1.0 / S
+
+
+@dataclass(frozen=True)
+class LumpedParams:
+    """An n-stage lumped pantograph (module docstring): masses `m` (kg), springs `k` (N/m) and dampers `c` (N s/m),
+    stage 1 the head; `F0` the static uplift on the last stage (N)."""
+
+    m: tuple[float, ...]
+    k: tuple[float, ...]
+    c: tuple[float, ...]
+    F0: float
+
+    def __post_init__(self) -> None:
+        m, k, c = (_vector(getattr(self, n), n) for n in ("m", "k", "c"))
+        if not 1 <= len(m) <= MAX_STAGES or len(k) != len(m) or len(c) != len(m):
+            raise ParameterError(f"a lumped pantograph needs m, k, c of one length (1 to {MAX_STAGES} stages), got "
+                                 f"{len(m)}, {len(k)}, {len(c)}")
+        for name, vals, lo in (("m", m, 1e-6), ("c", c, 0.0)):
+            for i, x in enumerate(vals):
+                if x < lo:
+                    raise ParameterError(f"lumped pantograph {name}[{i}] = {x!r}: must be >= {lo:g}")
+        for i, x in enumerate(k):
+            if x < 0 or (x == 0 and i < len(k) - 1):
+                raise ParameterError(f"lumped pantograph k[{i}] = {x!r}: must be > 0 (the last, to the base, >= 0)")
+        object.__setattr__(self, "m", m)
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "c", c)
+        object.__setattr__(self, "F0", _number(self.F0, "lumped pantograph F0"))
+
+    @property
+    def stages(self) -> int:
+        """The number of stages."""
+        return len(self.m)
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Mass, damping and stiffness matrices (M, C, K) of the chain."""
+        n = self.stages
+
+        def chain(v: tuple[float, ...]) -> np.ndarray:
+            X = np.zeros((n, n))
+            for i in range(n):
+                X[i, i] += v[i]
+                if i + 1 < n:
+                    X[i + 1, i + 1] += v[i]
+                    X[i, i + 1] = X[i + 1, i] = -v[i]
+            return X
+
+        return np.diag(self.m), chain(self.c), chain(self.k)
+
+    def receptance(self, freqs: np.ndarray) -> np.ndarray:
+        """Head displacement per upward force on the head, G(j 2 pi f) (m/N): `chain_receptance`."""
+        return chain_receptance(self.m, self.k, self.c, freqs)
+
+    def static_force(self) -> float:
+        """The contact force (N) at the working height (head at zero) against a rigid wire: F0 k-weighted,
+        F0 / (1 + k_n sum_{i<n} 1/k_i)."""
+        return self.F0 / (1.0 + self.k[-1] * sum(1.0 / x for x in self.k[:-1]))
+
+    def section(self) -> dict[str, Any]:
+        """The scene's `[pantograph] params` of this pantograph."""
+        return {"m": list(self.m), "k": list(self.k), "c": list(self.c), "F0": self.F0}
+
+
+@dataclass(frozen=True)
+class TransferParams:
+    """A transfer-function pantograph (module docstring): x' = A x + B u, head = C x (A in 1/s, B x per N, C m per
+    unit x), u the upward force on the head; `F0` the contact force (N) at the working height against a rigid wire."""
+
+    A: tuple[tuple[float, ...], ...]
+    B: tuple[float, ...]
+    C: tuple[float, ...]
+    F0: float
+
+    def __post_init__(self) -> None:
+        A = self.A
+        if isinstance(A, str | Mapping) or not isinstance(A, Sequence | np.ndarray) or not len(A):
+            raise ParameterError(f"transfer-function pantograph A must be a square list of lists, got {A!r}")
+        rows = tuple(_vector(r, f"transfer-function pantograph A[{i}]") for i, r in enumerate(A))
+        n = len(rows)
+        if not 1 <= n <= MAX_STATES or any(len(r) != n for r in rows):
+            raise ParameterError(f"transfer-function pantograph A must be square, 1 to {MAX_STATES} states, got "
+                                 f"{[len(r) for r in rows]}")
+        B = _vector(self.B, "transfer-function pantograph B")
+        C = _vector(self.C, "transfer-function pantograph C")
+        if len(B) != n or len(C) != n:
+            raise ParameterError(f"transfer-function pantograph B and C need {n} entries (A is {n} x {n}), got "
+                                 f"{len(B)} and {len(C)}")
+        object.__setattr__(self, "A", rows)
+        object.__setattr__(self, "B", B)
+        object.__setattr__(self, "C", C)
+        object.__setattr__(self, "F0", _number(self.F0, "transfer-function pantograph F0"))
+
+    @classmethod
+    def from_tf(cls, num: Sequence[float], den: Sequence[float], F0: float) -> TransferParams:
+        """The controllable realisation of G(s) = num(s) / den(s) (coefficients highest power first, s in rad/s;
+        strictly proper)."""
+        from scipy.signal import tf2ss
+
+        num, den = np.atleast_1d(np.asarray(num, float)), np.atleast_1d(np.asarray(den, float))
+        if len(np.trim_zeros(num, "f")) >= len(np.trim_zeros(den, "f")):
+            raise ParameterError("a transfer-function pantograph needs a strictly proper G(s) (numerator degree below "
+                                 "the denominator's)")
+        A, B, C, D = tf2ss(num, den)
+        return cls(tuple(map(tuple, A)), tuple(B[:, 0]), tuple(C[0]), F0)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, C) as arrays."""
+        return np.array(self.A, float), np.array(self.B, float), np.array(self.C, float)
+
+    def receptance(self, freqs: np.ndarray) -> np.ndarray:
+        """G(j 2 pi f) = C (j 2 pi f I - A)^-1 B (m/N)."""
+        A, B, C = self.arrays()
+        eye = np.eye(len(B))
+        return np.array([C @ np.linalg.solve(2j * np.pi * f * eye - A, B) for f in np.asarray(freqs, float)])
+
+    def static_force(self) -> float:
+        """The contact force (N) at the working height against a rigid wire: F0."""
+        return self.F0
+
+    def section(self) -> dict[str, Any]:
+        """The scene's `[pantograph] params` of this pantograph."""
+        return {"A": [list(r) for r in self.A], "B": list(self.B), "C": list(self.C), "F0": self.F0}
+
+
+class LinearPantograph:
+    """A linear pantograph under the wire (module docstring): x' = A x + b0 F0 - B f, the outputs `Cout` x (row 0 the
+    head), named `names`; `energy_of(x)` (J) where the model has one."""
+
+    affine = True
+    engine = "reference"
+
+    def __init__(self, A: np.ndarray, B: np.ndarray, b0: np.ndarray, F0: float, Cout: np.ndarray,
+                 names: Sequence[str], name: str, energy_of: Callable[[np.ndarray], float] | None = None):
+        self.name = name
+        self.A, self.B, self.b0 = np.asarray(A, float), np.asarray(B, float), np.asarray(b0, float)
+        self.F0 = float(F0)
+        self.Cout = np.atleast_2d(np.asarray(Cout, float))
+        self.c = self.Cout[0]
+        self.names = tuple(names)
+        self._energy_of = energy_of
+        self.x = np.zeros(len(self.B))
+        self._dt = None
+        self._pending = None
+
+    def _prepare(self, dt: float) -> None:
+        h = dt / 2
+        n = len(self.B)
+        lu = np.linalg.inv(np.eye(n) - h * self.A)
+        self._Phi = lu @ (np.eye(n) + h * self.A)
+        self._G0 = 2 * h * self.F0 * (lu @ self.b0)
+        self._Gf = h * (lu @ self.B)
+        self._cPhi, self._cG0, self._cGf = self.c @ self._Phi, float(self.c @ self._G0), float(self.c @ self._Gf)
+        self._dt = dt
+
+    def static(self, y_wire: float, k_wire: float) -> float:
+        """Static state pressing on a wire at y_wire through k_wire: A x + b0 F0 - B f = 0, f = k_wire (c x - y_wire)
+        (k_wire = 0: free, f = 0); returns f."""
+        n = len(self.B)
+        M = np.zeros((n + 1, n + 1))
+        M[:n, :n], M[:n, n] = self.A, -self.B
+        M[n, :n], M[n, n] = k_wire * self.c, -1.0
+        rhs = np.concatenate([-self.b0 * self.F0, [k_wire * y_wire]])
+        try:
+            z = np.linalg.solve(M, rhs)
+        except np.linalg.LinAlgError:
+            raise SolverError(f"the {self.name} pantograph has no static equilibrium against a wire of stiffness "
+                              f"{k_wire:g} N/m (its model is singular there)") from None
+        self.x = z[:n]
+        return float(z[n])
+
+    def affine_map(self, dt: float, f0: float) -> tuple[float, float]:
+        """(P, g): head height at t + dt is P - g f1 (exact, the scheme is linear)."""
+        if dt != self._dt:
+            self._prepare(dt)
+        return float(self._cPhi @ self.x) + self._cG0 - self._cGf * f0, self._cGf
+
+    def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
+        """Head height at t + dt by the trapezoidal rule under f0 -> f1 (pending until `commit`)."""
+        if dt != self._dt:
+            self._prepare(dt)
+        x = self._Phi @ self.x + self._G0 - self._Gf * (f0 + f1)
+        self._pending = x
+        return float(self.c @ x)
+
+    def commit(self) -> None:
+        """Accept the last trial."""
+        self.x = self._pending
+
+    def head(self) -> float:
+        """Head displacement (m) of the committed state."""
+        return float(self.c @ self.x)
+
+    def signals(self) -> dict[str, float]:
+        """The named outputs of the committed state (m)."""
+        y = self.Cout @ self.x
+        return {k: float(v) for k, v in zip(self.names, y, strict=True)}
+
+    def energy(self) -> float:
+        """The model's energy (J): kinetic + springs - work of F0 (lumped pantographs only)."""
+        if self._energy_of is None:
+            raise SolverError(f"the {self.name} pantograph (a transfer function) has no energy to report")
+        return self._energy_of(self.x)
+
+
+def lumped(p: LumpedParams, name: str = LUMPED) -> LinearPantograph:
+    """The lumped pantograph of `p` under the wire: state (x_1 .. x_n, v_1 .. v_n), outputs every stage's
+    displacement (`head_displacement`, `stage_2_displacement`, ..., `frame_displacement` for the last)."""
+    M, C, K = p.matrices()
+    n = p.stages
+    Mi = np.diag(1.0 / np.asarray(p.m))
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Mi @ K, -Mi @ C]])
+    B = np.zeros(2 * n)
+    B[n] = 1.0 / p.m[0]
+    b0 = np.zeros(2 * n)
+    b0[2 * n - 1] = 1.0 / p.m[-1]
+    names = ["head_displacement"] + [f"stage_{i + 1}_displacement" for i in range(1, n - 1)]
+    names += ["frame_displacement"] if n > 1 else []
+    Cout = np.eye(n, 2 * n)
+
+    def energy(x: np.ndarray) -> float:
+        q, v = x[:n], x[n:]
+        return float(0.5 * v @ M @ v + 0.5 * q @ K @ q - p.F0 * q[-1])
+
+    return LinearPantograph(A, B, b0, p.F0, Cout, names, name, energy)
+
+
+def transfer(p: TransferParams, name: str = TRANSFER) -> LinearPantograph:
+    """The transfer-function pantograph of `p` under the wire: its state is the model's, its output the head."""
+    A, B, C = p.arrays()
+    return LinearPantograph(A, B, B, p.F0, C[None, :], ["head_displacement"], name)
+
+
+# --- the scene's [pantograph] section ----------------------------------------------------------------------------
+#: kind -> (the keys of its `[pantograph] params`, its parameter class)
+KINDS: dict[str, tuple[tuple[str, ...], type]] = {LUMPED: (LUMPED_KEYS, LumpedParams),
+                                                  TRANSFER: (TRANSFER_KEYS, TransferParams)}
+
+
+def params_of(kind: str, value: Any) -> LumpedParams | TransferParams:
+    """The parameters of the linear pantograph `kind` from the scene's `[pantograph]` section `value` (`params` only;
+    SceneError naming the missing, unknown or bad key)."""
+    keys, cls = KINDS[kind]
+    if not isinstance(value, Mapping) or not value:
+        raise SceneError(f"the {kind} pantograph takes its parameters from the scene's [pantograph] section: params "
+                         f"= {{{', '.join(keys)}}} (got {value!r})")
+    bad = sorted(set(value) - {"effects", "params"})
+    if bad:
+        raise SceneError(f"unknown key(s) {bad} in [pantograph]; valid keys: ['params'] (the {kind} pantograph)")
+    if value.get("effects"):
+        raise SceneError(f"the {kind} pantograph has no effects: remove [pantograph] effects = "
+                         f"{dict(value['effects'])!r}")
+    params = value.get("params")
+    if not isinstance(params, Mapping):
+        raise SceneError(f"the {kind} pantograph needs [pantograph] params = {{{', '.join(keys)}}}, got {params!r}")
+    unknown, missing = sorted(set(params) - set(keys)), [k for k in keys if k not in params]
+    if unknown or missing:
+        raise SceneError(f"[pantograph] params of the {kind} pantograph: unknown {unknown}, missing {missing}; "
+                         f"valid keys: {list(keys)}")
+    try:
+        return cls(**{k: params[k] for k in keys})
+    except ParameterError as exc:
+        raise SceneError(f"[pantograph] params: {exc}") from None
+
+
+def make(kind: str, section: Mapping[str, Any], name: str | None = None) -> LinearPantograph:
+    """The linear pantograph `kind` (`LUMPED` or `TRANSFER`) of the scene's `[pantograph]` section."""
+    p = params_of(kind, section)
+    return lumped(p, name or kind) if isinstance(p, LumpedParams) else transfer(p, name or kind)

@@ -140,6 +140,8 @@ class ModelSpec:
     file_checks: Mapping[str, Callable[..., None]] = field(default_factory=dict)
     accuracy: Any = None
     uses: Mapping[str, Uses] = field(default_factory=dict)
+    #: the parameters of a scene when its own sections change them (the catenary's [line]); None: params_cls(**params)
+    params_builder: Callable[[Any], Any] | None = None
 
     def __post_init__(self) -> None:
         self._check_uses()

@@ -84,7 +84,10 @@ class Scene:
         return get_model(self.model)
 
     def build_params(self):
-        """The model's parameter dataclass with this scene's overrides applied (and validated by the dataclass)."""
+        """The model's parameter dataclass with this scene's overrides applied (and validated by the dataclass); a
+        model whose sections change its parameters builds them itself (`ModelSpec.params_builder`)."""
+        if self.spec.params_builder is not None:
+            return self.spec.params_builder(self)
         return self.spec.params_cls(**dict(self.params))
 
     def to_dict(self) -> dict[str, Any]:
@@ -242,7 +245,11 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     for k in spec.sections:
         if k in data:
             try:
-                extra[k] = spec.sections[k](data[k])
+                check = spec.sections[k]
+                if getattr(check, "wants_base", False):  # a section naming files: relative to the scene's folder
+                    extra[k] = check(data[k], base=Path(source).parent if source else None)
+                else:
+                    extra[k] = check(data[k])
             except MbsuiteError as exc:
                 raise _told(exc, where(k)) from None
 

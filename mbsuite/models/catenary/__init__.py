@@ -14,6 +14,7 @@ from ...registry import Effect, ModelSpec, RunPath, Uses
 from ...solver import SolverSettings
 from . import accuracy
 from .config import validate_train_section
+from .linefile import scene_params, validate_line_section
 from .pantographs import PANTOGRAPH_MODELS, PANTOGRAPHS, TWO_MASS, validate_section
 from .params import CatenaryParams
 from .quality import validate_section as validate_quality
@@ -58,8 +59,10 @@ SPEC = ModelSpec(
                           "one MuJoCo step per catenary step, secant-coupled (no 2-mass pantograph alone)"),
     },
     solver=SolverSettings(engine="reference", timestep=1e-4, duration=6.1),
-    sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train_section},
+    sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train_section,
+              "line": validate_line_section},
     cases="mbsuite.models.catenary.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
+    params_builder=scene_params,
 )

@@ -5,12 +5,14 @@ statistics' estimated errors (`accuracy.py`)."""
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ...cli.options import add_error_estimate, add_scene_options, check_workers, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import SceneError
 from ...results import Progress, Report
-from ...scenes import Scene
+from ...scenes import Scene, load_scene, scene_from_dict
+from .linefile import is_line_file
 
 COMMAND = "catenary"
 # the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
@@ -21,7 +23,8 @@ def register(sub, add_common, emit) -> str:
     """Add the `mbsuite catenary` command to the CLI's subparsers `sub`; returns its name."""
     p = sub.add_parser(COMMAND, help=CLI_COMMANDS[COMMAND])
     p.add_argument("scene", nargs="?", default="catenary",
-                   help="scene TOML path, 'catenary' (default scene) or catenary/<scene>")
+                   help="scene TOML path, 'catenary' (default scene), catenary/<scene>, or a line file (TOML with "
+                        "[[wires]]: run under the default scene, model README 'A line of your own')")
     p.add_argument("--speed", type=float, default=None, help="train speed (km/h); default: the scene's input.speed")
     p.add_argument("--timestep", type=float, default=None, help="override solver.timestep (s)")
     p.add_argument("--element-length", type=float, default=None, help="override params.element_length (m)")
@@ -61,9 +64,23 @@ class _Percent:
             self.last = k
 
 
+def line_scene(path: str) -> Scene:
+    """The default scene (`catenary/en50318`: 2-mass reference pantograph, 250 km/h) on the line of a line file: the
+    run over [0, 0.7 L] and the statistics window [0.4 L, 0.6 L] of its length L (the EN 50318 scene's proportions,
+    420 and 240-360 of 600 m); a scene of your own (`[line] file = ...`) sets them."""
+    from .linefile import read_line_file
+
+    L = read_line_file(path)[0].length
+    d = load_scene("catenary/en50318").to_dict()
+    d.update(name=Path(path).stem, description=f"the line of {path} under the scene catenary/en50318",
+             line={"file": str(Path(path).resolve())},
+             params={"x_start": 0.0, "x_end": 0.7 * L, "window_start": 0.4 * L, "window_end": 0.6 * L})
+    return scene_from_dict(d, source=str(path))
+
+
 def _scene(args: argparse.Namespace) -> Scene:
     """The command's catenary scene with the command line's overrides."""
-    scene = scene_of(args.scene)
+    scene = line_scene(args.scene) if is_line_file(args.scene) else scene_of(args.scene)
     if scene.model != "catenary":
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "
                          "catenary scene")

@@ -66,8 +66,8 @@ def test_the_en50318_scene_on_its_line_file_is_unchanged(speed):
 def test_stitch_wires_even_out_the_contact_wire_stiffness_along_a_span():
     """What the stitched catenary is for (Eppinger 1984, Ch. 1, Figure 1-1c): the contact wire's static receptance
     varies less along a span than on the simple line. Measured on the middle span of 5 (receptance at every node):
-    (max - min) / mean 0.73 simple against 0.55 stitched; the support's receptance rises from 0.35 to 0.53 of
-    mid-span's."""
+    (max - min) / mean 0.78 simple against 0.36 stitched; the support's receptance rises from 0.50 to 0.79 of the
+    span's largest. Bounds: the variation at most 0.7 of the simple line's, the support's share 1.3 times."""
     p = CatenaryParams(n_spans=5, x_end=300.0, window_start=120.0, window_end=240.0)
 
     def receptance(line):
@@ -83,8 +83,8 @@ def test_stitch_wires_even_out_the_contact_wire_stiffness_along_a_span():
 
     simple, stitched = receptance(lines.simple(p)), receptance(lines.stitched(p))
     var = [(r.max() - r.min()) / r.mean() for r in (simple, stitched)]
-    assert var[1] < 0.9 * var[0], var
-    assert stitched[0] / stitched.max() > 1.2 * simple[0] / simple.max()
+    assert var[1] < 0.7 * var[0], var
+    assert stitched[0] / stitched.max() > 1.3 * simple[0] / simple.max()
 
 
 def test_the_stitched_line_follows_the_fixed_scene():

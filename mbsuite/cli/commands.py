@@ -26,6 +26,8 @@ def analyses(spec: registry.ModelSpec, group: str | None) -> list[str]:
     out = [a for a in ANALYSES if (hooks[a] if a in hooks else getattr(spec, a)) is not None]
     if spec.paths:
         out += ["sweep", "perturb"]
+    if spec.accuracy is not None:
+        out += ["sensitivity", "optimise"]
     if spec.cases:
         out += ["workprecision", "hardcases"]
     if group:

@@ -18,7 +18,8 @@ from .options import SCENE_HELP, add_error_estimate, add_scene_options, add_swee
 from .output import add_common, emit
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
-GENERIC = ("list", "run", "view", "render", "sweep", "workprecision", "perturb", "hardcases")
+GENERIC = ("list", "run", "view", "render", "sweep", "sensitivity", "optimise", "workprecision", "perturb",
+           "hardcases")
 
 
 def deferred(module: str, name: str) -> Callable:
@@ -109,8 +110,8 @@ def parser_for(argv: list[str]) -> argparse.ArgumentParser:
 
 
 def add_generic_commands(sub: argparse._SubParsersAction) -> None:
-    """`list`, `run`, `view`, `render`, `sweep`, `workprecision`, `perturb`, `hardcases`: commands every model's scenes
-    take."""
+    """`list`, `run`, `view`, `render`, `sweep`, `sensitivity`, `optimise`, `workprecision`, `perturb`, `hardcases`:
+    commands every model's scenes take (the design studies: those declaring headline outputs)."""
     p = sub.add_parser("list", help="models, their paths and their shipped scenes")
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_list"))
@@ -155,6 +156,8 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     add_common(p)
     p.set_defaults(func=deferred(".sweep", "cmd_sweep"))
 
+    add_design_commands(sub)
+
     p = sub.add_parser("workprecision", help="what accuracy costs: error vs wall time for every engine and method")
     p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("--repeats", type=int, default=5, help="runs per setting; wall time = median (default 5)")
@@ -185,6 +188,72 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-slow", action="store_true", help="leave out the slow cases")
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_hardcases"))
+
+
+def add_design_commands(sub: argparse._SubParsersAction) -> None:
+    """`sensitivity` and `optimise`: the design studies of any scene declaring headline outputs (`cli.design`)."""
+    p = sub.add_parser("sensitivity", help="which parameters move a scene's headline outputs: Morris screening or "
+                                           "Sobol indices over declared ranges (SALib)")
+    p.add_argument("scene", help=SCENE_HELP)
+    _design_ranges(p)
+    p.add_argument("--method", choices=("morris", "sobol"), default="morris",
+                   help="morris: elementary effects, n (k + 1) runs; sobol: first-order and total indices, n (k + 2) "
+                        "runs (default morris)")
+    p.add_argument("--n", type=int, default=8,
+                   help="morris: trajectories; sobol: base sample, a power of two (default 8)")
+    p.add_argument("--levels", type=int, default=4, help="morris grid levels, even (default 4)")
+    p.add_argument("--outputs", help="comma list of headline outputs to analyse (default: all)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the sample and the bootstrap (default 0)")
+    p.add_argument("--workers", type=int, default=0, help="local processes or threads (0 = all cores)")
+    add_sweep_options(p)
+    add_scene_options(p)
+    add_common(p)
+    p.set_defaults(func=deferred(".design", "cmd_sensitivity"))
+
+    p = sub.add_parser("optimise", help="the design minimising a headline output over declared ranges, subject to "
+                                        "bounds (e.g. Fm in the EN 50367 band), at one or several speeds; or a "
+                                        "Pareto front")
+    p.add_argument("scene", help=SCENE_HELP)
+    _design_ranges(p)
+    p.add_argument("--objective", default="sigma", help="the headline output to minimise (default sigma)")
+    p.add_argument("--constraint", action="append", metavar="OUTPUT=LO:HI",
+                   help="bounds on a headline output, e.g. Fm=100:130 (an empty side is open: Fm=100:); "
+                        "Fm=band[:SYSTEM] is the EN 50367 band at each speed (repeatable)")
+    p.add_argument("--band", metavar="SYSTEM", choices=("AC", "DC3kV", "DC1.5kV"),
+                   help="shortcut for --constraint Fm=band:SYSTEM (the catenary's EN 50367 band)")
+    p.add_argument("--speed", metavar="KMH",
+                   help="train speed(s), km/h: one value sets input.speed; a comma list makes the robust variant "
+                        "(every design at each speed, --aggregate)")
+    p.add_argument("--over", action="append", metavar="SECTION.KEY=VALUES",
+                   help="operating points of the robust variant (any input/parameter), e.g. input.speed=250,300 "
+                        "(repeatable: every combination)")
+    p.add_argument("--aggregate", choices=("worst", "mean"), default="worst",
+                   help="over several operating points: minimise the worst (default) or the mean")
+    p.add_argument("--maxiter", type=int, default=20, help="generations of differential evolution (default 20)")
+    p.add_argument("--popsize", type=int, default=5, help="members per factor (scipy's popsize; default 5)")
+    p.add_argument("--penalty", type=float, default=10.0,
+                   help="objective units per unit of constraint violation (exact penalty; default 10)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the optimiser (default 0)")
+    p.add_argument("--pareto", metavar="LEVELS",
+                   help="a Pareto front instead: minimise the objective with --against >= each level (a,b,c or "
+                        "start:stop:step; epsilon-constraint)")
+    p.add_argument("--against", default="Fm", help="the output the front trades against, maximised (default Fm)")
+    p.add_argument("--error-estimate", action="store_true",
+                   help="re-run the optimum at each operating point with its error estimate (refined once and "
+                        "twice)")
+    p.add_argument("--workers", type=int, default=0, help="local processes or threads (0 = all cores)")
+    add_sweep_options(p)
+    add_scene_options(p)
+    add_common(p)
+    p.set_defaults(func=deferred(".design", "cmd_optimise"))
+
+
+def _design_ranges(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--vary", action="append", metavar="SECTION.KEY=LO:HI",
+                   help="a parameter and its range, e.g. params.m1=5:10 or pantograph.params.Pg=6.5e5:8e5 "
+                        "(repeatable)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
+                   help="change one value of the scene at every point, e.g. params.n_spans=4 (repeatable)")
 
 
 def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:

@@ -10,6 +10,11 @@ passage each, in fresh interpreters, assembly included, alternating, medians and
 
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py [--repeats 3] [--speeds 250 300] [--eppinger]
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --compare [--repeats 7] [--baseline REV]
+    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --lines [--repeats 7]
+
+`--lines` times the core's step loop (a whole passage, the 2-mass pantograph, the scene's mesh and step) on the
+simple, stitched and compound lines, alternating, and prints the medians per step and per element-step with their
+ratio to the simple line's (the compiled core's cost on a line with more wires per node).
 """
 
 from __future__ import annotations
@@ -128,6 +133,38 @@ def compare(speeds: list[float], repeats: int, baseline: str | None) -> None:
                         "ratio shipped / plain", "max |stat diff| (N, mm)"], rows))
 
 
+LINE_SCENES = ("catenary/en50318", "catenary/en50318_stitched", "catenary/en50318_compound")
+
+
+def lines(speeds: list[float], repeats: int) -> None:
+    """The core's step loop on each line of LINE_SCENES, alternating; medians per step and per element-step."""
+    from mbsuite.scenes import load_scene
+
+    scenes = {name: load_scene(name) for name in LINE_SCENES}
+    rows = []
+    for v in speeds:
+        cpu: dict[str, list[float]] = {name: [] for name in scenes}
+        size = {}
+        for _ in range(repeats):
+            for name, sc in scenes.items():
+                p, dt = sc.build_params(), sc.solver.timestep
+                cpu[name].append(core_loop_cpu(p, v, dt, True))
+                fe = assemble(p)
+                size[name] = (fe.n_elements, fe.n, int(np.diff(fe.node_offset).max()),
+                              round((p.x_end - p.x_start) / (v / 3.6) / dt))
+        base = None
+        for name in scenes:
+            med = statistics.median(cpu[name])
+            ne, n, blk, steps = size[name]
+            per = 1e9 * med / (ne * steps)
+            base = base or per
+            rows.append([v, name.split("/")[1], ne, n, blk, steps, f"{med:.2f}",
+                         f"{min(cpu[name]):.2f}-{max(cpu[name]):.2f}", f"{1e6 * med / steps:.1f}", f"{per:.1f}",
+                         f"{per / base:.2f}"])
+    print(format_table(["km/h", "line", "elements", "DOFs", "node block", "steps", "core loop CPU s (median)",
+                        "min-max", "us/step", "ns/element-step", "ratio to simple (per element-step)"], rows))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
@@ -137,7 +174,11 @@ def main() -> None:
     ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
     ap.add_argument("--compare", action="store_true", help="the shipped method against the plain Hermite wires")
     ap.add_argument("--baseline", default=None, help="with --compare: a git revision whose code runs the plain wires")
+    ap.add_argument("--lines", action="store_true", help="the core's step loop on the simple, stitched, compound lines")
     a = ap.parse_args()
+    if a.lines:
+        lines(a.speeds, a.repeats)
+        return
     if a.compare:
         compare(a.speeds, a.repeats, a.baseline)
         return

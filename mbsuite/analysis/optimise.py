@@ -320,7 +320,8 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
         options: SweepOptions | None = None, progress: bool | None = None) -> OptimiseResult:
     """Minimise `objective` over the factors' ranges (scipy `differential_evolution`, generations evaluated on the
     sweep machinery), subject to `constraints` (`Bound`s or `OUTPUT=LO:HI` texts) at every operating point of
-    `over`, aggregated by `aggregate`. `popsize`: members per factor (scipy's meaning); `maxiter`: generations.
+    `over`, aggregated by `aggregate`. `popsize`: members per factor (scipy's meaning, at least 5 in all);
+    `maxiter`: generations.
     `start`: a design evaluated first and reported beside the optimum (default: the scene's own values of the
     factors, when they lie in the ranges)."""
     from scipy.optimize import differential_evolution
@@ -356,8 +357,7 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
 
     res = differential_evolution(lambda x: prob.penalised([x])[0], [(f.lo, f.hi) for f in facs], maxiter=maxiter,
                                  popsize=popsize, tol=tol, rng=np.random.default_rng(seed), polish=False,
-                                 updating="deferred", workers=batch_map, x0=x0,
-                                 init="sobol" if _pow2(popsize, facs) else "latinhypercube")
+                                 updating="deferred", workers=batch_map, x0=x0, init="latinhypercube")
     best_x = np.asarray(res.x, dtype=float)
     value, viol, outs = prob.evaluate([best_x])[0]  # from the cache: the optimum was evaluated
     return OptimiseResult(objective, aggregate, facs, cons, ctxs, prob.design(best_x), float(value), viol == 0.0,
@@ -366,11 +366,6 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
                            "popsize": popsize, "tol": tol, "penalty": penalty, "generations": int(res.nit),
                            "polish": False, "updating": "deferred"},
                           str(res.message), units, scene.name if scene is not None else _name(fn), start_rec)
-
-
-def _pow2(popsize: int, facs: list[Factor]) -> bool:
-    total = popsize * len(facs)
-    return total >= 2 and not total & (total - 1)
 
 
 def _name(fn: Any) -> str:

@@ -25,7 +25,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 2
+ABI = 3
 
 
 class _Job(ctypes.Structure):
@@ -33,19 +33,20 @@ class _Job(ctypes.Structure):
         ("n", _I), ("bw", _I), ("nd", _I), ("nsup", _I), ("ncon", _I), ("nnode", _I), ("nnz", _I),
         ("slack", _I), ("unilateral", _I), ("max_iter", _I),
         ("h", _D), ("hh2", _D), ("c_ab", _D), ("inv_1ha", _D), ("c_kd", _D), ("two_hh", _D), ("kc", _D),
-        ("V", _D), ("dt", _D), ("max_disp", _D), ("cw_T", _D), ("cw_EI", _D),
-        ("L", _P), ("invd", _P), ("Kp", _P), ("Ki", _P), ("Kx", _P), ("mw", _P), ("cw", _P), ("T0", _P),
-        ("kdj", _P), ("Zg", _P), ("D", _P), ("xnode", _P), ("cwdof", _P), ("w0cw", _P), ("supidx", _P),
-        ("esig", _P), ("pq", _P), ("pref", _P),
+        ("V", _D), ("dt", _D), ("max_disp", _D), ("cw_EI", _D),
+        ("L", _P), ("invd", _P), ("Kp", _P), ("Ki", _P), ("Kx", _P), ("up", _P), ("lo", _P), ("dslack", _P),
+        ("T0", _P), ("kdj", _P), ("Zg", _P), ("D", _P), ("xnode", _P), ("cwdof", _P), ("w0cw", _P), ("supidx", _P),
+        ("esig", _P), ("pq", _P), ("pref", _P), ("ptk", _P), ("nirr", _I), ("irr_x0", _D), ("irr_dx", _D), ("irr", _P),
         ("u", _P), ("q", _P), ("p", _P), ("R", _P), ("vbs", _P), ("vb", _P),
         ("slk", _P), ("nslack", _I), ("sS", _P),
         ("present", _P), ("active", _P), ("elem", _P), ("xc", _P), ("xs", _P), ("xend", _P), ("Nl", _P),
         ("dofs", _P), ("w0d", _P), ("cols", _P), ("crng", _P), ("zrng", _P), ("f", _P), ("kce", _P), ("cbc", _P),
-        ("gv", _P), ("a", _P), ("Cm", _P), ("bz", _P),
+        ("rirr", _P), ("gv", _P), ("a", _P), ("Cm", _P), ("bz", _P),
         ("dstar", _P), ("P", _P), ("gp", _P), ("head", _P), ("work", _P), ("iwork", _P), ("pm", _P),
         ("rec_t", _P), ("rec_x", _P), ("rec_f", _P), ("rec_head", _P), ("rec_wire", _P), ("rec_frame", _P),
         ("rec_up", _P), ("rec_ns", _P),
-        ("blocked", _I), ("fidx", _P), ("blk", _P), ("pw", _P),
+        ("blocked", _I), ("fidx", _P), ("noff", _P), ("boff", _P), ("blk", _P), ("pw", _P), ("seg", _P),
+        ("nseg_f", _I), ("nseg_b", _I),
         ("n_local", ctypes.c_long), ("err", _I), ("err_con", _I), ("err_value", _D),
     ]
 
@@ -80,6 +81,54 @@ def _ptr(a: np.ndarray | None) -> int | None:
     return None if a is None else a.ctypes.data
 
 
+def _band_arrays(S, bw: int, node_offset: np.ndarray, free: np.ndarray) -> dict[str, np.ndarray]:
+    """The arrays of the factorisation of the SPD step matrix `S` (sparse, on the free DOFs, half-bandwidth `bw`):
+    its lower band and the storage of the factor's block form, node I's DOFs at `node_offset[I] ..
+    node_offset[I+1] - 1` of the padded vector, `free` the padded index of each free DOF (per node of size s between
+    nodes of sizes p and q: s^2 + s p + s^2 + s q doubles, `native/catenary.c`, build_blocks)."""
+    S = S.tocsr()
+    n = S.shape[0]
+    L = np.zeros((n, bw + 1))
+    for k in range(bw + 1):
+        L[k:, k] = S.diagonal(-k)
+    noff = np.asarray(node_offset, dtype=np.int64)
+    s = np.diff(noff)
+    sp = np.concatenate([[0], s[:-1]])
+    sq = np.concatenate([s[1:], [0]])
+    boff = np.concatenate([[0], np.cumsum(2 * s * s + s * (sp + sq))])
+    if boff[-1] >= 2**31 or noff[-1] >= 2**31:
+        raise SolverError(f"the catenary's padded DOF vector ({noff[-1]}) is too large for the native core")
+    return {"L": L, "invd": np.zeros(n), "fidx": np.asarray(free).astype(np.int32), "noff": noff.astype(np.int32),
+            "boff": boff.astype(np.int32), "blk": np.zeros(max(int(boff[-1]), 1)),
+            "pw": np.zeros(max(int(noff[-1]), 1)), "seg": np.zeros(6 * max(s.size, 1), np.int32)}
+
+
+class NativeFactor:
+    """The core's factorisation of an SPD matrix `S` on its own (no passage): node I's DOFs at `node_offset[I] ..
+    node_offset[I+1] - 1` of the padded vector, `free` the padded index of each row of S. `solve` runs the sweeps
+    the core steps with (block form when `blocked`, else the band)."""
+
+    def __init__(self, S, node_offset: np.ndarray, free: np.ndarray):
+        lib = self.lib = library()
+        S = S.tocsr()
+        r, c = S.nonzero()
+        j = self.job = _Job()
+        j.n, j.nnode = S.shape[0], np.size(node_offset) - 1
+        j.bw = int(np.max(np.abs(r - c))) if r.size else 0
+        self._arrays = _band_arrays(S, j.bw, node_offset, free)
+        for name, arr in self._arrays.items():
+            setattr(j, name, arr.ctypes.data)
+        if lib.mbs_cat_factor(ctypes.byref(j)):
+            raise SolverError(f"the matrix is not positive definite (native Cholesky, row {int(j.err_value)})")
+        self.blocked = bool(j.blocked)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """x = S^-1 b."""
+        x = np.ascontiguousarray(b, dtype=float).copy()
+        self.lib.mbs_cat_solve(ctypes.byref(self.job), x.ctypes.data)
+        return x
+
+
 class NativeCore:
     """The C twin of a passage of `sim` with `ncon` contact points (see the module docstring). Arrays are owned here
     (numpy) and the C job points into them; the state arrays (`u`, `q`, `p`, `f`, `head`, `pm`, ...) are views the
@@ -89,16 +138,13 @@ class NativeCore:
         lib = self.lib = library()
         fe, p = sim.fe, sim.fe.params
         n, nd, nc = fe.n, fe.T0.size, int(ncon)
+        if nd and (np.min(fe.dropper_upper) < 0 or np.min(fe.dropper_lower) < 0):
+            raise SolverError("a dropper hangs from a pinned DOF (fe.dropper_upper / dropper_lower hold -1)")
         self._keep: list[np.ndarray] = []
-        S = sim.S.tocsr()
-        bw = sim.lu.bandwidth
-        L = np.zeros((n, bw + 1))
-        for k in range(bw + 1):
-            L[k:, k] = S.diagonal(-k)
         K = sim.K.tocsr()
         K.sort_indices()
         j = self.job = _Job()
-        j.n, j.bw, j.nd, j.nsup, j.ncon, j.nnode = n, bw, nd, fe.supports.size, nc, fe.x.size
+        j.n, j.bw, j.nd, j.nsup, j.ncon, j.nnode = n, sim.lu.bandwidth, nd, fe.support_cw.size, nc, fe.x.size
         j.nnz = K.nnz
         j.slack, j.unilateral, j.max_iter = int(sim.slack), int(sim.unilateral), int(sim.max_active_iter)
         h = sim.h
@@ -108,21 +154,24 @@ class NativeCore:
         j.c_kd, j.two_hh, j.kc = (c_ab - h * h) * inv_1ha, 2 * h * h, p.k_contact
         j.V, j.dt, j.max_disp = sim.V, sim.dt, sim.max_displacement
         pc = fe.contact
-        j.cw_T, j.cw_EI = pc.T, pc.EI
-        cwdof = np.stack([fe.full_to_free[4 * np.arange(fe.x.size)], fe.full_to_free[4 * np.arange(fe.x.size) + 1]],
-                         axis=1)
-        w0cw = np.stack([fe.w0_full[4 * np.arange(fe.x.size)], fe.w0_full[4 * np.arange(fe.x.size) + 1]], axis=1)
-        sup = fe.full_to_free[4 * fe.supports]
+        j.cw_EI = pc.EI
+        irr = fe.irregularity
+        j.nirr = 0 if irr is None else int(np.size(irr.r))
+        j.irr_x0, j.irr_dx = (0.0, 1.0) if irr is None else (float(irr.x0), float(irr.dx))
         zg = np.ascontiguousarray(sim.Zg.T) if sim.slack else np.zeros((max(nd, 1), n))
         dd = np.ascontiguousarray(sim.D) if sim.slack else np.zeros((max(nd, 1), max(nd, 1)))
         m = nc + nd
         arrays = {
-            "L": L, "invd": np.zeros(n), "Kp": K.indptr.astype(np.int32), "Ki": K.indices.astype(np.int32),
-            "Kx": K.data.astype(float), "mw": fe.dropper_mw.astype(np.int32), "cw": fe.dropper_cw.astype(np.int32),
+            **_band_arrays(sim.S, j.bw, fe.node_offset, fe.free),
+            "Kp": K.indptr.astype(np.int32), "Ki": K.indices.astype(np.int32),
+            "Kx": K.data.astype(float), "up": fe.dropper_upper.astype(np.int32),
+            "lo": fe.dropper_lower.astype(np.int32), "dslack": np.asarray(sim.slackable, np.int32),
             "T0": fe.T0.astype(float), "kdj": np.asarray(sim.kd, float) if nd else np.zeros(1), "Zg": zg, "D": dd,
-            "xnode": fe.x.astype(float), "cwdof": cwdof.astype(np.int32), "w0cw": w0cw.astype(float),
-            "supidx": sup.astype(np.int32), "esig": pc.sig.astype(np.int32), "pq": pc.Q.reshape(-1).astype(float),
-            "pref": pc.ref.reshape(-1).astype(float),
+            "xnode": fe.x.astype(float), "cwdof": fe.cw_dof.astype(np.int32), "w0cw": fe.cw_w0.astype(float),
+            "supidx": fe.support_cw.astype(np.int32), "esig": pc.sig.astype(np.int32),
+            "pq": pc.Q.reshape(-1).astype(float), "pref": pc.ref.reshape(-1).astype(float),
+            "ptk": np.full(pc.ref.shape[0], pc.T) if pc.Tk is None else np.asarray(pc.Tk, float),
+            "irr": np.zeros(1) if irr is None else np.asarray(irr.r, float).reshape(-1),
             "u": np.zeros(n), "q": np.zeros(n), "p": np.zeros(n), "R": np.zeros(n), "vbs": np.zeros(n),
             "vb": np.zeros(n), "slk": np.zeros(max(nd, 1), np.int32), "sS": np.zeros(max(nd, 1)),
             "present": np.zeros(nc, np.int32), "active": np.zeros(nc, np.int32), "elem": -np.ones(nc, np.int32),
@@ -130,24 +179,27 @@ class NativeCore:
             "Nl": np.zeros(4 * nc), "dofs": np.zeros(4 * nc, np.int32), "w0d": np.zeros(4 * nc),
             "cols": np.zeros((nc, 4, n)), "crng": np.zeros(2 * nc, np.int32),
             "zrng": np.zeros(2 * max(nd, 1), np.int32), "f": np.zeros(nc), "kce": np.full(nc, float(p.k_contact)),
-            "cbc": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
+            "cbc": np.zeros(nc), "rirr": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
             "Cm": np.zeros(nc * nc), "bz": np.zeros(max(nc * nd, 1)), "dstar": np.zeros(max(nd, 1)),
             "P": np.zeros(nc), "gp": np.zeros(nc), "head": np.zeros(nc),
             "work": np.zeros(m * (m + 1) + m + 1), "iwork": np.zeros(2 * m + 2, np.int32),
             "pm": np.zeros(16 * nc),
-            "fidx": fe.free.astype(np.int32), "blk": np.zeros(64 * fe.x.size), "pw": np.zeros(4 * fe.x.size),
         }
-        for name, arr in arrays.items():
-            arr = np.ascontiguousarray(arr)
-            arrays[name] = arr
-            setattr(j, name, arr.ctypes.data)
-            setattr(self, name, arr)
-        self._arrays = arrays
+        self._bind(arrays)
         if lib.mbs_cat_factor(ctypes.byref(j)):
             raise SolverError(f"the step matrix is not positive definite (native Cholesky, row {int(j.err_value)})")
         if sim.slack:
             lib.mbs_cat_dropper_ranges(ctypes.byref(j))
         self.blocked = bool(j.blocked)
+
+    def _bind(self, arrays: dict[str, np.ndarray]) -> None:
+        """Point the job's fields at `arrays` (kept here, contiguous) and expose each as an attribute."""
+        for name, arr in arrays.items():
+            arr = np.ascontiguousarray(arr)
+            arrays[name] = arr
+            setattr(self.job, name, arr.ctypes.data)
+            setattr(self, name, arr)
+        self._arrays = arrays
 
     # --- state exchange ---------------------------------------------------------------------------------------
     @property

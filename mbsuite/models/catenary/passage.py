@@ -16,7 +16,6 @@ import numpy as np
 
 from ...errors import SolverError
 from ...stepping import Stepping
-from .fe import CW_W, NDOF_NODE
 
 #: steps between the plausibility checks of a passage (and the progress calls of `CoupledSimulation.run`)
 CHECK_EVERY = 200
@@ -28,6 +27,34 @@ def steps_to_cover(distance: float, V: float, dt: float) -> int:
     is taken to a relative 1e-8, so a 1e-12 change of V, dt or the positions cannot add a step."""
     r = distance / (V * dt)
     return int(math.ceil(r - 1e-8 * max(1.0, abs(r))))
+
+
+def irregularity_at(irr, x: float) -> tuple[float, float]:
+    """The contact wire's height irregularity r(x) (m) and its slope dr/dx at position x (m): `irr` (`fe.irregularity`:
+    heights `r` on the uniform grid x0 + i dx) interpolated linearly, 0 outside the grid and for None; the slope is
+    the right-hand one at a grid point. The compiled core evaluates r in the same operations (native/catenary.c)."""
+    if irr is None:
+        return 0.0, 0.0
+    r = irr.r
+    m = len(r)
+    t = (x - irr.x0) / irr.dx
+    if not t >= 0.0 or t > m - 1:
+        return 0.0, 0.0
+    i = int(t)
+    if i >= m - 1:
+        return float(r[m - 1]), 0.0
+    return float(r[i] + (t - i) * (r[i + 1] - r[i])), float((r[i + 1] - r[i]) / irr.dx)
+
+
+def dropper_energy(sim: Any, u: np.ndarray) -> float:
+    """The droppers' stored energy at the displacement u from the static state, beyond the static tensions' linear
+    term (J): the potential of T(delta) = T0 + k delta, or max(T0 + k delta, 0) for a tension-only dropper
+    (`sim.slackable`), less T0 delta (that term cancels against the static reactions' work: the static state is an
+    equilibrium)."""
+    delta = u[sim.up] - u[sim.lo]
+    kd, T0 = sim.kd, sim.fe.T0
+    Vd = np.where(sim.slackable & (delta < -T0 / kd), -0.5 * T0**2 / kd, T0 * delta + 0.5 * kd * delta**2)
+    return float(np.sum(Vd - T0 * delta))
 
 
 #: the energy terms recorded with `record_energy` (`Passage.energy_terms`)
@@ -94,9 +121,9 @@ class Passage(Stepping):
         q = np.zeros(n)
         pv = np.zeros(n)
         e, _ = sim.locate(x_start, 0)
-        self._set_contactelement(e, (x_start - fe.x[e]))
+        self._set_contactelement(e, x_start)
         Nl, dofs, valid = self.Nl, self._dofs, self._valid
-        w0 = float(Nl @ self._w0d)
+        w0 = float(Nl @ self._w0d) + self.r_irr
         c_static = sim.static_compliance(Nl, dofs)
         f = panto.static(w0, 1.0 / (1.0 / self.kce + c_static))
         if sim.unilateral and f < 0:
@@ -105,7 +132,7 @@ class Passage(Stepping):
             rhs = np.zeros(n)
             rhs[dofs[valid]] += (Nl * f)[valid]
             u = sim.static_solve(rhs)
-            if sim.slack and np.any(fe.T0 + sim.kd * (u[sim.mw] - u[sim.cw]) < 0):
+            if sim.slack and np.any((fe.T0 + sim.kd * (u[sim.up] - u[sim.lo]) < 0) & sim.slackable):
                 raise SolverError(f"the static contact force at x_start = {x_start} m slackens a dropper; "
                                   "start at a support")
             q = -h * (sim.K @ u)
@@ -118,13 +145,16 @@ class Passage(Stepping):
         self._g_dofs, self._g_vals = dofs[valid], (Nl * f)[valid]
         self.head = panto.head()
 
-    def _set_contactelement(self, e: int, dx: float) -> None:
-        """The contact point at distance dx into CW element e: its element data, shape functions, the contact wire's
-        point-load defect there (`cb`) and the contact spring in series with it (`kce`)."""
+    def _set_contactelement(self, e: int, xp: float) -> None:
+        """The contact point at xp (m) in CW element e: its element data, shape functions, the contact wire's
+        point-load defect there (`cb`), the contact spring in series with it (`kce`) and the contact wire's height
+        irregularity there (`r_irr`, m, and its slope `r_slope`)."""
         x_e, he, dofs, valid, w0d, cols = self.sim.element(e)
+        dx = xp - self.sim.fe.x[e]
         self.e, self._dofs, self._valid, self._w0d, self._cols = e, dofs, valid, w0d, cols
         self.Nl = self.sim.shape(dx / he, he, valid)
         self.cb, self.kce = self.sim.contact_stiffness(e, dx / he)
+        self.r_irr, self.r_slope = irregularity_at(self.sim.fe.irregularity, xp)
 
     # --- one step ---------------------------------------------------------------------------------------------
     def _one_step(self) -> None:
@@ -156,8 +186,8 @@ class Passage(Stepping):
         R = self.q.copy()
         R[self._g_dofs] += hh2 * self._g_vals
         if S:
-            R[sim.mw[S]] -= hh2 * sS
-            R[sim.cw[S]] += hh2 * sS
+            R[sim.up[S]] -= hh2 * sS
+            R[sim.lo[S]] += hh2 * sS
         return R, sim.lu.solve(R)
 
     def _contact_point(self, xp: float, vbs: np.ndarray) -> tuple:
@@ -166,15 +196,15 @@ class Passage(Stepping):
         influence on them (bz)."""
         sim, u, h2 = self.sim, self.u, 2 * self.sim.h
         e, _ = sim.locate(xp, self.e)
-        self._set_contactelement(e, xp - sim.fe.x[e])
+        self._set_contactelement(e, xp)
         Nl, dofs = self.Nl, self._dofs
         zc = self._cols @ Nl  # G N
         c = float(Nl @ zc[dofs])
-        a = float(Nl @ (u[dofs] + h2 * vbs[dofs])) + float(Nl @ self._w0d)
+        a = (float(Nl @ (u[dofs] + h2 * vbs[dofs])) + float(Nl @ self._w0d)) + self.r_irr
         if sim.slack:
-            mw, cw = sim.mw, sim.cw
-            bz = zc[mw] - zc[cw]
-            dstar = (u[mw] - u[cw]) + h2 * (vbs[mw] - vbs[cw])
+            up, lo = sim.up, sim.lo
+            bz = zc[up] - zc[lo]
+            dstar = (u[up] - u[lo]) + h2 * (vbs[up] - vbs[lo])
         else:
             bz = dstar = None
         return zc, a, c, bz, dstar
@@ -226,7 +256,7 @@ class Passage(Stepping):
         """End-of-step state: vb = vb* + (f G N - G B_S s_S) / (2h), u_{n+1} = u_n + 2h vb, and the momentum
         recursions with the full R (g_{n+1} included)."""
         sim, h, hh2 = self.sim, self.sim.h, self._hh2
-        mw, cw = sim.mw, sim.cw
+        up, lo = sim.up, sim.lo
         if S:
             vb = vbs + (zc * f - sim.Zg[:, S] @ sS) * (1.0 / (2 * h))
         else:
@@ -236,13 +266,13 @@ class Passage(Stepping):
         self._g_dofs, self._g_vals = self._dofs[valid], (self.Nl * f)[valid]
         R[self._g_dofs] += hh2 * self._g_vals
         if S:
-            R[mw[S]] -= hh2 * sS
-            R[cw[S]] += hh2 * sS
+            R[up[S]] -= hh2 * sS
+            R[lo[S]] += hh2 * sS
         Kvb = sim.K @ vb
         Mvb = (R - self._c_ab * Kvb) * self._inv_1ha
-        dv = (sim.kd * self._c_kd) * (vb[mw] - vb[cw])
-        Mvb[mw] += dv
-        Mvb[cw] -= dv
+        dv = (sim.kd * self._c_kd) * (vb[up] - vb[lo])
+        Mvb[up] += dv
+        Mvb[lo] -= dv
         A2 = 2 * Mvb
         B2 = self._two_hh * Kvb
         q_new = A2 - B2 - self.p
@@ -268,15 +298,15 @@ class Passage(Stepping):
 
     # --- what the state shows ---------------------------------------------------------------------------------
     def wire_height(self) -> float:
-        """CW height at the contact point, static sag and the point-load defect's deflection d f included (m): the
-        height the contact spring meets, f = k_c max(head - wire, 0)."""
+        """CW height at the contact point, static sag, the point-load defect's deflection d f and the height
+        irregularity r(x) included (m): the height the contact spring meets, f = k_c max(head - wire, 0)."""
         Nl = self.Nl
-        return float(Nl @ self._w0d) + float(Nl @ self.u[self._dofs]) + self.cb * self.force
+        return float(Nl @ self._w0d) + float(Nl @ self.u[self._dofs]) + self.cb * self.force + self.r_irr
 
     def dropper_tension(self) -> np.ndarray:
         """Elastic dropper tensions T0 + k delta (N); negative on a slack dropper."""
         sim = self.sim
-        return sim.fe.T0 + sim.kd * (self.u[sim.mw] - self.u[sim.cw])
+        return sim.fe.T0 + sim.kd * (self.u[sim.up] - self.u[sim.lo])
 
     def velocity(self) -> np.ndarray:
         """Catenary velocity, from M v = (q + p) / 2."""
@@ -285,28 +315,19 @@ class Passage(Stepping):
     def energy_terms(self) -> dict[str, float]:
         """The catenary energy relative to the static state (kinetic + wires + support springs + droppers with their
         exact law), the pantograph's energy (if it offers `energy()`, else NaN), the contact spring energy (the
-        wire's point-load defect under it included: f^2 (1/k_c + d) / 2) and the power -f V dw/dx that the imposed
-        horizontal motion feeds in through the sloping wire (its time integral closes the balance of an undamped
-        system)."""
+        wire's point-load defect under it included: f^2 (1/k_c + d) / 2) and the power -f V d(w + r)/dx that the
+        imposed horizontal motion feeds in through the sloping wire, its height irregularity r included (its time
+        integral closes the balance of an undamped system)."""
         sim, fe, u, f = self.sim, self.sim.fe, self.u, self.force
         v = self.velocity()
-        delta = u[sim.mw] - u[sim.cw]
-        kd, T0 = sim.kd, fe.T0
-        if sim.slack:  # potential of T(delta) = max(T0 + k delta, 0) relative to delta = 0
-            dmin = -T0 / kd
-            Vd = np.where(delta >= dmin, T0 * delta + 0.5 * kd * delta**2, -0.5 * T0**2 / kd)
-        else:
-            Vd = T0 * delta + 0.5 * kd * delta**2
-        # T0 delta terms cancel against the gravity/static reactions' work: the static state is an equilibrium, so
-        # only the part beyond the linear one is stored energy; keep it consistent with K0 (wires + supports)
-        E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + float(np.sum(Vd - T0 * delta))
+        E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + dropper_energy(sim, u)
         en = getattr(self.panto, "energy", None)
         x_e, he, dofs, valid, w0d, cols = sim.element(self.e)
         xi = (self.x - x_e) / he
         dN = np.array([(-6 * xi + 6 * xi * xi) / he, 1 - 4 * xi + 3 * xi * xi, (6 * xi - 6 * xi * xi) / he,
                        3 * xi * xi - 2 * xi])
         dN = np.where(valid, dN, 0.0)
-        slope = float(dN @ (u[dofs] + w0d))
+        slope = float(dN @ (u[dofs] + w0d)) + self.r_slope
         return {"catenary": E_c, "pantograph": en() if en is not None else np.nan,
                 "contact": 0.5 * f * f * (1.0 / fe.params.k_contact + self.cb), "drive_power": -f * sim.V * slope}
 
@@ -318,7 +339,7 @@ class Recorder:
         sim = passage.sim
         fe = sim.fe
         nrec = passage.nsteps // every + 1
-        sup_dofs = fe.full_to_free[NDOF_NODE * fe.supports + CW_W]
+        sup_dofs = fe.support_cw
         self.sup_sel = np.nonzero(sup_dofs >= 0)[0]
         self.sup_idx = sup_dofs[self.sup_sel]
         self.fe = fe

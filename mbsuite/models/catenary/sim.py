@@ -37,7 +37,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from ...errors import SolverError
-from .fe import CW_T, CW_W, NDOF_NODE, CatenaryFE
+from .fe import CatenaryFE
 from .native_core import NativeCore
 from .pantographs import Pantograph
 from .passage import CHECK_EVERY, CoupledResult, Passage, Recorder
@@ -75,7 +75,8 @@ class CoupledSimulation:
     factorisation, influence columns, the local contact/dropper solver). `start` gives a `Passage` to step; `run`
     steps one to its end and records it.
 
-    `dropper_law`: "slack" (tension-only) or "linear" (bilateral). `contact`: "unilateral" or "bilateral"."""
+    `dropper_law`: "slack" (the droppers whose law is slack, `fe.dropper_slack`, are tension-only; the others stay
+    bilateral) or "linear" (all bilateral). `contact`: "unilateral" or "bilateral"."""
 
     def __init__(self, fe: CatenaryFE, pantograph: Pantograph, speed: float, dt: float, dropper_law: str = "slack",
                  contact: str = "unilateral", max_active_iter: int = 100):
@@ -84,7 +85,10 @@ class CoupledSimulation:
         if contact not in ("unilateral", "bilateral"):
             raise SolverError(f"contact must be 'unilateral' or 'bilateral', got {contact!r}")
         self.fe, self.panto, self.V, self.dt = fe, pantograph, float(speed), float(dt)
-        self.slack = dropper_law == "slack"
+        #: per dropper: tension-only (may go slack); `slack`: any of them is
+        self.slackable = (np.asarray(fe.dropper_slack, dtype=bool) if dropper_law == "slack"
+                          else np.zeros(fe.T0.size, dtype=bool))
+        self.slack = bool(np.any(self.slackable))
         self.unilateral = contact == "unilateral"
         self.max_active_iter = max_active_iter
         p = fe.params
@@ -94,13 +98,14 @@ class CoupledSimulation:
         S = self.S = ((1 + h * self.alpha) * fe.M + (h * self.beta + h * h) * fe.K0 + h * h * fe.Kd).tocsr()
         self.lu = BandedSPD(S)
         self.max_displacement = MAX_DISPLACEMENT
-        self.mw, self.cw = fe.dropper_mw, fe.dropper_cw
+        self.up, self.lo = fe.dropper_upper, fe.dropper_lower  # free index of each dropper's upper / lower w DOF
+        self.cw_dof, self.cw_w0 = fe.cw_dof, fe.cw_w0  # the contact wire's free DOFs and static state per node
         self.kd = fe.k_drop  # per dropper (the wires' point-load defects in series)
         nd = fe.T0.size
         if self.slack:
             # G B with G = h^2 S^-1: response of u_{n+1} to unit slack corrections; D = B^T G B
             self.Zg = h * h * self.lu.solve(fe.B.toarray())
-            self.D = self.Zg[self.mw] - self.Zg[self.cw]
+            self.D = self.Zg[self.up] - self.Zg[self.lo]
         else:
             self.Zg = np.zeros((fe.n, 0))
             self.D = np.zeros((0, 0))
@@ -115,7 +120,7 @@ class CoupledSimulation:
         if c is None:
             fe = self.fe
             rhs = np.zeros((fe.n, 2))
-            for j, d in enumerate(fe.cw_dofs_of_node(i)):
+            for j, d in enumerate(self.cw_dof[i]):
                 if d >= 0:
                     rhs[d, j] = 1.0
             c = self.h * self.h * self.lu.solve(rhs)
@@ -128,10 +133,9 @@ class CoupledSimulation:
         d = self._elem.get(e)
         if d is None:
             fe = self.fe
-            dofs = np.array(fe.cw_dofs_of_node(e) + fe.cw_dofs_of_node(e + 1))
+            dofs = np.concatenate([self.cw_dof[e], self.cw_dof[e + 1]]).astype(int)
             valid = dofs >= 0
-            w0d = fe.w0_full[[NDOF_NODE * e + CW_W, NDOF_NODE * e + CW_T, NDOF_NODE * (e + 1) + CW_W,
-                              NDOF_NODE * (e + 1) + CW_T]]
+            w0d = np.concatenate([self.cw_w0[e], self.cw_w0[e + 1]]).astype(float)
             cols = np.ascontiguousarray(np.hstack([self._node_cols(e), self._node_cols(e + 1)]))
             if len(self._elem) > 4:
                 for k in sorted(self._elem)[:-2]:
@@ -164,15 +168,16 @@ class CoupledSimulation:
         (the effective one at the contact point, `contact_stiffness`).
 
         Returns f, S, s_S, active. Semi-smooth Newton (primal-dual active set) on the piecewise-linear conditions
-        f = k_c max(y_h - y_w, 0) and T0 + k delta + s = 0 with s >= 0 on slack droppers."""
-        kd, T0 = self.kd, self.fe.T0
+        f = k_c max(y_h - y_w, 0) and T0 + k delta + s = 0 with s >= 0 on slack droppers (only the tension-only
+        ones, `slackable`, enter the slack set)."""
+        kd, T0, slackable = self.kd, self.fe.T0, self.slackable
         if not S:  # fast path: no slack dropper
             f = kc * (P - a) / (1 + kc * (gp + c))
             if self.unilateral and f < 0:
                 f, active = 0.0, False
             else:
                 active = True
-            if not self.slack or np.min(T0 + kd * (dstar + bz * f)) >= 0:
+            if not self.slack or not np.any((T0 + kd * (dstar + bz * f) < 0) & slackable):
                 return f, S, np.zeros(0), active
         for _ in range(self.max_active_iter):
             m = len(S)
@@ -211,7 +216,7 @@ class CoupledSimulation:
                 tension = T0 + kd * delta
                 inS = np.zeros(T0.size, bool)
                 inS[S] = True
-                add = np.nonzero((tension < 0) & ~inS)[0]
+                add = np.nonzero((tension < 0) & ~inS & slackable)[0]
                 drop = [i for j, i in enumerate(S) if sS[j] < 0]
                 if add.size or drop:
                     S = sorted((set(S) - set(drop)) | {int(i) for i in add})

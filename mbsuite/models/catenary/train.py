@@ -36,7 +36,7 @@ from .native_core import NativeCore
 from .pantographs import Pantograph
 from .pantographs import build_train as build_pantographs
 from .params import CatenaryParams
-from .passage import CHECK_EVERY, CoupledResult, Passage, steps_to_cover
+from .passage import CHECK_EVERY, CoupledResult, Passage, dropper_energy, irregularity_at, steps_to_cover
 from .sim import CoupledSimulation
 from .stats import en50318_statistics, supports_in_window
 
@@ -100,7 +100,7 @@ class TrainPassage(Stepping):
         self.DS = np.zeros((nrec, nd), bool) if record_droppers else None
         self.T = np.zeros(nrec)
         self.X, self.F, self.H, self.W, self.FR = (np.zeros((nrec, nc)) for _ in range(5))
-        self.U = np.zeros((nrec, sim.fe.supports.size))
+        self.U = np.zeros((nrec, sim.fe.support_cw.size))
         self.NS = np.zeros(nrec, dtype=np.int32)
         self.psig: list[dict[str, np.ndarray]] = [{} for _ in range(nc)]
         self.static_forces = [0.0] * nc
@@ -177,7 +177,7 @@ class TrainPassage(Stepping):
                 self._enter(k, n)
         self._record(n, t_new)
         if self.DE is not None:
-            self.DE[n] = sim.fe.T0 + sim.kd * (core.u[sim.mw] - core.u[sim.cw])
+            self.DE[n] = sim.fe.T0 + sim.kd * (core.u[sim.up] - core.u[sim.lo])
             self.DS[n, core.slk[:core.nslack]] = True
         if self.record_energy and n % self.record_energy == 0:
             self.energy_rows.append(_energy(core, sim, self.pans))
@@ -391,18 +391,12 @@ class _Secant:
 def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, float]:
     """Energy terms of the coupled train (as `Passage.energy_terms`): catenary (kinetic + wires and supports +
     droppers with their exact law, relative to the static state), every pantograph, every contact spring (with the
-    wire's point-load defect under it), and the
-    power the imposed horizontal motion feeds in through the sloping wire, summed over the contacts."""
+    wire's point-load defect under it), and the power the imposed horizontal motion feeds in through the sloping
+    wire (its height irregularity included), summed over the contacts."""
     fe = sim.fe
     u = core.u
     v = sim.mass().solve(0.5 * (core.q + core.p))
-    delta = u[sim.mw] - u[sim.cw]
-    kd, T0 = sim.kd, fe.T0
-    if sim.slack:
-        Vd = np.where(delta >= -T0 / kd, T0 * delta + 0.5 * kd * delta**2, -0.5 * T0**2 / kd)
-    else:
-        Vd = T0 * delta + 0.5 * kd * delta**2
-    E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + float(np.sum(Vd - T0 * delta))
+    E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + dropper_energy(sim, u)
     E_p = E_k = P = 0.0
     for k, pan in enumerate(pans):
         if not core.present[k]:
@@ -417,6 +411,7 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
                        3 * xi * xi - 2 * xi])
         dofs = core.dofs[4 * k:4 * k + 4]
         valid = core.cwdof.reshape(-1)[2 * e:2 * e + 4] >= 0
-        slope = float(dN @ (np.where(valid, u[dofs], 0.0) + core.w0d[4 * k:4 * k + 4]))
+        slope = (float(dN @ (np.where(valid, u[dofs], 0.0) + core.w0d[4 * k:4 * k + 4]))
+                 + irregularity_at(fe.irregularity, float(core.xc[k]))[1])
         P += -f * sim.V * slope
     return {"catenary": E_c, "pantograph": E_p, "contact": E_k, "drive_power": P}

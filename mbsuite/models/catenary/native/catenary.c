@@ -3,13 +3,15 @@
  * The C twin of `sim.Passage.step` (the readable Python path; a test holds the two equal to rounding). One step of
  * the trapezoidal rule in its midpoint form (h = dt/2, S = M + hC + h^2 K, G = h^2 S^-1):
  *   predict:  R = q_n + h/2 g_n,  vb* = S^-1 R  (one banded Cholesky solve, S factorised once here);
- *   contacts: per contact k its element, Hermite shape functions N_k, the wire height a_k without new local forces,
+ *   contacts: per contact k its element, Hermite shape functions N_k, the wire height a_k without new local forces
+ *             (static sag and the contact wire's height irregularity r(x_k) included),
  *             the compliances C_kl = N_k . G N_l, the influence bz_kj of contact k on dropper j, the elongations
  *             dstar_j of the droppers, and the contact spring in series with the contact wire's point-load defect
  *             d_k there, k_c,k = 1 / (1/k_c + d_k) (fe.PointCorrection; the droppers' own defects are in kdj);
  *   local:    the contact forces f_k = k_c,k max(y_head,k - y_wire,k, 0) (unilateral) and the slack droppers' tension-
- *             cancelling corrections s_j >= 0, solved exactly by a primal-dual active-set iteration on this
- *             piecewise-linear problem, with each pantograph's head map y_head,k = P_k - gp_k f_k;
+ *             cancelling corrections s_j >= 0 (the droppers whose law is tension-only, dslack), solved exactly by a
+ *             primal-dual active-set iteration on this piecewise-linear problem, with each pantograph's head map
+ *             y_head,k = P_k - gp_k f_k;
  *   advance:  vb = vb* + (sum_k f_k G N_k - sum_j s_j G B_j) / (2h), u += 2h vb, and the momentum recursions
  *             q' = 2(M - h^2 K) vb - p, p' = 2(M + h^2 K) vb - q with M vb from S vb = R (g_{n+1} included).
  * `mbs_cat_run` loops these stages over a range of steps for affine 2-mass pantographs (EN 50318 reference
@@ -18,7 +20,7 @@
 #include <math.h>
 #include <string.h>
 
-#define CAT_ABI 2
+#define CAT_ABI 3
 /* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
  * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
  * rounding) */
@@ -30,13 +32,14 @@ typedef struct {
   int slack, unilateral, max_iter;
   /* scalars of the scheme */
   double h, hh2, c_ab, inv_1ha, c_kd, two_hh, kc, V, dt, max_disp;
-  double cw_T, cw_EI; /* contact wire tension and bending stiffness (its point-load defect) */
+  double cw_EI;  /* contact wire bending stiffness (its point-load defect) */
   /* matrices (caller's arrays) */
   double *L;     /* n*(bw+1): on entry the lower band of S (L[i*(bw+1)+k] = S[i][i-k]), factorised in place */
   double *invd;  /* n: 1 / diagonal of the Cholesky factor */
   int *Kp, *Ki;  /* CSR of K = K0 + Kd */
   double *Kx;
-  int *mw, *cw;  /* nd: free index of the MW / CW w DOF of each dropper */
+  int *up, *lo;  /* nd: free index of the w DOF of each dropper's upper / lower wire */
+  int *dslack;   /* nd: 1 when the dropper may go slack (its law is tension-only), 0 when it is bilateral */
   double *T0;    /* nd static dropper tensions */
   double *kdj;   /* nd dropper stiffnesses (the wires' point-load defects in series) */
   double *Zg;    /* nd*n: row j = G B_j */
@@ -48,6 +51,11 @@ typedef struct {
   int *esig;     /* nnode-1: each CW element's entry in pq, pref (fe.PointCorrection) */
   double *pq;    /* 16 per entry: the Hermite compliance Q of the element's DOFs on its reference beam */
   double *pref;  /* 3 per entry: a0, L (reference beam; L = 0: no correction), h */
+  double *ptk;   /* per entry: the tension of its reference beam */
+  /* the contact wire's height irregularity r(x): piecewise linear on x = irr_x0 + i irr_dx, i < nirr; 0 outside */
+  int nirr;
+  double irr_x0, irr_dx;
+  double *irr;   /* nirr heights (m) */
   /* catenary state and work */
   double *u, *q, *p, *R, *vbs, *vb; /* n each */
   int *slk;      /* nd: the slack set (sorted) */
@@ -69,6 +77,7 @@ typedef struct {
   double *f;     /* ncon contact forces at the end of the last step */
   double *kce;   /* ncon contact stiffness in series with the contact wire's point-load defect there */
   double *cbc;   /* ncon the defect d_k (m/N) */
+  double *rirr;  /* ncon the irregularity r(x_k) under each contact (m) */
   double *gv;    /* 4*ncon: N_k f_k of the last step (the local force g_n) */
   double *a, *Cm, *bz, *dstar; /* ncon, ncon*ncon, ncon*nd, nd */
   double *P, *gp; /* ncon head maps */
@@ -80,11 +89,16 @@ typedef struct {
   /* records (row = step index), may be NULL */
   double *rec_t, *rec_x, *rec_f, *rec_head, *rec_wire, *rec_frame, *rec_up; /* nrec, nrec*ncon x4, nrec*nsup */
   int *rec_ns;
-  /* block form of the factor (4 DOFs per node; see mbs_cat_factor) */
+  /* block form of the factor (see build_blocks) */
   int blocked;   /* 1 when the block form is in use */
-  int *fidx;     /* n: padded index (4 * node + local DOF) of each free DOF */
-  double *blk;   /* nnode*64: per node Di = D^-1, F = D^-1 E, Dt = D^-T, G = D^-T E_next^T (row-major 4x4 each) */
-  double *pw;    /* 4*nnode padded work vector */
+  int *fidx;     /* n: padded index of each free DOF (node I's DOFs are noff[I] .. noff[I+1]-1) */
+  int *noff;     /* nnode+1: padded offset of each node's DOFs (node sizes 1..MAXB) */
+  int *boff;     /* nnode+1: offset of each node's blocks in blk */
+  double *blk;   /* per node of size s (previous p, next q): Di = D^-1 (s*s), F = D^-1 E (s*p), Dt = D^-T (s*s),
+                    G = D^-T E_next^T (s*q), row-major */
+  double *pw;    /* noff[nnode]: padded work vector */
+  int *seg;      /* 6*nnode: the sweeps' stretches, (first, end, size) each (see block_solve) */
+  int nseg_f, nseg_b; /* number of stretches of the forward and the backward sweep */
   /* diagnostics */
   long n_local;
   int err;       /* 0 ok; 1 non-finite; 2 displacement too large; 3 lost the wire; 4 active set; 5 not SPD */
@@ -97,128 +111,243 @@ int mbs_cat_job_size(void) { return (int)sizeof(cat_job); }
 
 /* ------------------------------------------------------------------------------------- banded Cholesky */
 /* The factor L of S (band form) seen node by node: padded with an identity row/column for each pinned DOF, L is
- * block lower bidiagonal with 4x4 blocks (a node couples only to its neighbours, and Cholesky fills nothing outside
- * that profile), L = [D_I on the diagonal, E_I below it]. The sweeps then run block by block,
+ * block lower bidiagonal (a node couples only to its neighbours, and Cholesky fills nothing outside that profile),
+ * L = [D_I on the diagonal, E_I below it], node I's block of size s_I = noff[I+1] - noff[I] (2 DOFs per wire present
+ * at the node). The sweeps then run block by block,
  *   forward  y_I = D_I^-1 b_I - (D_I^-1 E_I) y_{I-1},   backward  x_I = D_I^-T y_I - (D_I^-T E_{I+1}^T) x_{I+1},
- * whose dependency chain is one 4x4 product per node instead of one multiply-subtract per DOF: the row sweeps of a
- * narrow band are bound by that chain's latency, the block sweeps by arithmetic. If L has an entry outside the
- * block profile the band sweeps are kept (blocked = 0). */
-static void inv_lower4(const double* D, double* X) {
-  memset(X, 0, sizeof(double) * 16);
-  for (int c = 0; c < 4; c++) {
-    for (int r = c; r < 4; r++) {
-      double s = (r == c) ? 1.0 : 0.0;
-      for (int k = c; k < r; k++) s -= D[r * 4 + k] * X[k * 4 + c];
-      X[r * 4 + c] = s / D[r * 4 + r];
+ * whose dependency chain is one small product per node instead of one multiply-subtract per DOF: the row sweeps of a
+ * narrow band are bound by that chain's latency, the block sweeps by arithmetic. A stretch of nodes of one size s in
+ * {2, 4, 6, 8} runs in a loop unrolled for that size with the previous node's values in registers; a node whose
+ * neighbour has another size takes the general loop (the same sums in the same order). If L has an entry outside the
+ * block profile, or a node more than MAXB DOFs, the band sweeps are kept (blocked = 0). */
+#define MAXB 8
+#define NSIZE(J, I) ((J)->noff[(I) + 1] - (J)->noff[(I)])
+
+static void inv_lower(const double* D, double* X, int s) {
+  memset(X, 0, sizeof(double) * s * s);
+  for (int c = 0; c < s; c++) {
+    for (int r = c; r < s; r++) {
+      double v = (r == c) ? 1.0 : 0.0;
+      for (int k = c; k < r; k++) v -= D[r * s + k] * X[k * s + c];
+      X[r * s + c] = v / D[r * s + r];
     }
   }
+}
+
+/* F . a over m terms in a fixed tree: pair sums u_k = F_2k a_2k + F_2k+1 a_2k+1 (a last single term when m is odd),
+ * then u_0 | u_0 + u_1 | (u_0 + u_1) + u_2 | (u_0 + u_1) + (u_2 + u_3) */
+static inline __attribute__((always_inline)) double tree_dot(const double* F, const double* a, const int m) {
+  if (m <= 0) return 0.0;
+  double u[4];
+  const int np = (m + 1) / 2;
+#pragma GCC unroll 4
+  for (int k = 0; k < np; k++) u[k] = (2 * k + 1 < m) ? F[2 * k] * a[2 * k] + F[2 * k + 1] * a[2 * k + 1] : F[2 * k] * a[2 * k];
+  if (np == 1) return u[0];
+  if (np == 2) return u[0] + u[1];
+  if (np == 3) return (u[0] + u[1]) + u[2];
+  return (u[0] + u[1]) + (u[2] + u[3]);
 }
 
 static int build_blocks(cat_job* J) {
   const int n = J->n, bw = J->bw, w = bw + 1, nn = J->nnode;
   J->blocked = 0;
-  if (!J->blk || !J->pw || !J->fidx) return 0;
-  double* Dm = J->blk; /* reuse the storage: first D_I and E_I, then the products */
-  /* D (16) and E (16) of each node in blk[I*64 + 0..31] */
-  memset(J->blk, 0, sizeof(double) * 64 * (size_t)nn);
+  if (!J->blk || !J->pw || !J->fidx || !J->noff || !J->boff) return 0;
   for (int I = 0; I < nn; I++) {
-    for (int r = 0; r < 4; r++) Dm[I * 64 + r * 5] = 1.0; /* identity for pinned DOFs */
+    if (NSIZE(J, I) < 1 || NSIZE(J, I) > MAXB) return 0;
   }
+  double* blk = J->blk;
+  /* D (s*s) and E (s*p) of each node in its Di and F slots; identity on the diagonal for pinned DOFs */
+  memset(blk, 0, sizeof(double) * (size_t)J->boff[nn]);
+  for (int I = 0; I < nn; I++) {
+    const int si = NSIZE(J, I);
+    for (int r = 0; r < si; r++) blk[J->boff[I] + r * si + r] = 1.0;
+  }
+  int I = 0;
   for (int i = 0; i < n; i++) {
-    const int pi = J->fidx[i], I = pi / 4, r = pi % 4;
-    Dm[I * 64 + r * 4 + r] = J->L[(long)i * w];
+    const int pi = J->fidx[i];
+    while (J->noff[I + 1] <= pi) I++;
+    const int si = NSIZE(J, I), r = pi - J->noff[I], sp = I > 0 ? NSIZE(J, I - 1) : 0;
+    double* D = blk + J->boff[I];
+    double* E = D + si * si;
+    D[r * si + r] = J->L[(long)i * w];
+    int Jn = I;
     for (int m = 1; m <= bw && m <= i; m++) {
       const double v = J->L[(long)i * w + m];
-      const int pj = J->fidx[i - m], Jn = pj / 4, c = pj % 4;
+      const int pj = J->fidx[i - m];
+      while (Jn > 0 && J->noff[Jn] > pj) Jn--;
+      const int c = pj - J->noff[Jn];
       if (Jn == I) {
-        Dm[I * 64 + r * 4 + c] = v;
+        D[r * si + c] = v;
       } else if (Jn == I - 1) {
-        Dm[I * 64 + 16 + r * 4 + c] = v;
+        E[r * sp + c] = v;
       } else if (v != 0.0) {
         return 0; /* outside the block profile: keep the band sweeps */
       }
     }
   }
-  double Di[16], Ei[16], X[16];
-  /* pass 1: Di and F = Di E into slots 0 and 16 (E of node I is consumed here; keep E^T of node I for G of I-1) */
+  double Di[MAXB * MAXB], Ei[MAXB * MAXB], X[MAXB * MAXB];
+  /* pass 1: Di, F = Di E and Dt = Di^T; E_I (s_I x s_{I-1}) is stashed in the G slot of node I-1 (s_{I-1} x s_I) */
   for (int I = nn - 1; I >= 0; I--) {
-    double* b = J->blk + (long)I * 64;
-    memcpy(Ei, b + 16, sizeof Ei);
-    inv_lower4(b, Di);
-    /* G of node I-1 needs Dt of I-1 and E_I^T: stash E_I in slot 48 of node I-1 */
-    if (I > 0) memcpy(J->blk + (long)(I - 1) * 64 + 48, Ei, sizeof Ei);
-    for (int r = 0; r < 4; r++)
-      for (int c = 0; c < 4; c++) {
-        double s = 0.0;
-        for (int k = 0; k < 4; k++) s += Di[r * 4 + k] * Ei[k * 4 + c];
-        X[r * 4 + c] = s;
+    const int si = NSIZE(J, I), sp = I > 0 ? NSIZE(J, I - 1) : 0;
+    double* b = blk + J->boff[I];
+    memcpy(Ei, b + si * si, sizeof(double) * si * sp);
+    inv_lower(b, Di, si);
+    if (I > 0) memcpy(blk + J->boff[I] - sp * si, Ei, sizeof(double) * si * sp);
+    for (int r = 0; r < si; r++)
+      for (int c = 0; c < sp; c++) {
+        double v = 0.0;
+        for (int k = 0; k < si; k++) v += Di[r * si + k] * Ei[k * sp + c];
+        X[r * sp + c] = v;
       }
-    memcpy(b, Di, sizeof Di);
-    memcpy(b + 16, X, sizeof X);
-    for (int r = 0; r < 4; r++)
-      for (int c = 0; c < 4; c++) b[32 + r * 4 + c] = Di[c * 4 + r]; /* Dt = Di^T */
+    memcpy(b, Di, sizeof(double) * si * si);
+    memcpy(b + si * si, X, sizeof(double) * si * sp);
+    for (int r = 0; r < si; r++)
+      for (int c = 0; c < si; c++) b[si * si + si * sp + r * si + c] = Di[c * si + r]; /* Dt = Di^T */
   }
-  /* pass 2: G_I = Dt_I E_{I+1}^T (E_{I+1} stashed in slot 48 of node I) */
-  for (int I = 0; I < nn; I++) {
-    double* b = J->blk + (long)I * 64;
-    if (I == nn - 1) {
-      memset(b + 48, 0, sizeof(double) * 16);
-      continue;
+  /* pass 2: G_I = Dt_I E_{I+1}^T (E_{I+1} stashed in the G slot of node I) */
+  for (int I = 0; I < nn - 1; I++) {
+    const int si = NSIZE(J, I), sq = NSIZE(J, I + 1);
+    double* G = blk + J->boff[I + 1] - si * sq;
+    const double* Dt = G - si * si;
+    memcpy(Ei, G, sizeof(double) * si * sq);
+    for (int r = 0; r < si; r++)
+      for (int c = 0; c < sq; c++) {
+        double v = 0.0;
+        for (int k = 0; k < si; k++) v += Dt[r * si + k] * Ei[c * si + k];
+        X[r * sq + c] = v;
+      }
+    memcpy(G, X, sizeof(double) * si * sq);
+  }
+  /* the stretches: forward, ascending (first, end, size): a node whose previous node has another size (or none)
+   * alone with size 0 (the general loop), else the longest run of nodes of its size; backward, descending (first,
+   * end) with first > end, likewise with the next node */
+  int* sg = J->seg;
+  int ns = 0;
+  for (int I = 0; I < nn;) {
+    const int si = NSIZE(J, I);
+    const int run = I > 0 && NSIZE(J, I - 1) == si && (si == 2 || si == 4 || si == 6 || si == 8);
+    int E = I + 1;
+    if (run) {
+      while (E < nn && NSIZE(J, E) == si) E++;
     }
-    memcpy(Ei, b + 48, sizeof Ei);
-    for (int r = 0; r < 4; r++)
-      for (int c = 0; c < 4; c++) {
-        double s = 0.0;
-        for (int k = 0; k < 4; k++) s += b[32 + r * 4 + k] * Ei[c * 4 + k];
-        X[r * 4 + c] = s;
-      }
-    memcpy(b + 48, X, sizeof X);
+    sg[3 * ns] = I, sg[3 * ns + 1] = E, sg[3 * ns + 2] = run ? si : 0;
+    ns++;
+    I = E;
   }
+  J->nseg_f = ns;
+  sg += 3 * ns;
+  ns = 0;
+  for (int I = nn - 1; I >= 0;) {
+    const int si = NSIZE(J, I);
+    int B = I - 1;
+    const int run = I < nn - 1 && NSIZE(J, I + 1) == si && (si == 2 || si == 4 || si == 6 || si == 8);
+    if (run) {
+      while (B >= 0 && NSIZE(J, B) == si) B--;
+    }
+    sg[3 * ns] = I, sg[3 * ns + 1] = B, sg[3 * ns + 2] = run ? si : 0;
+    ns++;
+    I = B;
+  }
+  J->nseg_b = ns;
   J->blocked = 1;
   return 0;
 }
 
+/* forward sweep of node I (size s, previous node's size p, its values a) */
+static inline __attribute__((always_inline)) void fwd_node(const double* D, const double* F, double* v,
+                                                           const double* a, const int s, const int p) {
+  double yv[MAXB] = {0.0};
+#pragma GCC unroll 8
+  for (int r = 0; r < s; r++) {
+    double t = D[r * s] * v[0];
+#pragma GCC unroll 8
+    for (int k = 1; k <= r; k++) t += D[r * s + k] * v[k];
+    yv[r] = t - tree_dot(F + r * p, a, p);
+  }
+#pragma GCC unroll 8
+  for (int r = 0; r < s; r++) v[r] = yv[r];
+}
+
+/* backward sweep of node I (size s, next node's size q, its values a) */
+static inline __attribute__((always_inline)) void bwd_node(const double* T, const double* G, double* v,
+                                                           const double* a, const int s, const int q) {
+  double xv[MAXB] = {0.0};
+#pragma GCC unroll 8
+  for (int r = 0; r < s; r++) {
+    double t = T[r * s + r] * v[r];
+#pragma GCC unroll 8
+    for (int k = r + 1; k < s; k++) t += T[r * s + k] * v[k];
+    xv[r] = t - tree_dot(G + r * q, a, q);
+  }
+#pragma GCC unroll 8
+  for (int r = 0; r < s; r++) v[r] = xv[r];
+}
+
+/* nodes I0 .. I1-1, all of size S, the node before I0 of size S too: the previous values stay in registers; each
+ * node's blocks take 4 S^2 doubles (its next node's size may differ only after the last one's D and F) */
+static inline __attribute__((always_inline)) void fwd_run(const cat_job* J, double* y, int I0, int I1, const int S) {
+  double a[MAXB];
+  double* v = y + J->noff[I0];
+  const double* D = J->blk + J->boff[I0];
+#pragma GCC unroll 8
+  for (int k = 0; k < S; k++) a[k] = v[k - S];
+  for (int I = I0; I < I1; I++, v += S, D += 4 * S * S) {
+    fwd_node(D, D + S * S, v, a, S, S);
+#pragma GCC unroll 8
+    for (int k = 0; k < S; k++) a[k] = v[k];
+  }
+}
+
+/* nodes I0 down to I1 + 1, all of size S, the node after I0 of size S too (the same 4 S^2 doubles per node) */
+static inline __attribute__((always_inline)) void bwd_run(const cat_job* J, double* y, int I0, int I1, const int S) {
+  double a[MAXB];
+  double* v = y + J->noff[I0];
+  const double* G = J->blk + J->boff[I0 + 1] - S * S;
+#pragma GCC unroll 8
+  for (int k = 0; k < S; k++) a[k] = v[k + S];
+  for (int I = I0; I > I1; I--, v -= S, G -= 4 * S * S) {
+    bwd_node(G - S * S, G, v, a, S, S);
+#pragma GCC unroll 8
+    for (int k = 0; k < S; k++) a[k] = v[k];
+  }
+}
+
+static void fwd_any(const cat_job* J, double* y, int I) {
+  const int s = NSIZE(J, I), p = I > 0 ? NSIZE(J, I - 1) : 0;
+  const double* D = J->blk + J->boff[I];
+  fwd_node(D, D + s * s, y + J->noff[I], p ? y + J->noff[I - 1] : y, s, p);
+}
+
+static void bwd_any(const cat_job* J, double* y, int I) {
+  const int s = NSIZE(J, I), q = I < J->nnode - 1 ? NSIZE(J, I + 1) : 0;
+  const double* G = J->blk + J->boff[I + 1] - s * q;
+  bwd_node(G - s * s, G, y + J->noff[I], q ? y + J->noff[I + 1] : y, s, q);
+}
+
 static void block_solve(const cat_job* J, double* x) {
-  const int n = J->n, nn = J->nnode;
+  const int n = J->n;
   double* y = J->pw;
   const int* fi = J->fidx;
-  memset(y, 0, sizeof(double) * 4 * (size_t)nn);
+  memset(y, 0, sizeof(double) * (size_t)J->noff[J->nnode]);
   for (int i = 0; i < n; i++) y[fi[i]] = x[i];
-  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
-  for (int I = 0; I < nn; I++) {
-    const double* D = J->blk + (long)I * 64;
-    const double* F = D + 16;
-    double* v = y + 4 * I;
-    const double t0 = D[0] * v[0];
-    const double t1 = D[4] * v[0] + D[5] * v[1];
-    const double t2 = D[8] * v[0] + D[9] * v[1] + D[10] * v[2];
-    const double t3 = D[12] * v[0] + D[13] * v[1] + D[14] * v[2] + D[15] * v[3];
-    const double y0 = t0 - ((F[0] * a0 + F[1] * a1) + (F[2] * a2 + F[3] * a3));
-    const double y1 = t1 - ((F[4] * a0 + F[5] * a1) + (F[6] * a2 + F[7] * a3));
-    const double y2 = t2 - ((F[8] * a0 + F[9] * a1) + (F[10] * a2 + F[11] * a3));
-    const double y3 = t3 - ((F[12] * a0 + F[13] * a1) + (F[14] * a2 + F[15] * a3));
-    v[0] = a0 = y0;
-    v[1] = a1 = y1;
-    v[2] = a2 = y2;
-    v[3] = a3 = y3;
+  const int* sg = J->seg;
+  for (int g = 0; g < J->nseg_f; g++, sg += 3) {
+    switch (sg[2]) {
+      case 2: fwd_run(J, y, sg[0], sg[1], 2); break;
+      case 4: fwd_run(J, y, sg[0], sg[1], 4); break;
+      case 6: fwd_run(J, y, sg[0], sg[1], 6); break;
+      case 8: fwd_run(J, y, sg[0], sg[1], 8); break;
+      default: fwd_any(J, y, sg[0]);
+    }
   }
-  a0 = a1 = a2 = a3 = 0.0;
-  for (int I = nn - 1; I >= 0; I--) {
-    const double* T = J->blk + (long)I * 64 + 32;
-    const double* G = T + 16;
-    double* v = y + 4 * I;
-    const double t0 = T[0] * v[0] + T[1] * v[1] + T[2] * v[2] + T[3] * v[3];
-    const double t1 = T[5] * v[1] + T[6] * v[2] + T[7] * v[3];
-    const double t2 = T[10] * v[2] + T[11] * v[3];
-    const double t3 = T[15] * v[3];
-    const double x0 = t0 - ((G[0] * a0 + G[1] * a1) + (G[2] * a2 + G[3] * a3));
-    const double x1 = t1 - ((G[4] * a0 + G[5] * a1) + (G[6] * a2 + G[7] * a3));
-    const double x2 = t2 - ((G[8] * a0 + G[9] * a1) + (G[10] * a2 + G[11] * a3));
-    const double x3 = t3 - ((G[12] * a0 + G[13] * a1) + (G[14] * a2 + G[15] * a3));
-    v[0] = a0 = x0;
-    v[1] = a1 = x1;
-    v[2] = a2 = x2;
-    v[3] = a3 = x3;
+  for (int g = 0; g < J->nseg_b; g++, sg += 3) {
+    switch (sg[2]) {
+      case 2: bwd_run(J, y, sg[0], sg[1], 2); break;
+      case 4: bwd_run(J, y, sg[0], sg[1], 4); break;
+      case 6: bwd_run(J, y, sg[0], sg[1], 6); break;
+      case 8: bwd_run(J, y, sg[0], sg[1], 8); break;
+      default: bwd_any(J, y, sg[0]);
+    }
   }
   for (int i = 0; i < n; i++) x[i] = y[fi[i]];
 }
@@ -361,7 +490,19 @@ static double point_defect(const cat_job* J, int e, double xi) {
   const double* Q = J->pq + 16 * k;
   double q = 0.0;
   for (int r = 0; r < 4; r++) q += N[r] * (((Q[4 * r] * N[0] + Q[4 * r + 1] * N[1]) + Q[4 * r + 2] * N[2]) + Q[4 * r + 3] * N[3]);
-  return beam_compliance(a0 + xi * h, L, J->cw_T, J->cw_EI) - q;
+  return beam_compliance(a0 + xi * h, L, J->ptk[k], J->cw_EI) - q;
+}
+
+/* the contact wire's height irregularity at x (m): linear between the table's points, 0 outside the table
+ * (fe.irregularity; sim.irregularity_at, the same operations) */
+static double irregularity(const cat_job* J, double x) {
+  const int m = J->nirr;
+  if (m <= 0) return 0.0;
+  const double t = (x - J->irr_x0) / J->irr_dx;
+  if (!(t >= 0.0) || t > (double)(m - 1)) return 0.0;
+  const int i = (int)t;
+  if (i >= m - 1) return J->irr[m - 1];
+  return J->irr[i] + (t - (double)i) * (J->irr[i + 1] - J->irr[i]);
 }
 
 /* element, shape functions and geometry of contact k at position xp; its contact stiffness with the defect */
@@ -377,13 +518,14 @@ void mbs_cat_place(cat_job* J, int k, double xp) {
   const double d = point_defect(J, e, xi);
   J->cbc[k] = d;
   J->kce[k] = d != 0.0 ? J->kc / (1.0 + J->kc * d) : J->kc;
+  J->rirr[k] = irregularity(J, xp);
 }
 
-/* CW height at contact k from the current u (static sag included) */
+/* CW height at contact k from the current u (static sag and the irregularity under it included) */
 double mbs_cat_wire(const cat_job* J, int k) {
   double s = 0.0;
   for (int m = 0; m < 4; m++) s += J->Nl[4 * k + m] * (J->w0d[4 * k + m] + J->u[J->dofs[4 * k + m]]);
-  return s;
+  return s + J->rirr[k];
 }
 
 /* ------------------------------------------------------------------------------------------ stages */
@@ -401,8 +543,8 @@ void mbs_cat_predict(cat_job* J, double t_new) {
   }
   for (int a = 0; a < J->nslack; a++) {
     const int j = J->slk[a];
-    R[J->mw[j]] -= hh2 * J->sS[a];
-    R[J->cw[j]] += hh2 * J->sS[a];
+    R[J->up[j]] -= hh2 * J->sS[a];
+    R[J->lo[j]] += hh2 * J->sS[a];
   }
   memcpy(vbs, R, sizeof(double) * n);
   band_solve(J, vbs, 0);
@@ -418,7 +560,7 @@ void mbs_cat_predict(cat_job* J, double t_new) {
       s += N[m] * (u[dk[m]] + h2 * vbs[dk[m]]);
       s0 += N[m] * J->w0d[4 * k + m];
     }
-    J->a[k] = s + s0;
+    J->a[k] = (s + s0) + J->rirr[k];
   }
   for (int k = 0; k < nc; k++) {
     if (!J->present[k]) continue;
@@ -442,7 +584,7 @@ void mbs_cat_predict(cat_job* J, double t_new) {
     if (J->slack) {
       const double* ck = J->cols + (long)k * 4 * n;
       for (int j = 0; j < nd; j++) {
-        const int im = J->mw[j], ic = J->cw[j];
+        const int im = J->up[j], ic = J->lo[j];
         double z = 0.0;
         for (int r = 0; r < 4; r++) z += (ck[(long)r * n + im] - ck[(long)r * n + ic]) * N[r];
         J->bz[k * nd + j] = z;
@@ -451,7 +593,7 @@ void mbs_cat_predict(cat_job* J, double t_new) {
   }
   if (J->slack) {
     for (int j = 0; j < nd; j++) {
-      const int im = J->mw[j], ic = J->cw[j];
+      const int im = J->up[j], ic = J->lo[j];
       J->dstar[j] = (u[im] - u[ic]) + h2 * (vbs[im] - vbs[ic]);
     }
   }
@@ -565,6 +707,7 @@ int mbs_cat_local(cat_job* J) {
         }
       }
       for (int j = 0; j < nd; j++) {
+        if (!J->dslack[j]) continue; /* a bilateral dropper never goes slack */
         double d = J->dstar[j];
         for (int k = 0; k < nc; k++) d += J->bz[k * nd + j] * f[k];
         for (int b = 0; b < ms; b++) d -= J->D[j * nd + S[b]] * s[b];
@@ -622,8 +765,8 @@ void mbs_cat_advance(cat_job* J) {
   }
   for (int b = 0; b < J->nslack; b++) {
     const int j = J->slk[b];
-    R[J->mw[j]] -= hh2 * J->sS[b];
-    R[J->cw[j]] += hh2 * J->sS[b];
+    R[J->up[j]] -= hh2 * J->sS[b];
+    R[J->lo[j]] += hh2 * J->sS[b];
   }
   const double c_ab = J->c_ab, inv = J->inv_1ha, thh = J->two_hh;
   const int *Kp = J->Kp, *Ki = J->Ki;
@@ -638,7 +781,7 @@ void mbs_cat_advance(cat_job* J) {
     q[i] = qn;
   }
   for (int j = 0; j < nd; j++) {
-    const int im = J->mw[j], ic = J->cw[j];
+    const int im = J->up[j], ic = J->lo[j];
     const double dv = 2.0 * J->kdj[j] * J->c_kd * (vb[im] - vb[ic]);
     q[im] += dv;
     p[im] += dv;

@@ -15,6 +15,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.catenary import irregularity, lines
 from mbsuite.models.catenary.fe import assemble
 from mbsuite.models.catenary.line import Clamp, Dropper, Line, PointMass, Support, Wire
@@ -415,3 +416,113 @@ def test_random_irregularity_has_the_requested_rms_and_is_fixed_by_its_seed():
     c = 2.5e-7
     r = irregularity.build({"seed": 5, "psd": [[0.05, c / 0.05**2], [1.0, c]], "n_waves": 200}, 1000.0).r
     assert abs(np.mean(r**2) / (c * (1 / 0.05 - 1)) - 1) < 0.06
+
+
+# --- line-file errors ---------------------------------------------------------------------------------------------
+#: a valid line file: two 50 m spans, contact and messenger wire, three droppers per span
+LINE_FILE = """name = "two spans"
+presag = {presag}
+[[wires]]
+name = "contact"
+role = "{role}"
+mass = 1.35
+tension = 20000.0
+EI = 195.0
+x0 = 0.0
+x1 = 100.0
+[[wires]]
+name = "messenger"
+role = "messenger"
+mass = 1.07
+tension = 16000.0
+EI = 131.7
+x0 = 0.0
+x1 = 100.0
+{extra_wire}
+[[supports]]
+x = 0.0
+k_contact = 300.0
+k_messenger = 5.0e4
+[[supports]]
+x = 50.0
+k_contact = 300.0
+k_messenger = 5.0e4
+[[supports]]
+x = 100.0
+k_contact = 300.0
+k_messenger = 5.0e4
+[[droppers]]
+x = 10.0
+upper = "{upper}"
+lower = "contact"
+law = "{law}"
+[[droppers]]
+x = 25.0
+upper = "messenger"
+lower = "contact"
+[[droppers]]
+x = 40.0
+upper = "messenger"
+lower = "contact"
+[[droppers]]
+x = 60.0
+upper = "messenger"
+lower = "contact"
+[[droppers]]
+x = 75.0
+upper = "messenger"
+lower = "contact"
+[[droppers]]
+x = 90.0
+upper = "messenger"
+lower = "contact"
+"""
+GOOD = dict(presag=0.0, role="contact", extra_wire="", upper="messenger", law="slack")
+STITCH = '[[wires]]\nname = "stitch"\nrole = "stitch"\nmass = 0.31\ntension = 3500.0\nx0 = 45.0\nx1 = 55.0\n'
+
+
+@pytest.mark.parametrize("change, culprits", [
+    ({"extra_wire": '[[wires]]\nname = "aux"\nx0 = 0.0\nx1 = 100.0\ncolour = "red"\n'}, ["wires[2]", "colour"]),
+    ({"presag": '0.0\nsag = 0.001'}, ["sag"]),
+    ({"upper": "mesenger"}, ["10.0", "mesenger"]),
+    ({"extra_wire": STITCH, "upper": "stitch"}, ["10.0", "off wire 'stitch'", "[45.0, 55.0]"]),
+    ({"extra_wire": STITCH.replace('"stitch"\nmass', '"contact"\nmass')},
+     ["exactly one wire with role 'contact'", "2"]),
+    ({"role": "messenger"}, ["exactly one wire with role 'contact'", "0"]),
+])
+def test_line_file_errors_name_the_culprit_and_the_file(tmp_path, change, culprits):
+    """Bad line files (an unknown key in a wire and at the top, a dropper naming a missing wire, a dropper off its
+    wire, two contact wires, none): `linefile.read_line_file` and `load_scene` of a scene with `[line] file = ...`
+    raise a SceneError naming the culprit and the file; the good file reads."""
+    good = tmp_path / "good.toml"
+    good.write_text(LINE_FILE.format(**GOOD))
+    assert len(read_line_file(good)[0].droppers) == 6
+    bad = tmp_path / "bad.toml"
+    bad.write_text(LINE_FILE.format(**{**GOOD, **change}))
+    scene = tmp_path / "scene.toml"
+    scene.write_text('model = "catenary"\n[line]\nfile = "bad.toml"\n[params]\nx_end = 100.0\nwindow_start = 20.0\n'
+                     'window_end = 80.0\n[input]\nspeed = 250.0\n')
+    for read in (lambda: read_line_file(bad), lambda: load_scene(str(scene)).build_params()):
+        with pytest.raises(SceneError) as err:
+            read()
+        for c in [*culprits, str(bad)]:
+            assert c in str(err.value), (c, str(err.value))
+
+
+def test_slack_dropper_in_compression_in_the_static_state_is_an_error_naming_it(tmp_path):
+    """A presag of 1/100 on 50 m spans holds the contact wire so far down that the droppers push it (the kink term
+    T (slope_left - slope_right) ~ -480 N against ~200 N of weight at x = 10 m): a slack dropper cannot, and
+    assembling the line of a scene with `[line] file = ...` is a ParameterError naming the dropper, its wires and its
+    tension; with law = "linear" (a strut) the same dropper assembles, in compression. Under the default 1/2000
+    the line assembles with every dropper in tension."""
+    (tmp_path / "scene.toml").write_text('model = "catenary"\n[line]\nfile = "line.toml"\n[params]\nx_end = 100.0\n'
+                                         'window_start = 20.0\nwindow_end = 80.0\n[input]\nspeed = 250.0\n')
+    line = tmp_path / "line.toml"
+    line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.01}))
+    with pytest.raises(ParameterError, match=r"dropper at x = 10\.0 m \(messenger -> contact\) is in compression"):
+        assemble(load_scene(str(tmp_path / "scene.toml")).build_params())
+    line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.01, "law": "linear"}))
+    with pytest.raises(ParameterError, match=r"dropper at x = 25\.0 m"):  # the next one, still slack
+        assemble(load_scene(str(tmp_path / "scene.toml")).build_params())
+    line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.0005}))
+    assert np.all(assemble(load_scene(str(tmp_path / "scene.toml")).build_params()).T0 > 0)

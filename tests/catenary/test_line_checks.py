@@ -188,7 +188,8 @@ def test_static_point_load_against_finite_differences(three_lines):
 def _fd_static_state(line: Line, groups: list[list[str]], h: float, g: float
                      ) -> tuple[FiniteDifferenceLine, np.ndarray, np.ndarray, np.ndarray]:
     """The static state of `line` by finite differences (the `fe` docstring's rules, solved here independently): the
-    wires under their weight, each dropper holding its lower wire at its design height (the contact wire on the
+    wires under their weight and the point masses (supports', the line's, half of each dropper's and its clamps' on
+    either end), each dropper holding its lower wire at its design height (the contact wire on the
     presag, another wire at 0), the contact wire also held at every support; `groups` (by hand) lists the wires in
     the order they are solved, each group's droppers' reactions loading the wires they hang from. Returns the FD
     line, every grid displacement, the dropper tensions and the contact wire's support reactions."""
@@ -201,6 +202,14 @@ def _fd_static_state(line: Line, groups: list[list[str]], h: float, g: float
         i = fd.at(w.name, w.x0) + np.arange(int(round((w.x1 - w.x0) / h)) + 1)
         f[i] = -w.mass * g * h
         f[i[[0, -1]]] *= 0.5
+    for s in line.supports:  # point masses: supports', the line's, the droppers' (half on each end) and clamps'
+        for name, m in s.m.items():
+            f[fd.at(name, s.x)] -= m * g
+    for pm in line.masses:
+        f[fd.at(pm.wire, pm.x)] -= pm.m * g
+    for d in line.droppers:
+        f[fd.at(d.upper, d.x)] -= (0.5 * d.mass + d.clamp_upper) * g
+        f[fd.at(d.lower, d.x)] -= (0.5 * d.mass + d.clamp_lower) * g
     u, t0 = np.zeros(fd.n), np.full(len(line.droppers), np.nan)
     sx = np.array([s.x for s in line.supports])
     preload = np.zeros(sx.size)
@@ -491,6 +500,64 @@ def test_static_state_of_stitched_and_compound_lines_against_finite_differences(
         err[h] = np.array([np.max(np.abs(fe.T0 - t0)), np.max(np.abs(fe.support_preload - preload)), shape])
     assert np.all(err[0.5] < [1.0, 2.0, 1.5e-3]), err
     assert np.all(err[0.25] < err[0.5] / 4), err
+
+
+def _write_line_file(line: Line, folder: Path) -> Path:
+    """`line` as a line file: wires, clamps and masses in TOML, supports and droppers as CSV tables."""
+    def value(v) -> str:
+        return f'"{v}"' if isinstance(v, str) else repr(list(map(list, v)) if isinstance(v, tuple) and v and
+                                                         isinstance(v[0], tuple) else list(v) if isinstance(v, tuple)
+                                                         else v).replace("'", '"')
+
+    toml = [f'name = "{line.name}"', f"presag = {line.presag!r}", 'supports_file = "supports.csv"',
+            'droppers_file = "droppers.csv"']
+    for table, rows in (("wires", line.wires), ("clamps", line.clamps), ("masses", line.masses)):
+        for r in rows:
+            toml += [f"[[{table}]]"] + [f"{k} = {value(v)}" for k, v in dataclasses.asdict(r).items()]
+    names = sorted({n for s in line.supports for n in s.k})
+    sup = ["x," + ",".join(f"k_{n},m_{n}" for n in names)]
+    sup += [f"{s.x!r}," + ",".join(f"{s.k.get(n, 0.0)!r},{s.m.get(n, 0.0)!r}" for n in names) for s in line.supports]
+    keys = [f.name for f in dataclasses.fields(line.droppers[0])]
+    drop = [",".join(keys)] + [",".join(str(getattr(d, k)) for k in keys) for d in line.droppers]
+    (folder / "supports.csv").write_text("\n".join(sup) + "\n")
+    (folder / "droppers.csv").write_text("\n".join(drop) + "\n")
+    (folder / "line.toml").write_text("\n".join(toml) + "\n")
+    return folder / "line.toml"
+
+
+def test_point_masses_of_a_line_file_in_the_static_state(tmp_path):
+    """The stitched line (three spans, presag 1/2000) with the masses a line file can give: droppers of 0.08 kg with
+    clamps of 0.065 kg (upper) and 0.165 kg (lower), 1.0 / 0.5 kg at every support on the contact wire / messenger,
+    connectors of 0.6 kg on both wires at 80 m and 0.3 kg on a stitch wire, written as a line file (TOML, supports
+    and droppers as CSV) and read back (`read_line_file`: the same `Line`). The masses' share of the static state
+    (with masses minus without, which cancels the FE's discretisation error) against `_fd_static_state`: beyond
+    20 m of the 80 m connector each dropper's tension grows by (0.08 / 2 + 0.165) 9.81 = 2.011 N by hand (FE
+    1.8e-6 N, FD 1.3e-6 N off: the contact wire's EI carries 2.9e-4 N of the connector 15 m on, 1.8e-6 N 23 m on;
+    bound 1e-4 N) and every support's pre-load by 1.0 x 9.81 N (3.2e-6 N; bound 1e-4 N); the FE's increments
+    against the FD's: tensions 3.5e-3 N (next to the connector; bound 1e-2 N), pre-loads 9.6e-7 N (bound 1e-4 N)."""
+    p = CatenaryParams(**THREE)
+    base = lines.stitched(p, presag=0.0005)
+    heavy = dataclasses.replace(
+        base, name="heavy stitched",
+        droppers=tuple(dataclasses.replace(d, mass=0.08, clamp_upper=0.065, clamp_lower=0.165) for d in base.droppers),
+        supports=tuple(Support(s.x, s.k, {"contact": 1.0, "messenger": 0.5}) for s in base.supports),
+        masses=(PointMass(80.0, "contact", 0.6), PointMass(80.0, "messenger", 0.6), PointMass(58.0, "stitch1", 0.3)))
+    read, irr = read_line_file(_write_line_file(heavy, tmp_path))
+    assert read == heavy and irr is None
+    groups = [["contact"], ["messenger", "stitch1", "stitch2"]]
+    out = []
+    for line in (base, read):
+        fe = assemble(dataclasses.replace(p, line=line))
+        _, _, t0, preload = _fd_static_state(line, groups, 0.01, p.g)
+        out.append((fe.T0, t0, fe.support_preload, preload))
+    (t_fe0, t_fd0, s_fe0, s_fd0), (t_fe1, t_fd1, s_fe1, s_fd1) = out
+    hand = (0.04 + 0.165) * p.g
+    far = np.array([abs(d.x - 80.0) > 20.0 for d in base.droppers])
+    for dt in (t_fe1 - t_fe0, t_fd1 - t_fd0):
+        assert np.max(np.abs(dt[far] - hand)) < 1e-4
+    assert np.max(np.abs((t_fe1 - t_fe0) - (t_fd1 - t_fd0))) < 1e-2
+    assert np.max(np.abs((s_fe1 - s_fe0) - 1.0 * p.g)) < 1e-4
+    assert np.max(np.abs((s_fe1 - s_fe0) - (s_fd1 - s_fd0))) < 1e-4
 
 # --- line-file errors ---------------------------------------------------------------------------------------------
 #: a valid line file: two 50 m spans, contact and messenger wire, three droppers per span

@@ -162,7 +162,7 @@ def evaluate(fn: Callable[[dict[str, Any]], Mapping[str, Any]], points: Sequence
              progress: bool | None = None, desc: str = "study") -> list[dict[str, float]]:
     """`fn` at every point on the sweep machinery, in the order of the points. A scene whose path is MuJoCo runs its
     points in threads (the native core releases the GIL), any other in processes, unless `options` names an
-    executor. Each result is checked to be a mapping of finite-or-nan numbers."""
+    executor. Each result must be a mapping of output name -> number."""
     from .sweep import run_sweep
 
     auto = "threads" if scene is not None and scene.solver.engine == "mujoco" else None
@@ -173,7 +173,11 @@ def evaluate(fn: Callable[[dict[str, Any]], Mapping[str, Any]], points: Sequence
         if not isinstance(r, Mapping):
             raise MbsuiteError(f"{desc}: the evaluation of point {i} returned {type(r).__name__}, not a mapping of "
                                "output name -> number")
-        out.append({str(k): float(v) for k, v in r.items()})
+        try:
+            out.append({str(k): float(v) for k, v in r.items()})
+        except (TypeError, ValueError):
+            raise MbsuiteError(f"{desc}: the evaluation of point {i} returned a value that is not a number: "
+                               f"{dict(r)!r}") from None
     return out
 
 

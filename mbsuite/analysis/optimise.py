@@ -377,8 +377,11 @@ def _start(scene: Scene | None, facs: list[Factor], start: Mapping[str, float] |
     factor has one inside its range, else None."""
     if start is not None:
         missing = [f.label for f in facs if f.label not in start]
-        if missing:
-            raise MbsuiteError(f"optimise start design: no value for {', '.join(missing)}")
+        extra = [k for k in start if k not in {f.label for f in facs}]
+        if missing or extra:
+            raise MbsuiteError("optimise start design: " + "; ".join(
+                ([f"no value for {', '.join(missing)}"] if missing else [])
+                + ([f"{', '.join(extra)} is not a factor (--vary)"] if extra else [])))
         x = np.array([float(start[f.label]) for f in facs])
     elif scene is not None:
         d = scene.to_dict()

@@ -44,6 +44,23 @@ def operating_points(scene: Any, speed: str | None, over: list[str] | None) -> d
     return out or None
 
 
+def start_design(scene: Any, texts: list[str] | None) -> dict[str, float] | None:
+    """`--start SECTION.KEY=VALUE` as the start design {factor: value} (None without any)."""
+    from ..analysis.sweep import parse_values
+    from .study import SECTIONS, split_key
+
+    if not texts:
+        return None
+    out = {}
+    for text in texts:
+        section, key, value = split_key(text, "--start", (*SECTIONS, *scene.spec.sections))
+        vals = parse_values(value)
+        if len(vals) != 1 or not isinstance(vals[0], float):
+            raise MbsuiteError(f"--start {text!r}: give one number")
+        out[f"{section}.{key}"] = vals[0]
+    return out
+
+
 def cmd_optimise(args: argparse.Namespace) -> None:
     """Run the optimisation (or the Pareto front) and emit its report (files under --out)."""
     from ..analysis import optimise
@@ -57,7 +74,8 @@ def cmd_optimise(args: argparse.Namespace) -> None:
     if over and all(len(v) == 1 for v in over.values()):  # one operating point: set it on the scene
         scene = apply_sets(scene, [f"{k}={v[0]}" for k, v in over.items()])
         over = None
-    common = dict(objective=args.objective, constraints=cons, over=over, aggregate=args.aggregate,
+    start = start_design(scene, args.start)
+    common = dict(start=start, objective=args.objective, constraints=cons, over=over, aggregate=args.aggregate,
                   penalty=args.penalty, maxiter=args.maxiter, popsize=args.popsize, seed=args.seed,
                   workers=args.workers, options=sweep_options(args))
     if args.pareto:

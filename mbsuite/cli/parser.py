@@ -234,6 +234,9 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--penalty", type=float, default=10.0,
                    help="objective units per unit of constraint violation (exact penalty; default 10)")
     p.add_argument("--seed", type=int, default=0, help="seed of the optimiser (default 0)")
+    p.add_argument("--start", action="append", metavar="SECTION.KEY=VALUE",
+                   help="the start design's value of a factor (repeatable; default: the scene's own values, when it "
+                        "has them inside the ranges)")
     p.add_argument("--pareto", metavar="LEVELS",
                    help="a Pareto front instead: minimise the objective with --against >= each level (a,b,c or "
                         "start:stop:step; epsilon-constraint)")

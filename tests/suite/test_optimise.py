@@ -96,6 +96,8 @@ def test_catenary_optimisation_end_to_end_on_a_short_line(tmp_path):
     (["--constraint", "sigma=band"], "bounds Fm only"),
     (["--objective", "sigmaa"], "not a headline output"),
     (["--speed", "250,abc"], "input.speed = 'abc'"),
+    (["--start", "params.k1=4000"], "params.k1 is not a factor"),
+    (["--start", "params.c1=500"], "params.c1 = 500 outside [0, 100]"),
 ])
 def test_bad_optimise_inputs_are_refused_naming_them(argv, words, capsys):
     rc = main(["optimise", "catenary/en50318", "--vary", "params.c1=0:100", *argv])

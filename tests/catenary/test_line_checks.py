@@ -474,11 +474,12 @@ def test_random_irregularity_has_the_requested_rms_and_is_fixed_by_its_seed():
 @pytest.mark.parametrize("kind, groups", [("stitched", [["contact"], ["messenger", "stitch1", "stitch2"]]),
                                           ("compound", [["contact"], ["auxiliary"], ["messenger"]])])
 def test_static_state_of_stitched_and_compound_lines_against_finite_differences(kind, groups):
-    """The static state (presag 1/1000, three spans) against `_fd_static_state` (h = 0.01 m; 3.3e-3 N and 1e-5 m
-    from h = 0.005 m): every dropper's tension (the stitch droppers hanging from the stitch wires, the contact wire
-    from the auxiliary and the auxiliary from the messenger), the steady arms' pre-loads, and every wire's static w at
-    the nodes at least 1 m from a key point (at a point force the FE's node is the wire's smooth part: the local
-    bump d P of the point-load correction is not in it, 0.55 mm at a messenger support, 0.6 mm at a stitch dropper).
+    """The static state (presag 1/1000, three spans) against `_fd_static_state` (h = 0.01 m: within 3.3e-3 N,
+    6.3e-3 N and 1.0e-5 m of h = 0.005 m): every dropper's tension (the stitch droppers hanging from the stitch
+    wires, the contact wire from the auxiliary and the auxiliary from the messenger), the steady arms' pre-loads, and
+    every wire's static w at the nodes at least 1 m from a key point (at a point force the FE's node is the wire's
+    smooth part: the local bump d P of the point-load correction is not in it, 0.55 mm at a messenger support,
+    0.6 mm at a stitch dropper).
     The FE at its 0.5 m elements, then 0.25 m, converging on the FD (about third order: the C1 wire rounds the kinks
     at the held points), measured stitched / compound: tensions 0.22 / 0.43 N -> 0.033 / 0.065 N (bound 1 N),
     pre-loads 0.40 / 0.81 N -> 0.061 / 0.12 N (bound 2 N), shape 4.6e-4 / 5.9e-5 m -> 7.4e-5 / 1.2e-5 m (bound

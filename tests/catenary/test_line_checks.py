@@ -1,8 +1,8 @@
 """Lines as data (`line.Line`, `lines.py`, `linefile.py`, `irregularity.py`) assembled by `fe.assemble`, checked
-against sources that are not the FE: a finite-difference solve of the same tensioned-beam equations written here,
-each wire's closed-form frequencies, reductions of the stitched and compound lines to the simple line, the presag
-and the dropper tensions by hand, irregularity profiles against their files and their requested rms, and the line
-file's errors."""
+against sources that are not the FE: a finite-difference solve of the same tensioned-beam equations written here
+(static response to a point load, static state, frequencies), each wire's closed-form frequencies, reductions of the
+stitched and compound lines to the simple line, the presag and the dropper tensions by hand, irregularity profiles
+against their files and their requested rms, and the line file's errors."""
 
 from __future__ import annotations
 
@@ -183,58 +183,6 @@ def test_static_point_load_against_finite_differences(three_lines):
         else:
             assert np.max(np.abs(t_fe - t_exact)) < 1.5e-4, (kind, x)
             assert np.max(np.abs(t_pl - t_exact)) > 1.5e-4, (kind, x)
-
-
-def _fd_static_state(line: Line, groups: list[list[str]], h: float, g: float
-                     ) -> tuple[FiniteDifferenceLine, np.ndarray, np.ndarray, np.ndarray]:
-    """The static state of `line` by finite differences (the `fe` docstring's rules, solved here independently): the
-    wires under their weight and the point masses (supports', the line's, half of each dropper's and its clamps' on
-    either end), each dropper holding its lower wire at its design height (the contact wire on the
-    presag, another wire at 0), the contact wire also held at every support; `groups` (by hand) lists the wires in
-    the order they are solved, each group's droppers' reactions loading the wires they hang from. Returns the FD
-    line, every grid displacement, the dropper tensions and the contact wire's support reactions."""
-    cw = line.contact.name
-    bare = dataclasses.replace(line, droppers=(), supports=tuple(
-        Support(s.x, {k: v for k, v in s.k.items() if k != cw}) for s in line.supports))  # the contact wire is held
-    fd = FiniteDifferenceLine(bare, h)
-    f = np.zeros(fd.n)
-    for w in line.wires:
-        i = fd.at(w.name, w.x0) + np.arange(int(round((w.x1 - w.x0) / h)) + 1)
-        f[i] = -w.mass * g * h
-        f[i[[0, -1]]] *= 0.5
-    for s in line.supports:  # point masses: supports', the line's, the droppers' (half on each end) and clamps'
-        for name, m in s.m.items():
-            f[fd.at(name, s.x)] -= m * g
-    for pm in line.masses:
-        f[fd.at(pm.wire, pm.x)] -= pm.m * g
-    for d in line.droppers:
-        f[fd.at(d.upper, d.x)] -= (0.5 * d.mass + d.clamp_upper) * g
-        f[fd.at(d.lower, d.x)] -= (0.5 * d.mass + d.clamp_lower) * g
-    u, t0 = np.zeros(fd.n), np.full(len(line.droppers), np.nan)
-    sx = np.array([s.x for s in line.supports])
-    preload = np.zeros(sx.size)
-    for group in groups:
-        idx = np.concatenate([fd.at(n, line.wire(n).x0) + np.arange(int(round((line.wire(n).x1 - line.wire(n).x0) / h))
-                                                                      + 1) for n in group])
-        held = {k: 0.0 for k in fd.pinned if k in idx}
-        mine = [j for j, d in enumerate(line.droppers) if d.lower in group]
-        for j in mine:
-            d = line.droppers[j]
-            held[fd.at(d.lower, d.x)] = _presag(np.array([d.x]), sx, line.presag)[0] if d.lower == cw else 0.0
-        if cw in group:
-            held.update({fd.at(cw, x): 0.0 for x in sx})
-        hk = np.array(sorted(held))
-        fr = np.setdiff1d(idx, hk)
-        u[hk] = [held[k] for k in hk]
-        u[fr] = splu(fd.K[fr][:, fr].tocsc()).solve(f[fr] - fd.K[fr][:, hk] @ u[hk])
-        r = fd.K @ u - f
-        for j in mine:
-            d = line.droppers[j]
-            t0[j] = r[fd.at(d.lower, d.x)]
-            f[fd.at(d.upper, d.x)] -= t0[j]
-        if cw in group:
-            preload = np.array([r[fd.at(cw, x)] for x in sx])
-    return fd, u, t0, preload
 
 
 # --- wave speed of each wire --------------------------------------------------------------------------------------
@@ -469,6 +417,59 @@ def test_random_irregularity_has_the_requested_rms_and_is_fixed_by_its_seed():
     r = irregularity.build({"seed": 5, "psd": [[0.05, c / 0.05**2], [1.0, c]], "n_waves": 200}, 1000.0).r
     assert abs(np.mean(r**2) / (c * (1 / 0.05 - 1)) - 1) < 0.06
 
+
+
+# --- the static state of lines with stitch and auxiliary wires and point masses -------------------------------
+def _fd_static_state(line: Line, groups: list[list[str]], h: float, g: float
+                     ) -> tuple[FiniteDifferenceLine, np.ndarray, np.ndarray, np.ndarray]:
+    """The static state of `line` by finite differences (the `fe` docstring's rules, solved here independently): the
+    wires under their weight and the point masses (supports', the line's, half of each dropper's and its clamps' on
+    either end), each dropper holding its lower wire at its design height (the contact wire on the
+    presag, another wire at 0), the contact wire also held at every support; `groups` (by hand) lists the wires in
+    the order they are solved, each group's droppers' reactions loading the wires they hang from. Returns the FD
+    line, every grid displacement, the dropper tensions and the contact wire's support reactions."""
+    cw = line.contact.name
+    bare = dataclasses.replace(line, droppers=(), supports=tuple(
+        Support(s.x, {k: v for k, v in s.k.items() if k != cw}) for s in line.supports))  # the contact wire is held
+    fd = FiniteDifferenceLine(bare, h)
+    f = np.zeros(fd.n)
+    for w in line.wires:
+        i = fd.at(w.name, w.x0) + np.arange(int(round((w.x1 - w.x0) / h)) + 1)
+        f[i] = -w.mass * g * h
+        f[i[[0, -1]]] *= 0.5
+    for s in line.supports:  # point masses: supports', the line's, the droppers' (half on each end) and clamps'
+        for name, m in s.m.items():
+            f[fd.at(name, s.x)] -= m * g
+    for pm in line.masses:
+        f[fd.at(pm.wire, pm.x)] -= pm.m * g
+    for d in line.droppers:
+        f[fd.at(d.upper, d.x)] -= (0.5 * d.mass + d.clamp_upper) * g
+        f[fd.at(d.lower, d.x)] -= (0.5 * d.mass + d.clamp_lower) * g
+    u, t0 = np.zeros(fd.n), np.full(len(line.droppers), np.nan)
+    sx = np.array([s.x for s in line.supports])
+    preload = np.zeros(sx.size)
+    for group in groups:
+        idx = np.concatenate([fd.at(n, line.wire(n).x0) + np.arange(int(round((line.wire(n).x1 - line.wire(n).x0) / h))
+                                                                      + 1) for n in group])
+        held = {k: 0.0 for k in fd.pinned if k in idx}
+        mine = [j for j, d in enumerate(line.droppers) if d.lower in group]
+        for j in mine:
+            d = line.droppers[j]
+            held[fd.at(d.lower, d.x)] = _presag(np.array([d.x]), sx, line.presag)[0] if d.lower == cw else 0.0
+        if cw in group:
+            held.update({fd.at(cw, x): 0.0 for x in sx})
+        hk = np.array(sorted(held))
+        fr = np.setdiff1d(idx, hk)
+        u[hk] = [held[k] for k in hk]
+        u[fr] = splu(fd.K[fr][:, fr].tocsc()).solve(f[fr] - fd.K[fr][:, hk] @ u[hk])
+        r = fd.K @ u - f
+        for j in mine:
+            d = line.droppers[j]
+            t0[j] = r[fd.at(d.lower, d.x)]
+            f[fd.at(d.upper, d.x)] -= t0[j]
+        if cw in group:
+            preload = np.array([r[fd.at(cw, x)] for x in sx])
+    return fd, u, t0, preload
 
 
 @pytest.mark.parametrize("kind, groups", [("stitched", [["contact"], ["messenger", "stitch1", "stitch2"]]),

@@ -10,8 +10,9 @@ the head at t + dt is exactly affine in the end-of-step force f1 (`affine_map`),
 (whose Newmark average-acceleration scheme is this rule on its first-order form: the same numbers to rounding).
 
 - `LumpedParams`: stage 1 is the head (the contact point), stage i hangs on stage i + 1 through k_i, c_i and the last
-  stage on the base through k_n, c_n (k_n may be 0); the static uplift F0 acts on the last stage, every spring
-  unstretched at zero displacement (k_n is referenced to the undisturbed contact wire level, as the reference's k2).
+  stage on the base through k_n, c_n; the static uplift F0 acts on the last stage, every spring
+  unstretched at zero displacement (k_n is referenced to the undisturbed contact wire level, as the reference's k2;
+  it may be 0 or negative: a static uplift that does not change, or rises, as the head falls).
   Two stages with the reference's m1 ... F0 are the EN 50318 2-mass pantograph.
 - `TransferParams`: a strictly proper state-space model (A, B, C) of the head's receptance G(s) = head displacement
   per upward force on the head, m/N (a fitted or measured frequency response); the static uplift F0 is the contact
@@ -98,9 +99,10 @@ class LumpedParams:
             for i, x in enumerate(vals):
                 if x < lo:
                     raise ParameterError(f"lumped pantograph {name}[{i}] = {x!r}: must be >= {lo:g}")
-        for i, x in enumerate(k):
-            if x < 0 or (x == 0 and i < len(k) - 1):
-                raise ParameterError(f"lumped pantograph k[{i}] = {x!r}: must be > 0 (the last, to the base, >= 0)")
+        for i, x in enumerate(k[:-1]):
+            if x <= 0:
+                raise ParameterError(f"lumped pantograph k[{i}] = {x!r}: must be > 0 (only the last, to the base, "
+                                     "may be <= 0)")
         object.__setattr__(self, "m", m)
         object.__setattr__(self, "k", k)
         object.__setattr__(self, "c", c)

@@ -93,11 +93,14 @@ def _add_fit_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--starts", type=int, default=STARTS,
                    help=f"starts of the lumped fit's multi-start (default {STARTS})")
     p.add_argument("--seed", type=int, default=0, help="seed of the starts (default 0)")
+    p.add_argument("--base-spring", choices=["static", "fitted"], default="static",
+                   help="the lumped pantograph's spring to the base: held at the model's static stiffness at the head "
+                        "(default; may be negative) or fitted as the others (positive)")
 
 
 def fit_args(args: argparse.Namespace) -> dict:
-    """`--stages/--band/--df/--height/--order/--starts/--seed` as `lumped_study.fit_report`'s keyword arguments,
-    each checked (MbsuiteError naming the flag)."""
+    """`--stages/--band/--df/--height/--order/--starts/--seed/--base-spring` as `lumped_study.fit_report`'s keyword
+    arguments, each checked (MbsuiteError naming the flag)."""
     lo, sep, hi = str(args.band).partition(":")
     try:
         band = (float(lo), float(hi))
@@ -112,7 +115,7 @@ def fit_args(args: argparse.Namespace) -> dict:
     if not 1 <= args.starts <= 1000:
         raise MbsuiteError(f"--starts {args.starts}: 1 to 1000")
     return {"stages": args.stages, "band": band, "df": args.df, "height": args.height, "order": args.order,
-            "starts": args.starts, "seed": args.seed}
+            "starts": args.starts, "seed": args.seed, "base_spring": args.base_spring}
 
 
 def fit_lumped_of(scene: Scene, args: argparse.Namespace):

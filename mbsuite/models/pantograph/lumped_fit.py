@@ -8,11 +8,13 @@ Coulomb friction is not linearisable and is left out, the contact is closed. Und
 the contact force f = -f_up.
 
 `fit_lumped`: an n-stage chain (`LumpedParams` of the catenary: stage 1 the head, the last stage on the base) by
-least squares on the complex receptance (`scipy.optimize.least_squares`, trust-region reflective), every mass,
-spring and damper positive through its logarithm; the residual is the relative complex error (G_fit - G) / |G| at
-every frequency of the band (weight 1 / |G|, all frequencies alike), from `STARTS` log-uniform starts (seeded) and
-the best kept. The static uplift F0 makes the chain's static contact force at the working height (head at zero,
-rigid wire) the model's.
+least squares on the complex receptance (`scipy.optimize.least_squares`, trust-region reflective, the Jacobian
+exact: `_chain_jacobian`), every mass, spring and damper positive through its logarithm; the residual is the relative
+complex error (G_fit - G) / |G| at every frequency of the band (weight 1 / |G|, all frequencies alike), from `STARTS`
+log-uniform starts (seeded), the best polished. By default the base spring k_n is not fitted: it holds the chain's
+static stiffness at the head at the model's (`static_stiffness`; negative for this pantograph, whose uplift rises as
+the head falls), so that the static uplift varies with the height as the model's. The static uplift F0 makes the
+chain's static contact force at the working height (head at zero, rigid wire) the model's.
 
 `fit_transfer`: a rational G(s) = N(s) / D(s) of stated order n (numerator degree n - 2: a mass's roll-off) by the
 Sanathanan-Koerner iteration (linear least squares with the previous denominator as weight, on the same relative
@@ -40,8 +42,9 @@ from .equations import PantographConfig, PantographODE
 from .params import PantographParams
 
 #: the multi-start of the lumped fit: this many log-uniform starts inside `START_BOX`, each at most `START_NFEV`
-#: evaluations, the best polished to convergence
-STARTS, START_NFEV = 12, 300
+#: evaluations on at most about `START_POINTS` of the frequencies, the best `POLISHED` polished on all of them (at
+#: most `POLISH_NFEV` evaluations each)
+STARTS, START_NFEV, START_POINTS, POLISHED, POLISH_NFEV = 32, 100, 80, 3, 2000
 #: the log-uniform box of the starts: masses (kg), springs (N/m), dampers (N s/m)
 START_BOX = {"m": (1.0, 100.0), "k": (10.0, 1e6), "c": (1.0, 1e4)}
 #: the default band (Hz), its spacing (Hz), the transfer function's default order
@@ -61,6 +64,12 @@ class DrivingPoint:
     A: np.ndarray
     B: np.ndarray
     C: np.ndarray
+
+    @property
+    def static_stiffness(self) -> float:
+        """The static stiffness at the head (N/m), 1 / G(0) = -1 / (C A^-1 B): negative where the uplift rises as the
+        head falls."""
+        return -1.0 / float(self.C @ np.linalg.solve(self.A, self.B))
 
 
 def band_freqs(band: tuple[float, float] = BAND, df: float = DF) -> np.ndarray:
@@ -124,13 +133,9 @@ class LumpedFit:
     nfev: int
 
 
-#: the bounds of the fitted values: masses (kg), springs (N/m), dampers (N s/m)
-BOUNDS = {"m": (1e-3, 1e4), "k": (1e-2, 1e9), "c": (1e-3, 1e7)}
-
-
-def _chain(theta: np.ndarray, n: int, F0: float = 0.0) -> LumpedParams:
-    v = np.exp(theta)
-    return LumpedParams(tuple(v[:n]), tuple(v[n:2 * n]), tuple(v[2 * n:]), F0)
+#: the bounds of the fitted values: masses (kg; a stage lighter than 0.1 kg is not one), springs (N/m), dampers
+#: (N s/m)
+BOUNDS = {"m": (0.1, 1e4), "k": (1e-2, 1e9), "c": (1e-3, 1e7)}
 
 
 def _box(box: dict[str, tuple[float, float]], n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -138,37 +143,99 @@ def _box(box: dict[str, tuple[float, float]], n: int) -> tuple[np.ndarray, np.nd
             np.log([box[k][1] for k in ("m", "k", "c") for _ in range(n)]))
 
 
-def fit_lumped(freqs: np.ndarray, G: np.ndarray, stages: int, static_force: float, *, starts: int = STARTS,
-               seed: int = 0, x_scale_tol: float = 1e-12) -> LumpedFit:
+def _chain_jacobian(m: np.ndarray, k: np.ndarray, c: np.ndarray, freqs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The chain's receptance G (nf,) and its derivatives with respect to log m, log k, log c (nf, 3n), forward
+    through the continued fraction of `chain_receptance`: dG/dS_1 = -G^2, dS_i/dS_{i+1} = z_i^2 / (z_i + S_{i+1})^2,
+    dS_i/dz_i = S_{i+1}^2 / (z_i + S_{i+1})^2, dS_i/dm_i = s^2."""
+    n = len(m)
+    s = 2j * np.pi * np.asarray(freqs, float)
+    S = [None] * n
+    S[n - 1] = m[-1] * s * s + k[-1] + c[-1] * s
+    for i in range(n - 2, -1, -1):
+        z = k[i] + c[i] * s
+        S[i] = m[i] * s * s + z * S[i + 1] / (z + S[i + 1])
+    G = 1.0 / S[0]
+    J = np.empty((s.size, 3 * n), complex)
+    P = -G * G  # dG/dS_j, carried down the chain
+    for j in range(n):
+        if j < n - 1:
+            z = k[j] + c[j] * s
+            q = 1.0 / (z + S[j + 1]) ** 2
+            dz = P * S[j + 1] ** 2 * q
+        else:
+            dz = P
+        J[:, j] = P * s * s * m[j]
+        J[:, n + j] = dz * k[j]
+        J[:, 2 * n + j] = dz * s * c[j]
+        if j < n - 1:
+            P = P * z * z * q
+    return G, J
+
+
+def fit_lumped(freqs: np.ndarray, G: np.ndarray, stages: int, static_force: float, *,
+               static_stiffness: float | None = None, starts: int = STARTS, seed: int = 0,
+               x_scale_tol: float = 1e-12) -> LumpedFit:
     """The n-stage lumped pantograph nearest the receptance `G` at `freqs` (module docstring), its F0 set so that
-    its static contact force at the working height is `static_force` (N)."""
+    its static contact force at the working height is `static_force` (N). `static_stiffness` (N/m): the chain's
+    static stiffness at the head is held at this value through its base spring k_n (which may then be negative: an
+    uplift that rises as the head falls) and k_n is not fitted; None: k_n is fitted as the others, positive."""
     if isinstance(stages, bool) or not isinstance(stages, int | np.integer) or not 1 <= stages <= 6:
         raise ParameterError(f"stages = {stages!r}: a lumped fit takes 1 to 6 stages")
     freqs, G = np.asarray(freqs, float), np.asarray(G, complex)
     if freqs.shape != G.shape or freqs.size < 3 * stages:
         raise ParameterError(f"a {stages}-stage fit needs at least {3 * stages} frequencies, as many as responses")
+    pinned = static_stiffness is not None
+    if pinned and not (math.isfinite(static_stiffness) and static_stiffness != 0.0):
+        raise ParameterError(f"static_stiffness = {static_stiffness!r} N/m: a finite non-zero number")
+    n = stages
     w = 1.0 / np.abs(G)
 
-    def residual(theta: np.ndarray) -> np.ndarray:
+    def unpack(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         v = np.exp(theta)
-        r = (chain_receptance(v[:stages], v[stages:2 * stages], v[2 * stages:], freqs) - G) * w
+        m, c = v[:n], v[-n:]
+        k = v[n:-n]
+        if pinned:  # 1 / K_s = sum 1/k_i: the base spring that holds the static stiffness
+            d = 1.0 / static_stiffness - float(np.sum(1.0 / k))
+            k = np.append(k, 1.0 / d if abs(d) > 1e-300 else 1e300)
+        return m, k, c
+
+    def residual(theta: np.ndarray, every: int = 1) -> np.ndarray:
+        r = (chain_receptance(*unpack(theta), freqs[::every]) - G[::every]) * w[::every]
         return np.concatenate([r.real, r.imag])
 
+    def jacobian(theta: np.ndarray, every: int = 1) -> np.ndarray:
+        m, k, c = unpack(theta)
+        J = _chain_jacobian(m, k, c, freqs[::every])[1]
+        if pinned:  # k_n = 1 / (1/K_s - sum_{i<n} 1/k_i): d k_n / d log k_i = -k_n^2 / k_i
+            J[:, n:2 * n - 1] -= J[:, [2 * n - 1]] * (k[-1] / k[:-1])[None, :]
+            J = np.delete(J, 2 * n - 1, axis=1)
+        J = J * w[::every, None]
+        return np.vstack([J.real, J.imag])
+
     rng = np.random.default_rng(seed)
-    lo, hi = _box(START_BOX, stages)
-    bounds = _box(BOUNDS, stages)
-    best, nfev = None, 0
+    keep = np.ones(3 * n, bool)
+    if pinned:
+        keep[2 * n - 1] = False
+    lo, hi = (b[keep] for b in _box(START_BOX, n))
+    bounds = tuple(b[keep] for b in _box(BOUNDS, n))
+    # the starts on every `every`-th frequency (at most START_POINTS), the best few polished on all of them
+    every = max(1, freqs.size // START_POINTS)
+    sols, nfev = [], 0
     for _ in range(int(starts)):
-        sol = least_squares(residual, rng.uniform(lo, hi), method="trf", bounds=bounds, max_nfev=START_NFEV)
+        sol = least_squares(residual, rng.uniform(lo, hi), jac=jacobian, method="trf", bounds=bounds,
+                            max_nfev=START_NFEV, kwargs={"every": every})
         nfev += sol.nfev
-        if best is None or sol.cost < best.cost:
-            best = sol
-    best = least_squares(residual, best.x, method="trf", bounds=bounds, xtol=x_scale_tol, ftol=x_scale_tol,
-                         gtol=x_scale_tol, max_nfev=20000)
-    nfev += best.nfev
-    p = _chain(best.x, stages)
+        sols.append(sol)
+    best = None
+    for sol in sorted(sols, key=lambda r: r.cost)[:POLISHED]:
+        pol = least_squares(residual, sol.x, jac=jacobian, method="trf", bounds=bounds, xtol=x_scale_tol,
+                            ftol=x_scale_tol, gtol=x_scale_tol, max_nfev=POLISH_NFEV)
+        nfev += pol.nfev
+        if best is None or pol.cost < best.cost:
+            best = pol
+    m, k, c = unpack(best.x)
     # LumpedParams.static_force is F0 / (1 + k_n sum_{i<n} 1/k_i): the F0 that gives `static_force`
-    p = LumpedParams(p.m, p.k, p.c, float(static_force) * (1.0 + p.k[-1] * sum(1.0 / x for x in p.k[:-1])))
+    p = LumpedParams(tuple(m), tuple(k), tuple(c), float(static_force) * (1.0 + k[-1] * float(np.sum(1.0 / k[:-1]))))
     return LumpedFit(p, fit_error(freqs, p.receptance(freqs), G), float(best.cost), int(starts), int(nfev))
 
 

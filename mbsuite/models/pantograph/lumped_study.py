@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ...errors import ParameterError
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
 from .inputs import config_of
@@ -39,15 +40,25 @@ def catenary_scene(kind: str, params: dict[str, Any], description: str) -> str:
             'to x_end at the given speed\n')
 
 
+#: how the lumped fit takes its base spring k_n: held at the model's static stiffness, or fitted (positive)
+BASE_SPRINGS = ("static", "fitted")
+
+
 def fit_report(scene: Scene, stages: int = 2, band: tuple[float, float] = BAND, df: float = DF,
-               height: float | None = None, order: int = ORDER, starts: int = STARTS, seed: int = 0) -> Report:
+               height: float | None = None, order: int = ORDER, starts: int = STARTS, seed: int = 0,
+               base_spring: str = "static") -> Report:
     """Fit an n-stage lumped and an order-`order` transfer-function pantograph to the driving-point receptance of the
     pantograph `scene` (its parameters and effects) at ram height `height` (m; default its y_op) over `band` (Hz,
-    spacing `df`); a Report with the parameters, the fit errors and the files (module docstring)."""
+    spacing `df`); `base_spring` "static": the chain's base spring holds the model's static stiffness at the head
+    (so that its static uplift varies with the height as the model's), "fitted": fitted as the others, positive. A
+    Report with the parameters, the fit errors and the files (module docstring)."""
+    if base_spring not in BASE_SPRINGS:
+        raise ParameterError(f"base_spring = {base_spring!r}; valid: {list(BASE_SPRINGS)}")
     freqs = band_freqs(band, df)
     p = scene.build_params()
     dp = driving_point(p, dict(config_of(scene).__dict__), height, freqs)
-    lf = fit_lumped(freqs, dp.G, stages, dp.static_force, starts=starts, seed=seed)
+    lf = fit_lumped(freqs, dp.G, stages, dp.static_force, starts=starts, seed=seed,
+                    static_stiffness=dp.static_stiffness if base_spring == "static" else None)
     tf = fit_transfer(freqs, dp.G, order, dp.static_force)
     above = freqs >= ABOVE_HZ
     G_l, G_t = lf.params.receptance(freqs), tf.params.receptance(freqs)
@@ -59,7 +70,8 @@ def fit_report(scene: Scene, stages: int = 2, band: tuple[float, float] = BAND, 
         err_above = {}
     sec_l, sec_t = lf.params.section(), tf.params.section()
     data = {
-        "height_m": dp.height, "static_contact_force_N": dp.static_force, "band_hz": [float(band[0]), float(band[1])],
+        "height_m": dp.height, "static_contact_force_N": dp.static_force, "static_stiffness_N_per_m":
+            dp.static_stiffness, "base_spring": base_spring, "band_hz": [float(band[0]), float(band[1])],
         "df_hz": float(df), "frequencies": int(freqs.size),
         "linearisation": "about the static equilibrium at the height, Coulomb friction left out, force input at the "
                          "contact point (no ram spring)",
@@ -79,8 +91,9 @@ def fit_report(scene: Scene, stages: int = 2, band: tuple[float, float] = BAND, 
         ea = err_above.get(name, {})
         rows.append([name, e["max_amplitude_rel"], e["at_f_amplitude_hz"], e["max_phase_deg"], e["at_f_phase_hz"],
                      ea.get("max_amplitude_rel", math.nan), ea.get("max_phase_deg", math.nan)])
-    lines = [f"driving-point receptance at height {dp.height:g} m (static contact force {dp.static_force:.4g} N), "
-             f"{freqs[0]:g}-{freqs[-1]:g} Hz, {freqs.size} frequencies",
+    lines = [f"driving-point receptance at height {dp.height:g} m (static contact force {dp.static_force:.4g} N, "
+             f"static stiffness {dp.static_stiffness:.4g} N/m), {freqs[0]:g}-{freqs[-1]:g} Hz, {freqs.size} "
+             f"frequencies; base spring {base_spring}",
              f"{stages}-stage lumped: m = {_fmt(lf.params.m)} kg, k = {_fmt(lf.params.k)} N/m, c = "
              f"{_fmt(lf.params.c)} N s/m, F0 = {lf.params.F0:.5g} N",
              f"transfer function of order {order}: poles "

@@ -312,16 +312,38 @@ static inline __attribute__((always_inline)) void bwd_run(const cat_job* J, doub
   }
 }
 
+/* one node whose neighbour has another size: the node kernels unrolled for each pair of even sizes, else the loops */
+#define PAIRS(X, s, p) \
+  switch (s * 16 + p) { \
+    X(2, 0) X(2, 2) X(2, 4) X(2, 6) X(2, 8) X(4, 0) X(4, 2) X(4, 4) X(4, 6) X(4, 8) \
+    X(6, 0) X(6, 2) X(6, 4) X(6, 6) X(6, 8) X(8, 0) X(8, 2) X(8, 4) X(8, 6) X(8, 8) \
+    default: GENERIC; \
+  }
+
 static void fwd_any(const cat_job* J, double* y, int I) {
   const int s = NSIZE(J, I), p = I > 0 ? NSIZE(J, I - 1) : 0;
   const double* D = J->blk + J->boff[I];
-  fwd_node(D, D + s * s, y + J->noff[I], p ? y + J->noff[I - 1] : y, s, p);
+  double* v = y + J->noff[I];
+  const double* a = p ? y + J->noff[I - 1] : y;
+#define GENERIC fwd_node(D, D + s * s, v, a, s, p)
+#define FWD(S_, P_) \
+  case S_ * 16 + P_: fwd_node(D, D + S_ * S_, v, a, S_, P_); break;
+  PAIRS(FWD, s, p)
+#undef FWD
+#undef GENERIC
 }
 
 static void bwd_any(const cat_job* J, double* y, int I) {
   const int s = NSIZE(J, I), q = I < J->nnode - 1 ? NSIZE(J, I + 1) : 0;
   const double* G = J->blk + J->boff[I + 1] - s * q;
-  bwd_node(G - s * s, G, y + J->noff[I], q ? y + J->noff[I + 1] : y, s, q);
+  double* v = y + J->noff[I];
+  const double* a = q ? y + J->noff[I + 1] : y;
+#define GENERIC bwd_node(G - s * s, G, v, a, s, q)
+#define BWD(S_, Q_) \
+  case S_ * 16 + Q_: bwd_node(G - S_ * S_, G, v, a, S_, Q_); break;
+  PAIRS(BWD, s, q)
+#undef BWD
+#undef GENERIC
 }
 
 static void block_solve(const cat_job* J, double* x) {

@@ -698,7 +698,8 @@ def test_slack_dropper_in_compression_in_the_static_state_is_an_error_naming_it(
     """A presag of 1/100 on 50 m spans holds the contact wire so far down that the droppers push it (the kink term
     T (slope_left - slope_right) ~ -480 N against ~200 N of weight at x = 10 m): a slack dropper cannot, and
     assembling the line of a scene with `[line] file = ...` is a ParameterError naming the dropper, its wires and its
-    tension; with law = "linear" (a strut) the same dropper assembles, in compression. Under the default 1/2000
+    tension; with law = "linear" (a strut) the same dropper assembles, in compression, and the droppers without a
+    law of their own are refused when the scene's `droppers` effect makes them slack (`slack_mask`). Under 1/2000
     the line assembles with every dropper in tension."""
     (tmp_path / "scene.toml").write_text('model = "catenary"\n[line]\nfile = "line.toml"\n[params]\nx_end = 100.0\n'
                                          'window_start = 20.0\nwindow_end = 80.0\n[input]\nspeed = 250.0\n')
@@ -707,7 +708,9 @@ def test_slack_dropper_in_compression_in_the_static_state_is_an_error_naming_it(
     with pytest.raises(ParameterError, match=r"dropper at x = 10\.0 m \(messenger -> contact\) is in compression"):
         assemble(load_scene(str(tmp_path / "scene.toml")).build_params())
     line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.01, "law": "linear"}))
-    with pytest.raises(ParameterError, match=r"dropper at x = 25\.0 m"):  # the next one, still slack
-        assemble(load_scene(str(tmp_path / "scene.toml")).build_params())
+    fe = assemble(load_scene(str(tmp_path / "scene.toml")).build_params())  # the others take the scene's law
+    with pytest.raises(ParameterError, match=r"dropper at x = 25\.0 m"):  # the next one: slack under "slack"
+        fe.slack_mask("slack")
+    assert not fe.slack_mask("linear").any()  # linear droppers may push
     line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.0005}))
     assert np.all(assemble(load_scene(str(tmp_path / "scene.toml")).build_params()).T0 > 0)

@@ -167,3 +167,23 @@ def test_mbsuite_catenary_runs_a_line_file(tmp_path, capsys):
     direct = simulate(p, 250.0, 2e-4)
     stats = out["runs"]["slack"]["statistics"]
     assert abs(stats["sigma"] - direct.stats["sigma"]) <= 1e-9
+
+
+def test_two_droppers_on_one_point_of_a_wire_are_refused():
+    """The static state holds the lower wire once per point: two droppers there would each take the whole reaction
+    (found by the independent checks: both at 86 N, the messenger 81 mm lower)."""
+    p = CatenaryParams(**SHORT)
+    base = lines.simple(p)
+    with pytest.raises(ParameterError, match=r"two droppers hang wire 'contact' at x = 30.0 m"):
+        dataclasses.replace(base, droppers=(*base.droppers, lines.Dropper(30.0, "messenger", "contact", 1e5)))
+
+
+def test_an_edited_profile_file_is_read_again(tmp_path):
+    """An irregularity profile is rebuilt when its file changes (the cache keys on the file's stamp, not its name)."""
+    from mbsuite.models.catenary import irregularity
+
+    f = tmp_path / "r.csv"
+    f.write_text("x,r\n0,0\n10,0.001\n20,0\n")
+    assert irregularity.build({"file": str(f)}, 20.0)(10.0) == pytest.approx(0.001)
+    f.write_text("x,r\n0,0\n10,0.005\n20,0\n30,0\n")
+    assert irregularity.build({"file": str(f)}, 20.0)(10.0) == pytest.approx(0.005)

@@ -327,6 +327,15 @@ class CatenaryFE:
         """FE elements of all wires."""
         return int(np.sum(self.slot[:, :-1] >= 0) - np.sum((self.slot[:, :-1] >= 0) & (self.slot[:, 1:] < 0)))
 
+    def slack_mask(self, effect: str) -> np.ndarray:
+        """(nd,) bool: the droppers that may go slack under the scene's `droppers` effect ("slack" or "linear"): a
+        dropper's own law where it has one, the effect's where it has none. Refuses (ParameterError) a dropper that
+        may go slack but is in compression in the static state."""
+        laws = np.array([d.law for d in self.line.droppers], dtype=object)
+        mask = (laws == "slack") | ((laws == "") & (effect == "slack"))
+        _check_compression(self.line, self.T0, mask)
+        return mask.astype(bool)
+
     def cw_dofs_of_node(self, i: int) -> tuple[int, int]:
         """Free indices (w, theta) of the CW at node i (-1 if pinned)."""
         c = int(self.slot[0, i])
@@ -487,18 +496,23 @@ def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
     Kst = (Kbeams + sp.diags(ground_static) + Kclamp).tocsr()
     w0_full, T0, preload = _static_state(line, x, slot, supports, up, low, Kst, qload, pinned)
     slack = np.array([d.law != "linear" for d in line.droppers], dtype=bool)
-    bad = np.nonzero(slack & (T0 < 0))[0]
-    if bad.size:
-        j = int(bad[0])
-        raise ParameterError(
-            f"line {line.name!r}: the dropper at x = {line.droppers[j].x} m ({line.droppers[j].upper} -> "
-            f"{line.droppers[j].lower}) is in compression in the static state (T0 = {T0[j]:.4g} N): a slack dropper "
-            "cannot hold the wire there (give it law = 'linear' if it is a strut, or change the line)")
+    _check_compression(line, T0, np.array([d.law == "slack" for d in line.droppers], dtype=bool))
     return CatenaryFE(params=p, line=line, x=x, supports=supports, droppers=droppers, node_offset=offset, slot=slot,
                       free=free, full_to_free=full_to_free, M=M, K0=K0, Kd=Kd, B=B,
                       dropper_upper=full_to_free[up], dropper_lower=full_to_free[low], dropper_slack=slack,
                       w0_full=w0_full, T0=T0, support_preload=preload, k_drop=k_drop, contact=pcs[0],
                       irregularity=line.irregularity)
+
+
+def _check_compression(line: Line, T0: np.ndarray, slack: np.ndarray) -> None:
+    """A `ParameterError` naming the first dropper of mask `slack` whose static tension is negative."""
+    bad = np.nonzero(slack & (T0 < 0))[0]
+    if bad.size:
+        d = line.droppers[int(bad[0])]
+        raise ParameterError(
+            f"line {line.name!r}: the dropper at x = {d.x} m ({d.upper} -> {d.lower}) is in compression in the static "
+            f"state (T0 = {T0[int(bad[0])]:.4g} N): a slack dropper cannot hold the wire there (give it law = "
+            "'linear' if it is a strut, or change the line)")
 
 
 def _static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarray, up: np.ndarray,
@@ -556,10 +570,11 @@ def _static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndar
         mine = np.nonzero(d_low == g)[0]
         for j in mine:
             held[int(pos[low[j]])] = float(z[j])
-        if g == group[0]:
+        if g == group[0]:  # the contact wire at each support with a steady arm (a ground spring on it)
             zs = line.design_height(x[supports])
             for i, s in enumerate(slot[0, supports]):
-                held[int(pos[s])] = float(zs[i])
+                if line.contact.name in line.supports[i].k:
+                    held[int(pos[s])] = float(zs[i])
         Kg = K[idx][:, idx].tocsr()
         Kg.eliminate_zeros()
         fg = f[idx]
@@ -586,5 +601,6 @@ def _static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndar
         for j in mine:  # the dropper now loads the wire it hangs from
             f[up[j]] -= T0[j]
         if g == group[0]:
-            preload = r[pos[slot[0, supports]]]
+            arm = np.array([line.contact.name in sp_.k for sp_ in line.supports], dtype=bool)
+            preload = np.where(arm, r[pos[slot[0, supports]]], 0.0)
     return u, T0, preload

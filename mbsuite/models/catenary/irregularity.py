@@ -133,7 +133,14 @@ _BUILT: dict[str, Irregularity] = {}
 def build(d: Mapping[str, Any], length: float, where: str = "irregularity") -> Irregularity:
     """The `Irregularity` of a checked table `d` over the line [0, length] (m) (the last few kept: a scene's
     parameters are built more than once)."""
-    key = repr((sorted(d.items()), float(length)))
+    stamp = None
+    if isinstance(d.get("file"), str):  # a profile file: its contents count, not only its name
+        try:
+            st = Path(d["file"]).stat()
+            stamp = (st.st_mtime_ns, st.st_size)
+        except OSError:
+            stamp = None
+    key = repr((sorted(d.items()), float(length), stamp))
     if key not in _BUILT:
         if len(_BUILT) > 8:
             _BUILT.clear()

@@ -228,7 +228,8 @@ class Line:
             raise ParameterError(f"line {self.name!r}: wire name(s) {dup} appear more than once")
         contact = [w for w in self.wires if w.role == "contact"]
         if len(contact) != 1:
-            raise ParameterError(f"line {self.name!r} needs exactly one wire with role 'contact', has {len(contact)}")
+            raise ParameterError(f"line {self.name!r} needs exactly one wire with role 'contact', has {len(contact)}"
+                                 + (f": {[w.name for w in contact]}" if contact else ""))
         cw = contact[0]
         if cw.x0 != 0.0 or any(w.x0 < 0 or w.x1 > cw.x1 for w in self.wires):
             raise ParameterError(f"line {self.name!r}: the contact wire must start at x = 0 and every wire lie on it "
@@ -247,8 +248,7 @@ class Line:
             if w is None:
                 raise ParameterError(f"line {self.name!r}: {what} names wire {wire!r}; wires: {list(wires)}")
             if not w.x0 - 1e-9 <= x <= w.x1 + 1e-9:
-                raise ParameterError(f"line {self.name!r}: {what} at x = {x} m lies off wire {wire!r} "
-                                     f"[{w.x0}, {w.x1}] m")
+                raise ParameterError(f"line {self.name!r}: {what} lies off wire {wire!r} [{w.x0}, {w.x1}] m")
 
         sup = tuple(sorted(self.supports, key=lambda s: s.x))
         if len(sup) < 2:
@@ -258,12 +258,18 @@ class Line:
                 raise ParameterError(f"line {self.name!r}: two supports at x = {a.x} m")
         object.__setattr__(self, "supports", sup)
         for s in sup:
-            on(cw.name, s.x, "a support")
+            on(cw.name, s.x, f"a support at x = {s.x} m")
             for w in (*s.k, *s.m):
                 on(w, s.x, f"support at x = {s.x} m")
+        ends: dict[tuple[str, float], float] = {}
         for d in self.droppers:
-            on(d.upper, d.x, f"dropper at x = {d.x} m (upper)")
-            on(d.lower, d.x, f"dropper at x = {d.x} m (lower)")
+            on(d.upper, d.x, f"dropper at x = {d.x} m (upper wire)")
+            on(d.lower, d.x, f"dropper at x = {d.x} m (lower wire)")
+            key = (d.lower, round(d.x, 9))
+            if key in ends:  # the static state holds the lower wire there: one reaction, not two tensions
+                raise ParameterError(f"line {self.name!r}: two droppers hang wire {d.lower!r} at x = {d.x} m; one "
+                                     "dropper per point of a wire (merge them: the sum of their stiffnesses)")
+            ends[key] = d.x
         for c in self.clamps:
             on(c.a, c.x, f"clamp at x = {c.x} m")
             on(c.b, c.x, f"clamp at x = {c.x} m")

@@ -83,3 +83,33 @@ def test_a_random_irregularity_is_reproducible_and_raises_the_force_variation():
     assert np.array_equal(a.result.force, a2.result.force)
     assert not np.array_equal(a.result.force, b.result.force)
     assert a.stats["sigma"] > level.stats["sigma"] and b.stats["sigma"] > level.stats["sigma"]
+
+
+def _stitched_short():
+    import mbsuite
+
+    return mbsuite.load_scene("catenary/en50318_stitched").replace(
+        params={"n_spans": 4, "x_end": 150.0, "window_start": 60.0, "window_end": 120.0})
+
+
+def test_a_train_a_design_grid_and_the_quality_report_run_on_a_stitched_line():
+    """Everything built for the simple line takes any line (a 4-span stitched line): two pantographs 60 m apart, where
+    the leading one's force record equals the single pantograph's until the trailing one enters at t = s / V (it
+    exerts no force before: 1e-9 N); a design-grid point equal to its direct run (bit for bit); the quality report's
+    sigma criterion of the statistics as the 0.3 Fm rule computed here."""
+    from mbsuite.models.catenary.analysis import run_scene, run_train_scene
+    from mbsuite.models.catenary.design import design_grid
+    from mbsuite.models.catenary.quality import QualityCriteria, assess
+
+    scene = _stitched_short()
+    single = run_scene(scene)
+    train = run_train_scene(scene.replace(train={"pantographs": ["reference2mass", "reference2mass"],
+                                                 "spacings": [60.0]}))
+    n_in = int(round(60.0 / (250.0 / 3.6) / scene.solver.timestep))
+    lead = train.results[0].force
+    assert np.max(np.abs(lead[:n_in] - single.result.force[:n_in])) < 1e-9
+    assert np.isfinite(train.stats[1]["sigma"])
+    grid = design_grid(scene, [250.0], {"m1": [7.2, 9.0]}, workers=1, progress=False)
+    assert grid["points"][1]["sigma"] == run_scene(scene, m1=9.0).stats["sigma"]
+    q = assess(single.stats, 250.0, QualityCriteria(), 60.0 / (250.0 / 3.6))
+    assert q["rows"]["sigma"]["pass"] == (single.stats["sigma"] <= 0.3 * single.stats["Fm"])

@@ -6,8 +6,9 @@ order, no numerical damping) in its midpoint form. With h = dt/2 and the mean ve
     S vb = q_n + h (g_n + g_{n+1}) / 2,      S = M + h C + h^2 K,      u_{n+1} = u_n + 2 h vb,
     q_n = M v_n - h K u_n   (kept by the recursions q_{n+1} = 2(M - h^2 K) vb - p_n, p_{n+1} = 2(M + h^2 K) vb - q_n)
 
-so one step costs one banded solve (S is symmetric positive definite with half-bandwidth 5 in the node-by-node DOF
-ordering: LAPACK banded Cholesky dpbtrf once, dpbtrs per step) and one sparse mat-vec. C = alpha M + beta K0
+so one step costs one banded solve (S is symmetric positive definite and narrow-banded in the node-by-node DOF
+ordering, `fe.node_offset`: half-bandwidth 5 on the simple line, 7 on the stitched and compound lines; LAPACK banded
+Cholesky dpbtrf once, dpbtrs per step) and one sparse mat-vec. C = alpha M + beta K0
 (Rayleigh on the wires and support springs; droppers are massless undamped springs). K = K0 + Kd holds the
 droppers as linear springs; g are the local forces: the contact force f N(x) (Hermite shape functions at the
 contact point) and, for slack droppers, a correction -s B_i that cancels the dropper's tension. Every point spring

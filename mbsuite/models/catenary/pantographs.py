@@ -25,7 +25,8 @@ found by `mbsuite.registry.get_model(name).under_wire` with the `[pantograph]` s
 and `params`, validated against that model's spec). `lumped` and `transfer` are the catenary's linear pantographs
 (`linear_pantographs.py`: an n-stage lumped one and a state-space model of a receptance), their parameters in the
 `[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step, but they run on the Python
-stages of the coupled step (`trial / commit`), not in the compiled loop. The catenary imports no pantograph model.
+coupling (`trial / commit`), not in the compiled loop, except the 2-stage lumped one, which is a `TwoMassPantograph`
+with its own numbers. The catenary imports no pantograph model.
 """
 
 from __future__ import annotations
@@ -225,8 +226,13 @@ def _linear_section(name: str, value: Any) -> dict[str, dict[str, Any]]:
 
 
 def _linear(name: str, params: Mapping[str, Any], effects: Mapping[str, Any], engine: str,
-            timestep: float) -> linear.LinearPantograph:
-    """`UnderWire` of a linear pantograph: its parameters from the `[pantograph]` section's `params`."""
+            timestep: float) -> linear.LinearPantograph | TwoMassPantograph:
+    """`UnderWire` of a linear pantograph: its parameters from the `[pantograph]` section's `params`. A 2-stage
+    lumped pantograph is the 2-mass pantograph's model and scheme with other numbers: it is made one
+    (`TwoMassPantograph`, stepped in the compiled loop)."""
+    p = linear.params_of(name, {"params": params})
+    if isinstance(p, linear.LumpedParams) and p.stages == 2:
+        return TwoMassPantograph(p.m[0], p.k[0], p.c[0], p.m[1], p.k[1], p.c[1], p.F0, name=name)
     return linear.make(name, {"params": params})
 
 

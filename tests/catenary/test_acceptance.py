@@ -58,7 +58,7 @@ def test_one_element_length_for_python_and_every_shipped_scene():
     from mbsuite.scenes import shipped_scenes
 
     names = shipped_scenes()["catenary"]
-    assert len(names) == 5
+    assert {"en50318", "en50318_linear", "en50318_stitched", "example_line"} <= set(names)
     for name in names:
         assert load_scene(f"catenary/{name}").build_params().element_length == CatenaryParams().element_length, name
     assert CatenaryParams().element_length == 0.5

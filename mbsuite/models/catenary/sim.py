@@ -76,8 +76,8 @@ class CoupledSimulation:
     factorisation, influence columns, the local contact/dropper solver). `start` gives a `Passage` to step; `run`
     steps one to its end and records it.
 
-    `dropper_law`: "slack" (the droppers whose law is slack, `fe.dropper_slack`, are tension-only; the others stay
-    bilateral) or "linear" (all bilateral). `contact`: "unilateral" or "bilateral"."""
+    `dropper_law`: the scene's `droppers` effect, "slack" (tension-only) or "linear" (bilateral), for the droppers
+    without a law of their own (`fe.slack_mask`). `contact`: "unilateral" or "bilateral"."""
 
     def __init__(self, fe: CatenaryFE, pantograph: Pantograph, speed: float, dt: float, dropper_law: str = "slack",
                  contact: str = "unilateral", max_active_iter: int = 100):
@@ -86,9 +86,8 @@ class CoupledSimulation:
         if contact not in ("unilateral", "bilateral"):
             raise SolverError(f"contact must be 'unilateral' or 'bilateral', got {contact!r}")
         self.fe, self.panto, self.V, self.dt = fe, pantograph, float(speed), float(dt)
-        #: per dropper: tension-only (may go slack); `slack`: any of them is
-        self.slackable = (np.asarray(fe.dropper_slack, dtype=bool) if dropper_law == "slack"
-                          else np.zeros(fe.T0.size, dtype=bool))
+        #: per dropper: tension-only (may go slack; `fe.slack_mask`); `slack`: any of them is
+        self.slackable = np.asarray(fe.slack_mask(dropper_law), dtype=bool)
         self.slack = bool(np.any(self.slackable))
         self.unilateral = contact == "unilateral"
         self.max_active_iter = max_active_iter

@@ -3,31 +3,34 @@
 from mutations.mutation import Mutation
 
 _FE = "mbsuite/models/catenary/fe.py"
+_LINES = "mbsuite/models/catenary/lines.py"
 _STATS = "mbsuite/models/catenary/stats.py"
-_MW = "(MW_W, (p.mw_mass, p.mw_tension, p.mw_EI))"
+_MW = "Wire(MESSENGER, MESSENGER, p.mw_mass, p.mw_tension, p.mw_EI, 0.0, L)"
 
 MUTATIONS: tuple[Mutation, ...] = (
     Mutation("catenary_droppers_bilateral", "mbsuite/models/catenary/sim.py",
-             "        self.slack = dropper_law == \"slack\"", "        self.slack = False",
+             "        self.slack = bool(np.any(self.slackable))", "        self.slack = False",
              "droppers made bilateral (they push as well as pull) in the slack-dropper scenes", "tests/catenary"),
     # --- assembly of each wire, droppers, supports
-    Mutation("catenary_mw_assembled_with_cw_EI", _FE, _MW, "(MW_W, (p.mw_mass, p.mw_tension, p.cw_EI))",
+    Mutation("catenary_mw_assembled_with_cw_EI", _LINES, _MW,
+             "Wire(MESSENGER, MESSENGER, p.mw_mass, p.mw_tension, p.cw_EI, 0.0, L)",
              "the messenger wire assembled with the contact wire's bending stiffness",
              "tests/catenary/test_assembly.py"),
-    Mutation("catenary_mw_assembled_with_cw_mass", _FE, _MW, "(MW_W, (p.cw_mass, p.mw_tension, p.mw_EI))",
+    Mutation("catenary_mw_assembled_with_cw_mass", _LINES, _MW,
+             "Wire(MESSENGER, MESSENGER, p.cw_mass, p.mw_tension, p.mw_EI, 0.0, L)",
              "the messenger wire assembled with the contact wire's mass per length (wrong MW wave speed)",
              "tests/catenary/test_assembly.py"),
     Mutation("catenary_consistent_mass_sign", _FE, "[54, 13 * h, 156, -22 * h]", "[54, -13 * h, 156, -22 * h]",
              "a sign slip in one rotary-translational term of the consistent element mass matrix",
              "tests/catenary/test_fe.py"),
-    Mutation("catenary_steady_arm_with_messenger_support_stiffness", _FE,
-             "    ground[NDOF_NODE * supports + CW_W] += series(p.k_steady_arm, d_cw[supports])",
-             "    ground[NDOF_NODE * supports + CW_W] += series(p.k_messenger_support, d_cw[supports])",
+    Mutation("catenary_steady_arm_with_messenger_support_stiffness", _LINES,
+             "{CONTACT: p.k_steady_arm, MESSENGER: p.k_messenger_support, **extra}",
+             "{CONTACT: p.k_messenger_support, MESSENGER: p.k_messenger_support, **extra}",
              "the steady arms given the messenger supports' stiffness (CW held too stiffly at the supports)",
              "tests/catenary/test_assembly.py"),
     Mutation("catenary_dropper_hung_one_node_along", _FE,
-             "(np.concatenate([NDOF_NODE * droppers + MW_W, NDOF_NODE * droppers + CW_W])",
-             "(np.concatenate([NDOF_NODE * (droppers + 1) + MW_W, NDOF_NODE * droppers + CW_W])",
+             "    up = np.array([wslot(d.upper, d.x)[0] for d in line.droppers], dtype=int)",
+             "    up = np.array([slot[wi[d.upper], at(d.x) + 1] for d in line.droppers], dtype=int)",
              "each dropper hung from the messenger node next to its own (an off-by-one index)",
              "tests/catenary/test_assembly.py"),
     # --- contact, start state, damping

@@ -62,6 +62,7 @@ NEEDS_GIT = pytest.mark.skipif(shutil.which("git") is None or not (ROOT / ".git"
 # every command of the command line with small arguments: (argv, the exit status it must give without a display)
 COMMANDS = [
     (["list", "--json"], 0),
+    (["pantograph", "fit-lumped", "--stages", "1", "--df", "0.5", "--starts", "2", "--order", "4", "--json"], 0),
     (["run", "iftomm/fourbar", "--json"], 0),
     (["view", "pantograph"], 2),  # no display here: the one-line message that points to offscreen rendering
     (["render", "iftomm/fourbar", "--out", "fourbar.png", "--width", "64", "--height", "48"], 0),

@@ -15,7 +15,7 @@ from ...solver import SolverSettings
 from . import accuracy
 from .config import validate_train_section
 from .linefile import scene_params, validate_line_section
-from .pantographs import PANTOGRAPH_MODELS, PANTOGRAPHS, TWO_MASS, validate_section
+from .pantographs import PANTOGRAPHS, SECTION_PANTOGRAPHS, TWO_MASS, validate_section
 from .params import CatenaryParams
 from .quality import validate_section as validate_quality
 
@@ -24,7 +24,7 @@ from .quality import validate_section as validate_quality
 #: difference 0.0; `tests/suite/test_unused_input.py`)
 USES = {
     **{f"params.{k}": Uses(effects={"pantograph": (TWO_MASS,)}) for k in ("m1", "k1", "c1", "m2", "k2", "c2", "F0")},
-    "pantograph": Uses(effects={"pantograph": tuple(PANTOGRAPH_MODELS)}),
+    "pantograph": Uses(effects={"pantograph": tuple(SECTION_PANTOGRAPHS)}),
 }
 
 SPEC = ModelSpec(
@@ -38,7 +38,9 @@ SPEC = ModelSpec(
                              "reference2mass: EN 50318 2-mass pantograph (parameters m1 ... F0 in [params]); "
                              "eppinger: the registry model 'pantograph' (Brecknell-Willis), its own effects and "
                              "parameters in the [pantograph] section, its path = solver.engine (reference = "
-                             "hand-derived ODE, mujoco = MuJoCo)"),
+                             "hand-derived ODE, mujoco = MuJoCo); lumped: an n-stage lumped pantograph (m, k, c, F0 "
+                             "lists in [pantograph] params); transfer: a state-space receptance (A, B, C, F0 in "
+                             "[pantograph] params; `mbsuite pantograph fit-lumped` writes both)"),
         "contact": Effect(("unilateral", "bilateral"), "unilateral",
                           "unilateral: penalty spring that only pushes; bilateral: attached (no contact loss)"),
     },

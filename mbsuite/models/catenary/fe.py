@@ -485,6 +485,10 @@ def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
                     for i, end in zip(ranges[k], w.ends, strict=True) if end == "pinned")
     mask = np.ones(nfull, bool)
     mask[pinned] = False
+    for j, d in enumerate(line.droppers):
+        if not (mask[up[j]] and mask[low[j]]):
+            raise ParameterError(f"line {line.name!r}: the dropper at x = {d.x} m ({d.upper} -> {d.lower}) sits on a "
+                                 "pinned wire end: it can carry nothing there (move it off the end)")
     free = np.nonzero(mask)[0]
     full_to_free = -np.ones(nfull, dtype=int)
     full_to_free[free] = np.arange(free.size)

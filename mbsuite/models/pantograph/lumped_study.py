@@ -31,8 +31,8 @@ def _toml_value(v: Any) -> str:
 
 def catenary_scene(kind: str, params: dict[str, Any], description: str) -> str:
     """The text of a catenary scene under the EN 50318 line with the linear pantograph `kind` of `params` (slack
-    droppers, 1 m elements, 0.2 ms: the reference scene `catenary/en50318`'s settings; the Eppinger scene's finer
-    0.5 m and 0.1 ms by `--element-length 0.5 --timestep 1e-4`)."""
+    droppers, 0.5 m elements, 0.2 ms: the reference scene `catenary/en50318`'s settings; the Eppinger scene's finer
+    0.1 ms by `--timestep 1e-4`)."""
     inline = ", ".join(f"{k} = {_toml_value(v)}" for k, v in params.items())
     return (f'model = "catenary"\ndescription = "{description}"\n\n[effects]\ndroppers = "slack"\n'
             f'pantograph = "{kind}"\ncontact = "unilateral"\n\n[input]\n'

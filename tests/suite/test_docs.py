@@ -55,6 +55,14 @@ def _toml_blocks() -> list[tuple[Path, str]]:
 @pytest.mark.parametrize(("path", "block"), _toml_blocks(), ids=[str(p.relative_to(ROOT)) for p, _ in _toml_blocks()])
 def test_toml_blocks_are_valid_scenes_or_fragments(path, block):
     data = tomllib.loads(block)
+    if "wires" in data and "model" not in data:  # a catenary line file: read, checked and assembled
+        from mbsuite.models.catenary.fe import assemble
+        from mbsuite.models.catenary.linefile import line_from_dict
+        from mbsuite.models.catenary.params import CatenaryParams
+
+        line = line_from_dict(data, path.parent, str(path))
+        assemble(CatenaryParams(line=line, x_end=line.length, window_start=0.0, window_end=line.length))
+        return
     if "model" in data:
         mbsuite.scene_from_dict(data)
         return

@@ -58,6 +58,26 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
      "The Modelica Standard Library's CoupledClutches example on both paths against its reference result."),
     ("Drive design tables", "mbsuite drive design tables", ["design_tables.png"],
      "The thesis' Chapter 5 design tables recomputed."),
+    ("A stitched line", "mbsuite catenary catenary/en50318_stitched --speed 300 --quality",
+     ["force_uplift_reference2mass_300kmh.png", "quality_reference2mass_300kmh.png"],
+     "The 2-mass pantograph under the stitched EN 50318 line at 300 km/h: force, wire height and uplift; quality."),
+    ("A line of your own", "mbsuite catenary catenary/example_line", ["force_uplift_reference2mass_250kmh.png"],
+     "A tension section from a line file: varying spans, stitch wires, masses, presag and a height profile."),
+    ("Sensitivity of the Eppinger pantograph under the wire",
+     "mbsuite sensitivity catenary/en50318_eppinger --set solver.engine=mujoco --vary pantograph.params.mh=10:17 "
+     "--vary pantograph.params.kh=1500:3000 --vary pantograph.params.bh=5:20 --vary pantograph.params.b2=100:220 "
+     "--vary pantograph.params.Pg=6.8e5:7.6e5 --method morris --n 4 --seed 1", ["sensitivity.png"],
+     "Morris elementary effects (mu*, with 95 % intervals) of five pantograph parameters on the EN 50318 statistics."),
+    ("The best 2-mass pantograph for the line",
+     "mbsuite optimise catenary/en50318 --vary params.k1=3000:6000 --vary params.c1=0:60 --vary params.c2=50:130 "
+     "--vary params.F0=100:140 --objective sigma --band AC --speed 250 --maxiter 6 --popsize 3 --seed 1",
+     ["optimise.png"], "Differential evolution for the lowest sigma with Fm inside the EN 50367 band: every design."),
+    ("Sigma against the mean force",
+     "mbsuite optimise catenary/en50318 --vary params.c2=50:130 --vary params.F0=100:140 --objective sigma "
+     "--against Fm --pareto 95,105,115 --band AC --speed 250 --maxiter 3 --popsize 4 --seed 2", ["pareto.png"],
+     "The epsilon-constraint front of sigma against Fm at 250 km/h."),
+    ("Lumped pantographs fitted to the multibody one", "mbsuite pantograph fit-lumped --stages 3", ["lumped_fit.png"],
+     "The Eppinger pantograph's driving-point receptance against its 3-stage lumped and transfer-function fits."),
 ]
 
 

@@ -1,4 +1,5 @@
-"""Command line: `mbsuite list | run | view | render | sweep | workprecision | perturb | hardcases` plus each model's
+"""Command line: `mbsuite list | run | view | render | sweep | workprecision | perturb | hardcases | sensitivity |
+optimise` plus each model's
 command group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
 
 Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the

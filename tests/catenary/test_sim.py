@@ -195,7 +195,7 @@ def test_energy_balance_closes_on_a_stitched_line_with_masses_and_an_irregularit
     scale = np.max(np.abs(total - total[0]))
     assert scale > 5.0 and np.sum(np.diff((r.force <= 0).astype(int)) == 1) >= 5
     assert np.max(np.abs(total - total[0] - work(E["drive_power"]))) < 5e-3 * scale
-    # the irregularity's share of the power, from the lead's own profile (line.Irregularity.slope)
+    # the irregularity's share of the power, from the profile's own slope (line.Irregularity.slope)
     p_irr = -r.force * V * irr.slope(r.x)
     assert np.max(np.abs(total - total[0] - work(E["drive_power"] - p_irr))) > 0.1 * scale
 

@@ -10,7 +10,7 @@ LOW_VENV := .venv-lowest
 LOW_STAMP := $(LOW_VENV)/.installed
 export MPLBACKEND ?= Agg
 
-.PHONY: demo test test-slow test-lowest lock lint bench mutants corpus docs clean
+.PHONY: demo test test-slow test-perturbed test-lowest lock lint bench mutants corpus docs clean
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -36,6 +36,14 @@ test: $(STAMP)  ## default suite (slow studies excluded)
 
 test-slow: $(STAMP)  ## long studies only
 	$(BIN)/python -m pytest -q -m slow
+
+# the tests that read digit-sensitive quantities (marker `rounding`), again with every input perturbed by seeded relative
+# draws of 1e-12 ... 1e-10: another machine's rounding, emulated (tests/conftest.py, docs/reproducibility.md)
+PERTURB_SEEDS ?= 1 2
+test-perturbed: $(STAMP)  ## the `rounding` tests under seeded 1e-12...1e-10 input perturbations, one run per seed
+	@status=0; for s in $(PERTURB_SEEDS); do \
+	  $(BIN)/python -m pytest -q --perturb 1e-12:1e-10 --perturb-seed $$s || status=1; \
+	done; exit $$status
 
 test-lowest: $(LOW_STAMP)  ## default suite at the lowest versions pyproject.toml allows, in .venv-lowest
 	$(LOW_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|matplotlib|distributed|tqdm|mujoco|pin|pytest|hypothesis|pandas)=='

@@ -126,13 +126,15 @@ def positive(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) 
 
 def param(default: Any, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
           hi_open: bool = False, unit: str = "", doc: str = "", kind: type = float,
-          choices: tuple[Any, ...] | None = None) -> Any:
-    """A dataclass field with its valid range: `l1: float = param(1.95, lo=0, lo_open=True, unit="m", doc=...)`."""
+          choices: tuple[Any, ...] | None = None, draw: str | None = None) -> Any:
+    """A dataclass field with its valid range: `l1: float = param(1.95, lo=0, lo_open=True, unit="m", doc=...)`.
+    `draw`: the key of its perturbation draw when it is shared (`perturbation.POSITION`: coordinates that coincide
+    across objects)."""
     lim = Limit(lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, unit=unit, doc=doc, kind=kind, choices=choices,
                 default=default)
     if isinstance(default, list | dict | set):
         raise TypeError("param() defaults must be immutable")
-    return dataclasses.field(default=default, metadata={"limit": lim})
+    return dataclasses.field(default=default, metadata={"limit": lim, **({"draw": draw} if draw else {})})
 
 
 def limit_of(cls_or_obj: Any, name: str) -> Limit | None:

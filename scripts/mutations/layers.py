@@ -43,9 +43,19 @@ MUTATIONS: tuple[Mutation, ...] = (
              "the recorded channels read one column early (the first channel gets the time column, each other its "
              "neighbour's values)", "tests/engines/test_core.py"),
     Mutation("perturbation_draws_one_signed", "mbsuite/perturbation.py",
-             "    dz = d.eps * d.z(key, x)", "    dz = d.eps * abs(d.z(key, x))",
+             "        z = float(rng.standard_normal())", "        z = abs(float(rng.standard_normal()))",
              "perturbation draws all of one sign (|z| instead of a standard normal z): every copy is biased upwards",
              "tests/suite/test_perturbation.py"),
+    Mutation("condition_kappa_under_reads", "mbsuite/stability.py",
+             "    return Condition(y0, worst, worst / (eps * scale), eps, draws)",
+             "    return Condition(y0, worst, worst / (eps * scale) / draws, eps, draws)",
+             "the condition estimate of a derived quantity divided by the number of draws: kappa under-reads, and "
+             "every audit that reads it passes", "tests/suite/test_perturbation.py"),
+    Mutation("perturbation_range_ignored", "mbsuite/perturbation.py",
+             "        return self.eps * (self.eps_max / self.eps) ** float(rng.uniform()) * z",
+             "        return self.eps * z",
+             "a perturbation range [eps, eps_max] draws every quantity at its lower end: the rounding emulation of "
+             "the perturbed test run is a hundred times weaker than stated", "tests/suite/test_perturbation.py"),
     Mutation("perturbation_mirror_dropped", "mbsuite/perturbation.py",
              "        y = x * (1.0 - dz)", "        y = x * (1.0 + dz)",
              "a draw that would cross a declared range end is not mirrored: the quantity silently stays unperturbed",

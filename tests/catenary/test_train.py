@@ -57,7 +57,9 @@ def test_trailing_pantograph_behind_a_lowered_one_is_the_single_one():
     tr = simulate_train(P5, 250.0, 2e-4, [_panto(P5, F0=-50.0), _panto(P5)], [100.0])
     assert tr.static_forces[0] == 0.0 and np.all(tr.results[0].force == 0.0)
     r = tr.results[1]
-    assert r.x[0] == 0.0 and r.x[-1] == P5.x_end and r.t.size == single.result.t.size
+    # positions to 1e-9 m: the entry position is V n dt, exactly 0.0 in one association of the product and 1.4e-14 m
+    # in the other
+    assert abs(r.x[0]) < 1e-9 and abs(r.x[-1] - P5.x_end) < 1e-9 and r.t.size == single.result.t.size
     assert np.max(np.abs(r.force - single.result.force)) < 1e-9
     for k in (*STATS, "uplift_mm"):
         assert tr.stats[1][k] == pytest.approx(single.stats[k], abs=1e-9), k
@@ -89,7 +91,9 @@ def test_energy_balance_of_two_pantographs_closes():
     work = np.concatenate([[0.0], np.cumsum(0.5 * (E["drive_power"][1:] + E["drive_power"][:-1])
                                             * np.diff(r.energy_t))])
     # the trailing pantograph's own energy enters with it (its static state): remove that step from the balance
-    entry = np.searchsorted(r.energy_t, 50.0 / (400 / 3.6) - 1e-12)
+    # the record nearest the entry instant (the entry lies on the record grid: a tie broken by 1e-12 s would be a
+    # last-bit decision; records are 5 steps = 5e-4 s apart)
+    entry = int(np.argmin(np.abs(r.energy_t - 50.0 / (400 / 3.6))))
     jump = total[entry] - total[entry - 1] - (work[entry] - work[entry - 1])
     total = total - np.where(np.arange(total.size) >= entry, jump, 0.0)
     scale = np.max(np.abs(total - total[0]))

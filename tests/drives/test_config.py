@@ -12,6 +12,7 @@ import itertools
 import numpy as np
 import pytest
 
+from mbsuite import perturbation
 from mbsuite.errors import SceneError
 from mbsuite.models.drives.config import (
     CONTROLLERS,
@@ -159,5 +160,6 @@ def test_rotor_inertia_floor(key):
     run = run_setup(sc.replace(params={key: 1e-9}))
     sim = MujocoRotorSim(run.system, mjcf_path(run.mjcf), timestep=1e-4)
     i = ["J_m", "J_s", "J_l"].index(key)
-    assert run.system.J[i] == 1e-9
-    assert sim.m.body_inertia[sim.m.jnt_bodyid[sim.jnt[i]]][2] == 1e-9
+    # the floor itself (in the perturbed tests: the floor moved up by the draw in force, never below it)
+    assert 1e-9 <= run.system.J[i] <= 1e-9 * (1 + 8 * perturbation.size())
+    assert sim.m.body_inertia[sim.m.jnt_bodyid[sim.jnt[i]]][2] == run.system.J[i]

@@ -134,6 +134,7 @@ def _disengaged_closed_form(t_end: float = 2.0) -> list[tuple[float, str]]:
     return events
 
 
+@pytest.mark.literal_inputs("event times against the MSL closed form of the literal constants to 2e-14 s")
 def test_one_way_clutch_disengaged_against_closed_form():
     expected = _disengaged_closed_form()
     assert len(expected) == 8  # lock/release four times (the expected sequence from the MSL equations)
@@ -146,6 +147,7 @@ def test_one_way_clutch_disengaged_against_closed_form():
         assert max(abs(a[0] - b[0]) for a, b in zip(got, expected, strict=True)) <= tol, engine
 
 
+@pytest.mark.literal_inputs("speeds against the closed forms of the literal constants to 3e-12")
 def test_simple_gear_shift_phases():
     """Expected sequence from the MSL equations: the brake holds the ring until 2 s (gear ratio load/engine =
     1/(1 + ratio) = 0.4); the ramp engages the clutch (backward: the sun turns faster than the held ring), the brake

@@ -8,6 +8,7 @@ shipped scene at its defaults and every hard case, at 1e-12 and 1e-9."""
 from __future__ import annotations
 
 import json
+import zlib
 
 import numpy as np
 import pytest
@@ -98,6 +99,78 @@ def test_the_check_catches_a_last_bit_discontinuity(monkeypatch):
     declared = stability.check_scene(sc, eps=1e-12, draws=2, base=rep.base, jumps={"stats.*": "declared"})
     assert {o.jump for o in declared.jumps() if o.name.startswith("stats.")} == {"declared"}
     assert not declared.ok and all(o.ok for o in declared.outputs if o.name.startswith("stats."))
+
+
+def _z(seed: int, key: str, x: float) -> float:
+    """The documented draw, computed here by hand: numpy's generator seeded with (seed, CRC32 of 'key|repr(x)')."""
+    return float(np.random.default_rng((seed, zlib.crc32(f"{key}|{x!r}".encode()))).standard_normal())
+
+
+def _cubed_stiffness() -> float:
+    return load_scene("pantograph/lab").build_params().ks ** 3
+
+
+def test_condition_reads_the_kappa_of_a_hand_computed_case():
+    """The audits of the crossing-reading tests rest on `stability.condition`; a kappa that under-reads would pass
+    them all. Held against a closed form: y = ks^3 (the pantograph's contact stiffness, built through its parameter
+    dataclass). A copy changes ks by eps z, so y by 3 eps z y (1 + O(eps)): over two draws kappa (scale |y|) is
+    3 max |z| to 1e-3 (the rounding of y itself, 1.1e-16 against a change of 1e-12), with z computed here from the
+    documented draw. A quantity with a jump (floor of a value a
+    last bit below an integer) reads kappa = inf or past KAPPA_MAX; an array that changes length reads inf."""
+    ks = load_scene("pantograph/lab").build_params().ks
+    eps = 1e-12
+    hand = 3.0 * max(abs(_z(s, "PantographParams.ks", ks)) for s in (5, 6))
+    got = stability.condition(_cubed_stiffness, scale=ks**3, eps=eps, draws=2, seed=5)
+    assert got.value == ks**3 and got.draws == 2 and got.eps == eps
+    assert got.kappa == pytest.approx(hand, rel=1e-3), (got.kappa, hand)
+    assert got.max_change == pytest.approx(hand * eps * ks**3, rel=1e-3)
+    # the range [eps, eps_max]: each quantity's size drawn log-uniform after z (z the same draw)
+    lo, hi = 1e-12, 1e-10
+    rng = np.random.default_rng((7, zlib.crc32(f"PantographParams.ks|{ks!r}".encode())))
+    z, u = float(rng.standard_normal()), float(rng.uniform())
+    with perturbation.perturbed(lo, 7, hi):
+        rel = load_scene("pantograph/lab").build_params().ks / ks - 1.0
+    assert rel == pytest.approx(lo * (hi / lo) ** u * z, rel=1e-4, abs=1e-15)
+    # ill-conditioned: floor(ks / 1000 - 1e-13) sits a last bit below a jump (ks = 180 000 exactly)
+    jump = stability.condition(lambda: np.floor(load_scene("pantograph/lab").build_params().ks / 1e3 - 1e-13),
+                               scale=1.0, eps=eps, draws=4)
+    assert jump.kappa > stability.KAPPA_MAX
+    grows = stability.condition(lambda: np.arange(int(load_scene("pantograph/lab").build_params().ks > ks) + 2),
+                                scale=1.0, eps=eps, draws=4)
+    assert grows.kappa == np.inf
+    with pytest.raises(ValueError, match="scale"):
+        stability.condition(_cubed_stiffness, scale=0.0)
+
+
+def test_check_scene_kappa_and_verdict_against_a_hand_computed_case(monkeypatch):
+    """`check_scene`'s kappa and verdict on a run whose headline output is a closed form of one parameter: y = ks^3
+    reads kappa = 3 max |z| and passes; y = 1 / (ks - 0.99999 ks0) amplifies a relative change by 1e5 and reads
+    1e5 max |z| (within KAPPA_MAX, passes); y = 1 / (ks - (1 - 1e-9) ks0) by 1e9: past KAPPA_MAX, fails unless
+    declared, and a declared jump passes with its reason. Each kappa equal to 1e-9 to the hand evaluation of the
+    closed form at ks0 (1 + eps z), z computed here from the documented draw."""
+    from types import SimpleNamespace
+
+    ks0 = load_scene("pantograph/lab").build_params().ks
+    law = {"f": lambda ks: ks**3}
+
+    def fake_run(scene):
+        y = law["f"](scene.build_params().ks)
+        return SimpleNamespace(stats={"y": y}, events=[], signals={}, units={}, health=[])
+
+    monkeypatch.setattr(stability, "run", fake_run)
+    zs = [_z(s, "PantographParams.ks", ks0) for s in (0, 1)]
+    sc = load_scene("pantograph/lab")
+    for amp, ok in ((None, True), (1e5, True), (1e9, False)):
+        f = law["f"] = (lambda ks: ks**3) if amp is None else (lambda ks, a=amp: 1.0 / (ks - (1.0 - 1.0 / a) * ks0))
+        hand = max(abs(f(ks0 * (1.0 + 1e-12 * z)) - f(ks0)) for z in zs) / (1e-12 * abs(f(ks0)))
+        rep = stability.check_scene(sc, eps=1e-12, draws=2, jumps={})
+        (out,) = [o for o in rep.outputs if o.name == "stats.y"]
+        assert out.kappa == pytest.approx(hand, rel=1e-9), (amp, out.kappa, hand)
+        assert out.kappa == pytest.approx(3 * max(map(abs, zs)) if amp is None else amp * max(map(abs, zs)),
+                                          rel=1e-3 if amp is None else 3e-3)
+        assert rep.ok is ok
+    declared = stability.check_scene(sc, eps=1e-12, draws=2, jumps={"stats.y": "a pole at ks0"})
+    assert declared.ok and [o.jump for o in declared.jumps()] == ["a pole at ks0"]
 
 
 def _all_scenes():

@@ -216,7 +216,8 @@ def build_nodes(p: CatenaryParams | Line, element_length: float | None = None
     the line of `p` (its `line`, else the simple line of its fields) or of a `Line` (then `element_length` is needed).
 
     Key points (`Line.key_points`: supports, droppers, clamps, masses, wire ends) are nodes; each interval between key
-    points is split into ceil(length / element_length) equal elements."""
+    points is split into ceil(length / element_length) equal elements (a length within 1e-6 of itself above a whole
+    number of element lengths counts as that number)."""
     if isinstance(p, CatenaryParams):
         line, element_length = line_of(p), p.element_length
     else:
@@ -224,8 +225,10 @@ def build_nodes(p: CatenaryParams | Line, element_length: float | None = None
     keys = line.key_points()
     pieces = []
     for a, b in zip(keys[:-1], keys[1:], strict=True):
-        r = (b - a) / element_length  # a whole number of elements stays one under a relative change < 1e-8
-        n = max(1, math.ceil(r - 1e-8 * max(1.0, r)))
+        # a whole number of elements stays one under a relative change < 1e-6: the interval between two key points
+        # 600 m out moves by 1e-7 of itself under the stability check's draws of 1e-10
+        r = (b - a) / element_length
+        n = max(1, math.ceil(r - 1e-6 * max(1.0, r)))
         pieces.append(a + (b - a) * np.arange(n) / n)
     pieces.append(keys[-1:])
     x = np.concatenate(pieces)

@@ -28,8 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ... import perturbation
 from ...errors import ParameterError
 from ...limits import check_fields, param, real
+from ...perturbation import POSITION
 
 WIRE_ROLES = ("contact", "messenger", "stitch", "auxiliary", "other")
 END_KINDS = ("pinned", "free")
@@ -56,8 +58,8 @@ class Wire:
     mass: float = param(1.0, lo=0.0, hi=100.0, unit="kg/m", doc="mass per length (0 only for a massless tie)")
     tension: float = param(1e4, lo=0.0, hi=1e6, unit="N", doc="tension (0: a bending beam alone)")
     EI: float = param(0.0, lo=0.0, hi=1e6, unit="N m^2", doc="bending stiffness")
-    x0: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="start of the wire")
-    x1: float = param(1.0, lo=0.0, lo_open=True, hi=1e6, unit="m", doc="end of the wire")
+    x0: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="start of the wire", draw=POSITION)
+    x1: float = param(1.0, lo=0.0, lo_open=True, hi=1e6, unit="m", doc="end of the wire", draw=POSITION)
     ends: tuple[str, str] = ("pinned", "pinned")
     #: (x_a, x_b, T): tension T (N) between x_a and x_b instead of `tension`
     tension_segments: tuple[tuple[float, float, float], ...] = ()
@@ -77,6 +79,8 @@ class Wire:
             if len(s) != 3:
                 raise ParameterError(f"wire {self.name!r}: tension_segments[{i}] = {s!r} must be [x_a, x_b, T]")
             a, b, T = (_number(f"wire {self.name!r} tension_segments[{i}]", v) for v in s)
+            # inside the stability check the segment's ends move as every position does (`perturbation.POSITION`)
+            a, b = perturbation.value(a, key=POSITION), perturbation.value(b, key=POSITION)
             if not (self.x0 <= a < b <= self.x1) or T < 0:
                 raise ParameterError(f"wire {self.name!r}: tension_segments[{i}] = {list(s)} must satisfy "
                                      f"x0 <= x_a < x_b <= x1 ([{self.x0}, {self.x1}] m) and T >= 0")
@@ -105,12 +109,12 @@ class Wire:
 class Support:
     """A support at x: ground springs `k` and point masses `m` on named wires."""
 
-    x: float
+    x: float = field(metadata={"draw": POSITION})
     k: dict[str, float] = field(default_factory=dict)
     m: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", _number("support x", self.x, lo=0.0))
+        object.__setattr__(self, "x", perturbation.value(_number("support x", self.x, lo=0.0), key=POSITION))
         for what in ("k", "m"):
             d = getattr(self, what)
             if not isinstance(d, dict):
@@ -123,7 +127,7 @@ class Support:
 class Dropper:
     """A dropper at x from `upper` to `lower` (module docstring)."""
 
-    x: float
+    x: float = field(metadata={"draw": POSITION})
     upper: str
     lower: str
     k: float = param(1e5, lo=0.0, lo_open=True, hi=1e12, unit="N/m", doc="axial stiffness")
@@ -143,7 +147,7 @@ class Dropper:
 class Clamp:
     """A bilateral spring k between wires a and b at x."""
 
-    x: float
+    x: float = field(metadata={"draw": POSITION})
     a: str
     b: str
     k: float = param(1e7, lo=0.0, lo_open=True, hi=1e15, unit="N/m", doc="clamp stiffness")
@@ -159,7 +163,7 @@ class Clamp:
 class PointMass:
     """A point mass m on `wire` at x (a registration clamp, an electrical connector)."""
 
-    x: float
+    x: float = field(metadata={"draw": POSITION})
     wire: str
     m: float = param(0.0, lo=0.0, hi=1e3, unit="kg", doc="mass")
 

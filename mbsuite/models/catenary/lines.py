@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ...errors import ParameterError
 from ...limits import check_fields, param
 from .line import Clamp, Dropper, Line, Support, Wire
@@ -84,23 +86,27 @@ def stitched(p: CatenaryParams, s: StitchParams | None = None, presag: float = 0
                 for i, xs in enumerate(interior)]
     clamps = [Clamp(xs + side * a, w.name, MESSENGER, s.k_clamp) for xs, w in zip(interior, stitches, strict=True)
               for side in (-1, 1)]
-    on_stitch = {}
+    # the droppers at x_s +- dropper_offset, matched to 1e-9 of the line's length (the dropper's x is computed from
+    # the span and its position in the span, this one from the support: equal up to rounding, and up to the draws
+    # of the stability check)
+    tol = 1e-9 * max(1.0, base.length)
+    dx = np.array([d.x for d in base.droppers])
+    on_stitch: dict[int, str] = {}
+    missing = []
     for xs, w in zip(interior, stitches, strict=True):
         for side in (-1, 1):
-            on_stitch[round(xs + side * s.dropper_offset, 9)] = w.name
-    droppers, moved = [], set()
-    for d in base.droppers:
-        key = round(d.x, 9)
-        if key in on_stitch:
-            droppers.append(Dropper(d.x, on_stitch[key], d.lower, d.k, d.law))
-            moved.add(key)
-        else:
-            droppers.append(d)
-    missing = sorted(set(on_stitch) - moved)
+            xt = xs + side * s.dropper_offset
+            near = np.nonzero(np.abs(dx - xt) <= tol)[0]
+            if near.size:
+                on_stitch[int(near[0])] = w.name
+            else:
+                missing.append(xt)
     if missing:
         raise ParameterError(f"stitch droppers: no dropper at x = {missing[:4]} m (dropper_offset = "
                              f"{s.dropper_offset} m from the interior supports); dropper_positions are "
                              f"{p.dropper_positions}")
+    droppers = [Dropper(d.x, on_stitch[i], d.lower, d.k, d.law) if i in on_stitch else d
+                for i, d in enumerate(base.droppers)]
     return Line((cw, mw, *stitches), base.supports, tuple(droppers), tuple(clamps), presag=presag, name="stitched")
 
 

@@ -39,7 +39,7 @@ test-slow: $(STAMP)  ## long studies only
 
 # the tests that read digit-sensitive quantities (marker `rounding`), again with every input perturbed by seeded relative
 # draws of 1e-12 ... 1e-10: another machine's rounding, emulated (tests/conftest.py, docs/reproducibility.md)
-PERTURB_SEEDS ?= 1 2
+PERTURB_SEEDS ?= 1 2 3 4 5 6
 test-perturbed: $(STAMP)  ## the `rounding` tests under seeded 1e-12...1e-10 input perturbations, one run per seed
 	@status=0; for s in $(PERTURB_SEEDS); do \
 	  $(BIN)/python -m pytest -q --perturb 1e-12:1e-10 --perturb-seed $$s || status=1; \

@@ -29,7 +29,8 @@ class _Draw:
     eps: float
     seed: int
     eps_max: float | None = None
-    made: set[tuple[str, float]] = dataclasses.field(default_factory=set)  # (key, value) this copy produced
+    outer: _Draw | None = None  # the draw in force when this one was entered (nested copies compose)
+    made: set[float] = dataclasses.field(default_factory=set)  # the values this copy produced
 
     def rel(self, key: str, x: float) -> float:
         """The relative change eps z of value x under name `key`, z a standard normal: the same name and value get
@@ -41,6 +42,22 @@ class _Draw:
             return self.eps * z
         return self.eps * (self.eps_max / self.eps) ** float(rng.uniform()) * z
 
+    def apply(self, x: float, limit: Any, key: str) -> float:
+        """x perturbed by the outer draws, then by this one; a value this copy produced stays as it is (an object
+        rebuilt from another's fields, a rotor inertia taken from a perturbed parameter)."""
+        if x in self.made:
+            return x
+        if self.outer is not None:
+            x = self.outer.apply(x, limit, key)
+        dz = self.rel(key, x)
+        y = x * (1.0 + dz)
+        if limit is not None and not _inside(limit, y):
+            y = x * (1.0 - dz)
+            if not _inside(limit, y):
+                return x
+        self.made.add(y)
+        return y
+
 
 #: the draw key shared by coordinates along a line (supports, droppers, clamps, wire ends): equal stays equal
 POSITION = "position"
@@ -51,12 +68,13 @@ _ACTIVE: ContextVar[_Draw | None] = ContextVar("mbsuite_perturbation", default=N
 @contextlib.contextmanager
 def perturbed(eps: float, seed: int, eps_max: float | None = None) -> Iterator[None]:
     """Inside: parameters, scene inputs and initial states are perturbed by relative `eps` (seeded draw), or by a
-    relative size drawn per quantity in [eps, eps_max]."""
+    relative size drawn per quantity in [eps, eps_max]. Inside another `perturbed`, on top of its draws (a stability
+    check made in the perturbed tests compares its copies with the run as the outer draws made it)."""
     if not (math.isfinite(eps) and 0.0 < eps < 1e-3):
         raise ValueError(f"perturbation eps must be in (0, 1e-3), got {eps!r}")
     if eps_max is not None and not (math.isfinite(eps_max) and eps <= eps_max < 1e-3):
         raise ValueError(f"perturbation eps_max must be in [eps, 1e-3) = [{eps!r}, 1e-3), got {eps_max!r}")
-    token = _ACTIVE.set(_Draw(float(eps), int(seed), None if eps_max is None else float(eps_max)))
+    token = _ACTIVE.set(_Draw(float(eps), int(seed), None if eps_max is None else float(eps_max), _ACTIVE.get()))
     try:
         yield
     finally:
@@ -80,16 +98,9 @@ def value(x: float, limit: Any = None, key: str = "") -> float:
     """`x` perturbed by the draw in force (unchanged outside `perturbed`, or if x is 0), kept inside `limit`;
     `key` names the quantity (the draw depends on the seed, the key and the value)."""
     d = _ACTIVE.get()
-    if d is None or x == 0.0 or not math.isfinite(x) or (key, x) in d.made:
-        return x  # a value this copy produced is not perturbed again (an object rebuilt from another's fields)
-    dz = d.rel(key, x)
-    y = x * (1.0 + dz)
-    if limit is not None and not _inside(limit, y):
-        y = x * (1.0 - dz)
-        if not _inside(limit, y):
-            return x
-    d.made.add((key, y))
-    return y
+    if d is None or x == 0.0 or not math.isfinite(x):
+        return x
+    return d.apply(x, limit, key)
 
 
 def _inside(limit: Any, y: float) -> bool:

@@ -148,11 +148,11 @@ WORK = re.compile(r"(^|\.)stats\.(nfev|steps)$")  # solver work: shows changed s
 ENV_NOTES = ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "OPENBLAS_NUM_THREADS", "GLIBC_TUNABLES",
              "NPY_DISABLE_CPU_FEATURES", "MBSUITE_NATIVE_EXTRA_CFLAGS")
 PROBE = (
-    "import json, platform, numpy, scipy, scipy.linalg, mujoco\n"
+    "import json, platform, numpy, scipy, scipy.linalg, mujoco, mbsuite\n"
     "blas = numpy.__config__.CONFIG.get('Build Dependencies', {}).get('blas', {})\n"
     "print(json.dumps({'numpy': numpy.__version__, 'scipy': scipy.__version__, 'mujoco': mujoco.__version__,"
     " 'openblas': blas.get('version'), 'python': platform.python_version(),"
-    " 'libc': ' '.join(platform.libc_ver())}))\n"
+    " 'libc': ' '.join(platform.libc_ver()), 'mbsuite': mbsuite.__file__}))\n"
 )
 
 
@@ -178,9 +178,12 @@ def supported(kernel: str, flags: set[str]) -> bool:
     return all(any(f in flags for f in group) for group in KERNELS[kernel].needs)
 
 
-def child_env(kernel: str) -> dict[str, str]:
-    """os.environ plus this kernel's OPENBLAS_CORETYPE (removed for 'default'), with OpenBLAS naming its core."""
+def child_env(kernel: str, code: Path | None = None) -> dict[str, str]:
+    """os.environ plus this kernel's OPENBLAS_CORETYPE (removed for 'default'), with OpenBLAS naming its core, and
+    the copy of mbsuite in `code` first on the import path."""
     env = dict(os.environ)
+    if code is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(code), *filter(None, [os.environ.get("PYTHONPATH")])])
     coretype = KERNELS["default" if kernel == REPEAT else kernel].coretype
     if coretype is None:
         env.pop("OPENBLAS_CORETYPE", None)
@@ -195,12 +198,30 @@ def cores(stderr: str) -> list[str]:
     return re.findall(r"^Core: (\S+)", stderr, flags=re.M)
 
 
+def package_dir() -> Path | None:
+    """The directory of the mbsuite package this Python imports (the working tree for an editable install)."""
+    spec = importlib.util.find_spec("mbsuite")
+    return Path(spec.origin).parent if spec is not None and spec.origin is not None else None
+
+
+def snapshot(dest: Path) -> Path | None:
+    """Copy mbsuite and its model files (mjcf/, models_urdf/) into `dest`: every run imports the same code even if
+    the working tree is edited meanwhile. Returns the directory to put on PYTHONPATH."""
+    pkg = package_dir()
+    if pkg is None:
+        return None
+    shutil.copytree(pkg, dest / pkg.name, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for folder in ("mjcf", "models_urdf"):
+        if (pkg.parent / folder).is_dir():
+            shutil.copytree(pkg.parent / folder, dest / folder)
+    return dest
+
+
 def source_fingerprint() -> dict[str, str]:
     """Hash of every file of mbsuite's package and models: a concurrent edit between runs changes it."""
-    spec = importlib.util.find_spec("mbsuite")
-    if spec is None or spec.origin is None:
+    pkg = package_dir()
+    if pkg is None:
         return {}
-    pkg = Path(spec.origin).parent
     out: dict[str, str] = {}
     for root in (pkg, pkg.parent / "mjcf", pkg.parent / "models_urdf"):
         if root.is_dir():
@@ -272,9 +293,9 @@ def window_stats(csv_path: Path, t_settle: float) -> Values:
     return out
 
 
-def run_command(mbsuite: str, cmd: Command, kernel: str, timeout: float) -> dict:
+def run_command(mbsuite: str, cmd: Command, kernel: str, timeout: float, code: Path | None = None) -> dict:
     """One command under one kernel: flattened numbers, quantities, event lists, cores loaded, wall time."""
-    env = child_env(kernel)
+    env = child_env(kernel, code)
     with tempfile.TemporaryDirectory(prefix="digits_per_kernel_") as tmp:
         argv = [mbsuite, *cmd.argv, "--json"] + (["--out", tmp] if cmd.csv else [])
         t0 = time.perf_counter()
@@ -305,9 +326,9 @@ def run_command(mbsuite: str, cmd: Command, kernel: str, timeout: float) -> dict
         return rec
 
 
-def probe(kernel: str) -> dict:
-    """Versions and the cores OpenBLAS loads under this kernel's environment."""
-    p = subprocess.run([sys.executable, "-c", PROBE], env=child_env(kernel), capture_output=True, text=True,
+def probe(kernel: str, code: Path | None = None) -> dict:
+    """Versions, the mbsuite imported and the cores OpenBLAS loads under this kernel's environment."""
+    p = subprocess.run([sys.executable, "-P", "-c", PROBE], env=child_env(kernel, code), capture_output=True, text=True,
                        check=False)
     info = json.loads(p.stdout) if p.returncode == 0 and p.stdout.strip() else {"error": p.stderr.strip()[-400:]}
     info["cores"] = cores(p.stderr)
@@ -402,6 +423,9 @@ def main() -> None:
                     "on it, wall times do)")
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds one command may take (default 900)")
     ap.add_argument("--mbsuite", default=None, help="the mbsuite executable (default: next to this Python)")
+    ap.add_argument("--snapshot", action=argparse.BooleanOptionalAction, default=True,
+                    help="run every command on a copy of mbsuite taken at start, so that edits of the working tree "
+                    "made meanwhile cannot enter one kernel's runs and not another's (default: on)")
     args = ap.parse_args()
 
     t_start = time.perf_counter()
@@ -428,19 +452,22 @@ def main() -> None:
         print(f"[{time.perf_counter() - t_start:6.0f} s] {msg}", file=sys.stderr, flush=True)
 
     fingerprints: dict[str, dict[str, str]] = {"start": source_fingerprint()}
+    tmp_code = tempfile.TemporaryDirectory(prefix="digits_per_kernel_code_")
+    code = snapshot(Path(tmp_code.name)) if args.snapshot else None
     probes: dict[str, dict] = {}
     results: dict[str, dict[str, dict]] = {}
     for k in kernels:
-        probes[k] = probe(k)
-        log(f"{k}: OpenBLAS loads {', '.join(probes[k]['cores']) or '?'}")
+        probes[k] = probe(k, code)
+        log(f"{k}: OpenBLAS loads {', '.join(probes[k]['cores']) or '?'}; mbsuite from {probes[k].get('mbsuite')}")
         with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            futs = {c.key: pool.submit(run_command, mbsuite, c, k, args.timeout) for c in commands}
+            futs = {c.key: pool.submit(run_command, mbsuite, c, k, args.timeout, code) for c in commands}
             results[k] = {}
             for c in commands:
                 rec = futs[c.key].result()
                 results[k][c.key] = rec
                 log(f"  {k:18s} {c.key:30s} {rec.get('wall_s', 0):7.1f} s  {rec.get('error', '')}")
         fingerprints[f"after {k}"] = source_fingerprint()
+    tmp_code.cleanup()
 
     # which core each run loaded, and whether the forced one took
     core_of = {k: sorted({c for rec in results[k].values() for c in rec.get("cores", [])}) for k in kernels}
@@ -523,11 +550,19 @@ def main() -> None:
         if changed:
             edits[when] = changed
         prev = fp
+    code_id = hashlib.sha256(json.dumps(fingerprints["start"], sort_keys=True).encode()).hexdigest()[:12]
+    if code is not None:
+        out.append(f"- code: every run imported one copy of mbsuite and its model files, taken at start from "
+                   f"{package_dir()} ({len(fingerprints['start'])} files, content hash {code_id})")
+    else:
+        out.append(f"- code: the working tree {package_dir()} (content hash at start {code_id}; --no-snapshot)")
     if edits:
-        out.append("- **mbsuite's files changed while this ran** (a concurrent edit; a kernel's differences may then "
-                   "come from the edit, and 'default (repeat)' shows whether they did): "
+        out.append("- mbsuite's working tree changed while this ran: "
                    + "; ".join(f"{when}: {', '.join(ch[:8])}{' ...' if len(ch) > 8 else ''}"
-                               for when, ch in edits.items()))
+                               for when, ch in edits.items())
+                   + (" (not used: the runs imported the copy taken at start)" if code is not None else
+                      " — **the runs imported the edited files**: a kernel's differences may come from the edit; "
+                      "'default (repeat)' shows whether they did"))
     for n in notes:
         out.append(f"- **{n}**")
 
@@ -596,7 +631,8 @@ def main() -> None:
     if args.json_out:
         payload = {
             "cpu": cpu, "flags": sorted(flags), "versions": versions, "probes": probes, "core_of": core_of,
-            "skipped": skipped, "machine_env": machine, "source_edits": edits, "total_wall_s": round(total, 1),
+            "skipped": skipped, "machine_env": machine, "code_hash": code_id, "source_edits": edits,
+            "total_wall_s": round(total, 1),
             "rows": [{"label": lab, "command": key, "patterns": list(p)} for lab, key, p in ROWS],
             "results": results, "comparisons": comp,
         }

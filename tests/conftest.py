@@ -10,7 +10,8 @@ crossings").
 `rounding` is set by folder or file below (ROUNDING) and by `@pytest.mark.rounding` on single tests elsewhere.
 `@pytest.mark.literal_inputs("why")` keeps a test out of the perturbed run: it compares a run with a closed form
 written in the scene's literal numbers to round-off (1e-14), and a perturbed input is another problem whose closed form
-differs by 1e-10; such a test reads no crossing, and the same physics is covered perturbed by a looser test. One
+differs by 1e-10; or it re-enacts a defect that only last-bit differences of the literal inputs trigger. Such a test
+reads no crossing. A stability check made inside the perturbed run composes its draws with the run's. One
 seed holds for the whole run, so a module fixture and the test that rebuilds its parameters see the same draws.
 Runs in other processes (a CLI started with subprocess) and in other threads are not perturbed."""
 

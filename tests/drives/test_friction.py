@@ -86,6 +86,8 @@ def test_no_slip_below_breakaway_and_mujoco_creep():
     sys2 = _two_rotors(J0, J1, tau, peak=peak, drive=drive2)
     res2 = simulate_reference(sys2, [0, 0, 0], [0, 0, 0], 0.05, sample_dt=1e-3)
     assert res2.events == [] and np.all(res2.modes[0] == -1)  # sliding backward (w_rel = w1 - w0 < 0) from t = 0
+    J0, J1 = sys2.J[:2]  # the system the run used (in the perturbed tests: its perturbed coefficients)
+    tau, drive2 = sys2.frictions[0].parts[0].level, sys2.sources[0].c0
     slip = 0.5 * ((drive2 - tau) / J0 - tau / J1) * res2.t**2
     np.testing.assert_allclose(res2.q[0] - res2.q[1], slip, rtol=1e-13, atol=0.0)
 
@@ -119,4 +121,4 @@ def test_breakaway_threshold_is_sharp(factor, slips):
         expected = 0.5 * ((drive - tau) / J0 - tau / J1) * res.t**2
         np.testing.assert_allclose(res.q[0] - res.q[1], expected, rtol=1e-13, atol=0.0)
     else:
-        assert res.events == [] and slip == 0.0
+        assert res.events == [] and slip <= 1e-10  # rounding only (test_no_slip_below_breakaway_and_mujoco_creep)

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from ...errors import ParameterError
 from ...limits import check_fields, param, real
+from ...perturbation import POSITION
 from .line import Line
 
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
@@ -61,11 +62,11 @@ class CatenaryParams:
                                                                 "leaves the wire)")
     # --- contact and run ------------------------------------------------------------------------------------------
     k_contact: float = param(5.0e4, lo=0.0, lo_open=True, hi=1e10, unit="N/m", doc="penalty contact stiffness")
-    x_start: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="pantograph start position")
-    x_end: float = param(420.0, lo=0.0, hi=1e6, unit="m", doc="pantograph end position")
+    x_start: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="pantograph start position", draw=POSITION)
+    x_end: float = param(420.0, lo=0.0, hi=1e6, unit="m", doc="pantograph end position", draw=POSITION)
     # --- analysis (EN 50318 statistics) -------------------------------------------------------------------------
-    window_start: float = param(240.0, lo=0.0, hi=1e6, unit="m", doc="start of the statistics window")
-    window_end: float = param(360.0, lo=0.0, hi=1e6, unit="m", doc="end of the statistics window")
+    window_start: float = param(240.0, lo=0.0, hi=1e6, unit="m", doc="start of the statistics window", draw=POSITION)
+    window_end: float = param(360.0, lo=0.0, hi=1e6, unit="m", doc="end of the statistics window", draw=POSITION)
     filter_cutoff: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz",
                                  doc="low-pass cut-off of the contact force")
     filter_order: int = param(4, lo=1, hi=10, kind=int, unit="-", doc="Butterworth order (forwards and backwards)")
@@ -104,11 +105,15 @@ class CatenaryParams:
         if self.line is None and self.element_length > self.span_length:
             raise ParameterError(f"element_length ({self.element_length}) must not exceed span_length")
         L = self.length
+        if L < self.x_end <= L * (1.0 + 1e-9):  # an end within 1e-9 of the line's length is its end (rounding)
+            object.__setattr__(self, "x_end", L)
         if not 0.0 <= self.x_start < self.x_end <= L:
             raise ParameterError(
                 f"params.x_start = {self.x_start} m, params.x_end = {self.x_end} m: the pantograph run must satisfy "
                 f"0 <= x_start < x_end <= {L:g} m (the line's length)"
             )
+        if self.x_end < self.window_end <= self.x_end * (1.0 + 1e-9):  # the run's end, up to rounding
+            object.__setattr__(self, "window_end", self.x_end)
         if not self.x_start <= self.window_start < self.window_end <= self.x_end:
             if not self.window_start < self.window_end:
                 culprit = (f"params.window_start = {self.window_start} m must be below params.window_end = "

@@ -115,17 +115,20 @@ def _cubed_stiffness() -> float:
 def test_condition_reads_the_kappa_of_a_hand_computed_case():
     """The audits of the crossing-reading tests rest on `stability.condition`; a kappa that under-reads would pass
     them all. Held against a closed form: y = ks^3 (the pantograph's contact stiffness, built through its parameter
-    dataclass). A copy changes ks by eps z, so y by 3 eps z y (1 + O(eps)): over two draws kappa (scale |y|) is
-    3 max |z| to 1e-3 (the rounding of y itself, 1.1e-16 against a change of 1e-12), with z computed here from the
-    documented draw. A quantity with a jump (floor of a value a
-    last bit below an integer) reads kappa = inf or past KAPPA_MAX; an array that changes length reads inf."""
+    dataclass). A copy changes ks by eps z, so y by 3 eps z y (1 + O(eps)): over two draws kappa (scale |y|) equals
+    the closed form evaluated by hand at ks (1 + eps z) to 1e-9, and 3 max |z| to 1e-3 absolute (the rounding of y
+    itself, 2.2e-16 against a change of 1e-12), with z computed here from the documented draw. A quantity with a
+    jump (floor of a value a last bit below an integer) reads kappa past KAPPA_MAX; an array that changes length
+    reads inf."""
     ks = load_scene("pantograph/lab").build_params().ks
     eps = 1e-12
-    hand = 3.0 * max(abs(_z(s, "PantographParams.ks", ks)) for s in (5, 6))
+    zs = [_z(s, "PantographParams.ks", ks) for s in (5, 6)]
+    exact = max(abs((ks * (1.0 + eps * z)) ** 3 - ks**3) for z in zs)  # the same closed form, evaluated by hand
+    hand = 3.0 * max(map(abs, zs))
     got = stability.condition(_cubed_stiffness, scale=ks**3, eps=eps, draws=2, seed=5)
     assert got.value == ks**3 and got.draws == 2 and got.eps == eps
-    assert got.kappa == pytest.approx(hand, rel=1e-3), (got.kappa, hand)
-    assert got.max_change == pytest.approx(hand * eps * ks**3, rel=1e-3)
+    assert got.max_change == pytest.approx(exact, rel=1e-9) and got.kappa == pytest.approx(exact / (eps * ks**3))
+    assert got.kappa == pytest.approx(hand, abs=1e-3), (got.kappa, hand)
     # the range [eps, eps_max]: each quantity's size drawn log-uniform after z (z the same draw)
     lo, hi = 1e-12, 1e-10
     rng = np.random.default_rng((7, zlib.crc32(f"PantographParams.ks|{ks!r}".encode())))

@@ -34,6 +34,7 @@ def test_reference_mode_sequence(ref):
                    ("clutch1", -1, 0), ("clutch1", 0, -1), ("clutch3", -1, 0), ("clutch1", -1, 2)]
 
 
+@pytest.mark.literal_inputs("CoupledClutches speeds against the closed form of the literal constants to 2.5e-10 rad/s")
 def test_hand_path_closed_form_and_event_precision(hand):
     """t < 0.4 s: only clutch 1 slides, closed form; events converge to <= 1e-9 s under tolerance refinement."""
     m = hand.t < 0.4

@@ -878,6 +878,11 @@ def numerics_attempts() -> Iterator[Attempt]:
     yield scene("catenary-element-tiny", a, "catenary element_length 1e-4 m (6 million elements: size guard)",
                 MODEL_SCENES["catenary"].replace("element_length = 0.5", "element_length = 1e-4"),
                 culprit="element_length", timeout=90)
+    yield scene("catenary-x-end-past-the-line", a, "catenary x_end 1e-6 beyond the 600 m line (not rounding)",
+                with_lines(MODEL_SCENES["catenary"], "params", "x_end = 600.0006"), culprit="x_end")
+    yield scene("catenary-window-end-past-the-run", a, "catenary window_end 1e-6 beyond x_end (not rounding)",
+                with_lines(MODEL_SCENES["catenary"], "params", "x_end = 300.0\nwindow_start = 200.0\n"
+                           "window_end = 300.0003"), culprit="window_end")
     yield scene("catenary-spans-huge", a, "catenary with 100 000 spans (memory)",
                 with_lines(MODEL_SCENES["catenary"], "params", "n_spans = 100000"), culprit="n_spans", timeout=90)
     yield scene("coupler-omega-max", a, "coupler at omega = 1000 rad/s, timestep 5e-4 (fast spin)",

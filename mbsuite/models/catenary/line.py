@@ -109,7 +109,7 @@ class Wire:
 class Support:
     """A support at x: ground springs `k` and point masses `m` on named wires."""
 
-    x: float = field(metadata={"draw": POSITION})
+    x: float  # perturbed as a position in __post_init__ (a support does not go through check_fields)
     k: dict[str, float] = field(default_factory=dict)
     m: dict[str, float] = field(default_factory=dict)
 

@@ -18,7 +18,7 @@ zero is measured against its quantity's size; 'bitwise' when every value is the 
 second default run: it must be bitwise, else the measurement has a noise floor. The events table says whether the
 lock/slip/contact-loss sequences and their counts are the same, and how far event times moved.
 
-    .venv/bin/python scripts/digits_per_kernel.py --json-out /tmp/digits_per_kernel.json   # about 5 min on 2 cores
+    .venv/bin/python scripts/digits_per_kernel.py --json-out out/digits_per_kernel.json   # about 5 min on 2 cores
     .venv/bin/python scripts/digits_per_kernel.py --quick --kernels default,SandyBridge
 """
 

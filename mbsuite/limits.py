@@ -58,7 +58,8 @@ def real(value: Any) -> int | float | None:
 class Limit:
     """The valid values of one number or word.
 
-    - `kind`: `float` (any finite real), `int` (an integral number) or `str` (one of `choices`);
+    - `kind`: `float` (any finite real), `int` (an integral number), `str` (one of `choices`, or any text without
+      them) or `bool` (true or false only);
     - `lo`, `hi`: range ends (None: unbounded), open when `lo_open` / `hi_open`;
     - `choices`: allowed values for `str` (or a fixed set of numbers);
     - `unit`: SI unit, `doc`: one line; `default`: the value used when a scene omits the key (shown in outputs).
@@ -81,6 +82,10 @@ class Limit:
 
     def describe(self) -> str:
         """The valid range in words, e.g. `(0, inf) m` or `one of ['equilibrium', 'fortran']`."""
+        if self.kind is bool:
+            return "true or false"
+        if self.kind is str and self.choices is None:
+            return "text"
         if self.choices is not None:
             return f"one of {list(self.choices)}"
         lo = "-inf" if self.lo is None else f"{self.lo:g}"
@@ -94,6 +99,10 @@ class Limit:
         """Return `value` (as float/int/str) if valid, else raise `error` naming `name`, the value, where it came from
         (`where`, a phrase with a leading space) and the range."""
         bad = f"{name} = {value!r}{where} is invalid; valid: {self.describe()}"
+        if self.kind is bool:
+            if not isinstance(value, bool | np.bool_):
+                raise error(bad)
+            return bool(value)
         if self.kind is str or (self.choices is not None and all(isinstance(c, str) for c in self.choices)):
             if not isinstance(value, str) or (self.choices is not None and value not in self.choices):
                 raise error(bad)
@@ -124,17 +133,20 @@ def positive(unit: str = "", doc: str = "", hi: float | None = None, **kw: Any) 
     return Limit(lo=0.0, lo_open=True, hi=hi, unit=unit, doc=doc, **kw)
 
 
-def param(default: Any, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
+def param(default: Any = _NO_DEFAULT, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
           hi_open: bool = False, unit: str = "", doc: str = "", kind: type = float,
           choices: tuple[Any, ...] | None = None, draw: str | None = None) -> Any:
     """A dataclass field with its valid range: `l1: float = param(1.95, lo=0, lo_open=True, unit="m", doc=...)`.
     `draw`: the key of its perturbation draw when it is shared (`perturbation.POSITION`: coordinates that coincide
-    across objects)."""
+    across objects). Without `default` the field is required (a quantity of the user's own design: no default)."""
     lim = Limit(lo=lo, hi=hi, lo_open=lo_open, hi_open=hi_open, unit=unit, doc=doc, kind=kind, choices=choices,
                 default=default)
     if isinstance(default, list | dict | set):
         raise TypeError("param() defaults must be immutable")
-    return dataclasses.field(default=default, metadata={"limit": lim, **({"draw": draw} if draw else {})})
+    metadata = {"limit": lim, **({"draw": draw} if draw else {})}
+    if default is _NO_DEFAULT:
+        return dataclasses.field(metadata=metadata)
+    return dataclasses.field(default=default, metadata=metadata)
 
 
 def limit_of(cls_or_obj: Any, name: str) -> Limit | None:
@@ -166,7 +178,7 @@ def limits_table(cls: Any) -> list[tuple[str, str, str, str, str]]:
         lim = f.metadata.get("limit")
         if lim is None:
             continue
-        default = f.default if f.default is not dataclasses.MISSING else ""
+        default = f.default if f.default is not dataclasses.MISSING else "required"
         rows.append((f.name, repr(default), lim.describe(), lim.unit, lim.doc))
     return rows
 

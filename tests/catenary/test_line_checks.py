@@ -640,30 +640,36 @@ k_messenger = 5.0e4
 x = 10.0
 upper = "{upper}"
 lower = "contact"
+k = 1.0e5
 law = "{law}"
 [[droppers]]
 x = 25.0
 upper = "messenger"
 lower = "contact"
+k = 1.0e5
 [[droppers]]
 x = 40.0
 upper = "messenger"
 lower = "contact"
+k = 1.0e5
 [[droppers]]
 x = 60.0
 upper = "messenger"
 lower = "contact"
+k = 1.0e5
 [[droppers]]
 x = 75.0
 upper = "messenger"
 lower = "contact"
+k = 1.0e5
 [[droppers]]
 x = 90.0
 upper = "messenger"
 lower = "contact"
+k = 1.0e5
 """
 GOOD = dict(presag=0.0, role="contact", extra_wire="", upper="messenger", law="slack")
-STITCH = '[[wires]]\nname = "stitch"\nrole = "stitch"\nmass = 0.31\ntension = 3500.0\nx0 = 45.0\nx1 = 55.0\n'
+STITCH = '[[wires]]\nname = "stitch"\nrole = "stitch"\nmass = 0.31\ntension = 3500.0\nEI = 10.0\nx0 = 45.0\nx1 = 55.0\n'
 
 
 @pytest.mark.parametrize("change, culprits", [

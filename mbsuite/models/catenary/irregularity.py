@@ -28,82 +28,120 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
-from ...limits import real
+from ...limits import Limit
+from ...schema import Items, Rule, Section
 from .line import Irregularity
 
-IRREGULARITY_KEYS = ("file", "scale", "seed", "rms", "wavelength_min", "wavelength_max", "psd", "n_waves", "dx")
 DEFAULT_DX = 0.05
 DEFAULT_WAVES = 2000
+#: most waves of a random profile, most points of a profile's grid (length / dx), most waves x points (the work of
+#: the sum; 2e10 multiply-adds is about a minute) and most rows of a profile file: size guards, checked before
+#: anything is allocated
+MAX_WAVES = 100_000
+MAX_POINTS = 20_000_000
+MAX_WORK = 2e10
+MAX_PROFILE_ROWS = 1_000_000
+
+_RANDOM_KEYS = ("seed", "rms", "wavelength_min", "wavelength_max", "psd", "n_waves")
 
 
-def _num(d: Mapping[str, Any], key: str, where: str, lo: float = 0.0, lo_open: bool = True,
-         default: float | None = None) -> float:
-    if key not in d:
-        if default is None:
-            raise SceneError(f"{where}: {key} is missing")
-        return default
-    v = real(d[key])
-    if v is None or not math.isfinite(v) or (v <= lo if lo_open else v < lo):
-        raise SceneError(f"{where}: {key} = {d[key]!r} must be a finite number {'>' if lo_open else '>='} {lo:g}")
-    return float(v)
+def _file_keys(d: Mapping[str, Any]) -> str | None:
+    extra = sorted(set(d) & set(_RANDOM_KEYS))
+    if "file" in d and extra:
+        return f"{extra} belong to a random profile; a profile from a file reads file, scale, dx"
+    if "file" not in d and "scale" in d:
+        return "scale is read only with file"
+    return None
 
 
-def check_irregularity(d: Any, where: str) -> None:
-    """Check an irregularity table (module docstring) without building it: keys, numbers, the file's columns."""
-    if not isinstance(d, Mapping):
-        raise SceneError(f"{where} must be a table with keys {list(IRREGULARITY_KEYS)}")
-    bad = sorted(set(d) - set(IRREGULARITY_KEYS))
-    if bad:
-        raise SceneError(f"{where}: unknown key(s) {bad}; valid keys: {list(IRREGULARITY_KEYS)}")
+def _random_keys(d: Mapping[str, Any]) -> str | None:
     if "file" in d:
-        extra = sorted(set(d) - {"file", "scale", "dx"})
-        if extra:
-            raise SceneError(f"{where}: {extra} belong to a random profile; a profile from a file reads file, "
-                             "scale, dx")
-        _read_profile(d["file"], where)
-        if "scale" in d:
-            v = real(d["scale"])
-            if v is None or not math.isfinite(v):
-                raise SceneError(f"{where}: scale = {d['scale']!r} must be a finite number")
-    else:
-        if "seed" not in d or real(d["seed"]) is None or int(real(d["seed"])) != real(d["seed"]) or d["seed"] < 0:
-            raise SceneError(f"{where}: a random profile needs seed = a non-negative integer (got "
-                             f"{d.get('seed')!r}); or give file = a profile CSV")
-        if ("psd" in d) == ("rms" in d):
-            raise SceneError(f"{where}: give either rms (with wavelength_min, wavelength_max) or psd = [[k, S], ...]")
-        if "scale" in d:
-            raise SceneError(f"{where}: scale is read only with file")
-        _band(d, where)
-    dx = _num(d, "dx", where, default=DEFAULT_DX)
-    if "file" not in d:
-        kmax = _band(d, where)[1]
-        if dx > 1.0 / (8.0 * kmax) * (1 + 1e-12):
-            raise SceneError(f"{where}: dx = {dx:g} m must be at most an eighth of the shortest wavelength "
-                             f"({1.0 / kmax:g} m): <= {1.0 / (8.0 * kmax):g} m")
+        return None
+    if "seed" not in d:
+        return "a random profile needs seed = a non-negative integer; or give file = a profile CSV"
+    if ("psd" in d) == ("rms" in d):
+        return "give either rms (with wavelength_min, wavelength_max) or psd = [[k, S], ...]"
+    if "rms" in d and not {"wavelength_min", "wavelength_max"} <= set(d):
+        return "rms needs wavelength_min and wavelength_max (m)"
+    if "psd" in d and ({"wavelength_min", "wavelength_max"} & set(d)):
+        return "wavelength_min and wavelength_max go with rms; psd states its own band"
+    return None
 
 
-def _band(d: Mapping[str, Any], where: str) -> tuple[float, float, Any]:
-    """(k_min, k_max, S(k)) of a random profile."""
+def _band_order(d: Mapping[str, Any]) -> str | None:
+    if "rms" in d and not d["wavelength_max"] > d["wavelength_min"]:
+        return f"wavelength_max = {d['wavelength_max']:g} m must exceed wavelength_min = {d['wavelength_min']:g} m"
+    if "psd" in d and any(b[0] <= a[0] for a, b in zip(d["psd"], d["psd"][1:], strict=False)):
+        return "psd rows [k (cycles/m), S (m^2 m)] need k increasing"
+    return None
+
+
+def _dx_resolves(d: Mapping[str, Any]) -> str | None:
+    if "file" in d:
+        return None
+    kmax = _band(d)[1]
+    if d["dx"] > 1.0 / (8.0 * kmax) * (1 + 1e-12):
+        return (f"dx = {d['dx']:g} m must be at most an eighth of the shortest wavelength ({1.0 / kmax:g} m): "
+                f"<= {1.0 / (8.0 * kmax):g} m")
+    return None
+
+
+#: the declaration of an irregularity table (a scene's `[line.irregularity]`, a line file's `[irregularity]`)
+SECTION = Section("irregularity", {
+    "file": Limit(kind=str, doc="CSV profile with the columns x (m) and r (m), x increasing (resampled on dx)"),
+    "scale": Limit(lo=-1e3, hi=1e3, doc="factor on the file's heights (with file; absent: 1)"),
+    "seed": Limit(kind=int, lo=0, hi=2**63 - 1, doc="seed of the random phases (a random profile)"),
+    "rms": Limit(lo=0.0, hi=1.0, unit="m", doc="rms height of a flat spectrum over the wavelength band"),
+    "wavelength_min": Limit(lo=0.0, lo_open=True, hi=1e4, unit="m", doc="shortest wavelength of the band (with rms)"),
+    "wavelength_max": Limit(lo=0.0, lo_open=True, hi=1e4, unit="m", doc="longest wavelength of the band (with rms)"),
+    "psd": Items((Limit(lo=0.0, lo_open=True, hi=1e3, unit="cycles/m", doc="k (cycles/m)"),
+                  Limit(lo=0.0, lo_open=True, hi=1.0, unit="m^2 m", doc="S (m^2 per cycle/m)")), min=2, max=10_000,
+                 doc="one-sided PSD of the height, interpolated log-log, zero outside"),
+    "n_waves": Limit(kind=int, lo=1, hi=MAX_WAVES, default=DEFAULT_WAVES, doc="waves of a random profile"),
+    "dx": Limit(lo=1e-3, hi=10.0, unit="m", default=DEFAULT_DX, doc="grid of the profile"),
+}, rules=(
+    Rule("a profile from a file reads file, scale and dx; a random profile seed, n_waves, dx and rms with "
+         "wavelength_min and wavelength_max, or psd", _file_keys, given=True),
+    Rule("a random profile needs seed and either rms (with wavelength_min and wavelength_max) or psd", _random_keys,
+         given=True),
+    Rule("wavelength_max > wavelength_min; psd's k increasing", _band_order),
+    Rule("dx <= an eighth of the shortest wavelength (a random profile)", _dx_resolves),
+), doc="a contact-wire height profile: from a file, or random from a seed and a spectrum")
+
+
+def check_irregularity(d: Any, where: str) -> dict[str, Any]:
+    """The irregularity table `d` (module docstring) checked against `SECTION`, its profile file read; returns the
+    checked table with its defaults."""
+    out = SECTION.check(d, where)
+    if "file" in out:
+        _read_profile(out["file"], where)
+    return out
+
+
+def _band(d: Mapping[str, Any]) -> tuple[float, float, Any]:
+    """(k_min, k_max, S(k)) of a checked random profile."""
     if "psd" in d:
-        tab = d["psd"]
-        try:
-            a = np.asarray(tab, dtype=float)
-        except (TypeError, ValueError):
-            a = np.zeros((0,))
-        if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 2 or not np.all(np.isfinite(a)) or np.any(a <= 0) \
-                or np.any(np.diff(a[:, 0]) <= 0):
-            raise SceneError(f"{where}: psd must be >= 2 rows [k (cycles/m), S (m^2 m)] with k increasing and all "
-                             "values positive")
+        a = np.asarray(d["psd"], dtype=float)
         lk, ls = np.log(a[:, 0]), np.log(a[:, 1])
         return float(a[0, 0]), float(a[-1, 0]), lambda k: np.exp(np.interp(np.log(k), lk, ls))
-    lmin = _num(d, "wavelength_min", where)
-    lmax = _num(d, "wavelength_max", where)
-    if not lmax > lmin:
-        raise SceneError(f"{where}: wavelength_max = {lmax:g} m must exceed wavelength_min = {lmin:g} m")
-    rms = _num(d, "rms", where, lo_open=False)
+    lmin, lmax, rms = float(d["wavelength_min"]), float(d["wavelength_max"]), float(d["rms"])
     kmin, kmax = 1.0 / lmax, 1.0 / lmin
     s = rms * rms / (kmax - kmin)
     return kmin, kmax, lambda k: np.full(np.shape(k), s)
+
+
+def size_of(d: Mapping[str, Any], length: float, where: str) -> int:
+    """The grid points of a checked profile over [0, length] m, refused (SceneError naming dx, n_waves and the
+    estimate) past `MAX_POINTS` points or `MAX_WORK` waves x points, before anything is allocated."""
+    n = int(math.floor(length / d["dx"] + 1e-9)) + 1
+    if n > MAX_POINTS:
+        raise SceneError(f"{where}: dx = {d['dx']:g} m over the line's {length:g} m is {n:,} grid points "
+                         f"({8 * n / 1e6:,.0f} MB a profile); at most {MAX_POINTS:,}: enlarge dx")
+    if "file" not in d and n * d["n_waves"] > MAX_WORK:
+        raise SceneError(f"{where}: n_waves = {d['n_waves']:,} on {n:,} grid points (dx = {d['dx']:g} m) is "
+                         f"{float(n) * d['n_waves']:.3g} multiply-adds; at most {MAX_WORK:.0e}: fewer waves or a "
+                         "coarser dx")
+    return n
 
 
 def _read_profile(fname: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
@@ -112,7 +150,11 @@ def _read_profile(fname: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
     path = Path(fname)
     try:
         with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
+            rows = []
+            for row in csv.DictReader(fh):
+                if len(rows) >= MAX_PROFILE_ROWS:
+                    raise SceneError(f"{where}: the profile {path} has more than {MAX_PROFILE_ROWS:,} rows")
+                rows.append(row)
     except OSError as exc:
         raise SceneError(f"{where}: cannot read the profile {path}: {exc.strerror or exc}") from exc
     if not rows or set(rows[0]) != {"x", "r"}:
@@ -149,16 +191,16 @@ def build(d: Mapping[str, Any], length: float, where: str = "irregularity") -> I
 
 
 def _build(d: Mapping[str, Any], length: float, where: str) -> Irregularity:
-    check_irregularity(d, where)
-    dx = _num(d, "dx", where, default=DEFAULT_DX)
-    n = int(math.floor(length / dx + 1e-9)) + 1
+    d = check_irregularity(d, where)
+    dx = d["dx"]
+    n = size_of(d, length, where)
     grid = dx * np.arange(n)
     if "file" in d:
         x, r = _read_profile(d["file"], where)
-        scale = float(real(d.get("scale", 1.0)))
+        scale = float(d.get("scale", 1.0))
         return Irregularity(0.0, dx, scale * np.interp(grid, x, r, left=0.0, right=0.0), source=str(d["file"]))
-    kmin, kmax, S = _band(d, where)
-    nw = int(_num(d, "n_waves", where, default=DEFAULT_WAVES))
+    kmin, kmax, S = _band(d)
+    nw = d["n_waves"]
     dk = (kmax - kmin) / nw
     k = kmin + (np.arange(nw) + 0.5) * dk
     amp = np.sqrt(2.0 * S(k) * dk)
@@ -172,7 +214,8 @@ def _build(d: Mapping[str, Any], length: float, where: str) -> Irregularity:
 
 def variance(d: Mapping[str, Any]) -> float:
     """The variance (m^2) of the random profile of `d`: sum_i S(k_i) dk (module docstring)."""
-    kmin, kmax, S = _band(d, "irregularity")
-    nw = int(_num(d, "n_waves", "irregularity", default=DEFAULT_WAVES))
+    d = SECTION.check(d, "irregularity")
+    kmin, kmax, S = _band(d)
+    nw = d["n_waves"]
     dk = (kmax - kmin) / nw
     return float(np.sum(S(kmin + (np.arange(nw) + 0.5) * dk)) * dk)

@@ -23,6 +23,7 @@ Conventions (SI units, x along the track from the first pinned end, heights up):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -30,55 +31,58 @@ import numpy as np
 
 from ... import perturbation
 from ...errors import ParameterError
-from ...limits import check_fields, param, real
+from ...limits import Limit, check_fields, param
 from ...perturbation import POSITION
+from ...schema import Items, check_value
 
 WIRE_ROLES = ("contact", "messenger", "stitch", "auxiliary", "other")
 END_KINDS = ("pinned", "free")
 DROPPER_LAWS = ("", "slack", "linear")
 #: most wires at one position: the compiled core's node blocks hold at most 8 DOFs (w, theta per wire)
 MAX_WIRES_AT_A_NODE = 4
+#: the contact wire's mid-span presag / span length (parabolic between supports)
+PRESAG = Limit(lo=0.0, hi=0.05, hi_open=True, unit="", doc="mid-span presag / span length (absent: 0, level)")
 
 
-def _number(what: str, v, lo: float | None = None, lo_open: bool = False) -> float:
-    x = real(v)
-    if x is None or not math.isfinite(x):
-        raise ParameterError(f"{what} = {v!r} must be a finite number")
-    if lo is not None and (x <= lo if lo_open else x < lo):
-        raise ParameterError(f"{what} = {v!r} must be {'>' if lo_open else '>='} {lo:g}")
-    return float(x)
+#: a support's ground spring on a wire (`k_<wire>` in a line file) and its point mass there (`m_<wire>`)
+SUPPORT_K = Limit(lo=0.0, hi=1e12, unit="N/m", doc="ground spring on the wire named after k_ (steady arm, support)")
+SUPPORT_M = Limit(lo=0.0, hi=1e3, unit="kg", doc="point mass on the wire named after m_ (clamp, steady arm)")
+#: a tension segment of a wire: [x_a, x_b, T]
+SEGMENT = (Limit(lo=0.0, hi=1e6, unit="m", doc="x_a (m)"), Limit(lo=0.0, hi=1e6, unit="m", doc="x_b (m)"),
+           Limit(lo=0.0, hi=1e6, unit="N", doc="T (N)"))
 
 
 @dataclass(frozen=True)
 class Wire:
     """A tensioned wire over [x0, x1] (module docstring)."""
 
-    name: str
-    role: str = param("other", kind=str, choices=WIRE_ROLES, doc="contact, messenger, stitch, auxiliary or other")
-    mass: float = param(1.0, lo=0.0, hi=100.0, unit="kg/m", doc="mass per length (0 only for a massless tie)")
-    tension: float = param(1e4, lo=0.0, hi=1e6, unit="N", doc="tension (0: a bending beam alone)")
-    EI: float = param(0.0, lo=0.0, hi=1e6, unit="N m^2", doc="bending stiffness")
-    x0: float = param(0.0, lo=0.0, hi=1e6, unit="m", doc="start of the wire", draw=POSITION)
-    x1: float = param(1.0, lo=0.0, lo_open=True, hi=1e6, unit="m", doc="end of the wire", draw=POSITION)
-    ends: tuple[str, str] = ("pinned", "pinned")
+    name: str = param(kind=str, doc="the wire's name (droppers, clamps, masses and supports name it)")
+    role: str = param(kind=str, choices=WIRE_ROLES, doc="contact, messenger, stitch, auxiliary or other")
+    mass: float = param(lo=0.0, hi=100.0, unit="kg/m", doc="mass per length (0 only for a massless tie)")
+    tension: float = param(lo=0.0, hi=1e6, unit="N", doc="tension (0: a bending beam alone)")
+    EI: float = param(lo=0.0, hi=1e6, unit="N m^2", doc="bending stiffness (0: a string)")
+    x0: float = param(lo=0.0, hi=1e6, unit="m", doc="start of the wire", draw=POSITION)
+    x1: float = param(lo=0.0, lo_open=True, hi=1e6, unit="m", doc="end of the wire", draw=POSITION)
+    ends: tuple[str, str] = field(default=("pinned", "pinned"), metadata={"schema": Items(
+        Limit(kind=str, choices=END_KINDS), min=2, max=2, default=("pinned", "pinned"),
+        doc="the ends at x0 and x1: pinned (w = 0) or free (held by clamps)")})
     #: (x_a, x_b, T): tension T (N) between x_a and x_b instead of `tension`
-    tension_segments: tuple[tuple[float, float, float], ...] = ()
+    tension_segments: tuple[tuple[float, float, float], ...] = field(default=(), metadata={"schema": Items(
+        SEGMENT, max=10_000, default=(), doc="tension T (N) between x_a and x_b (m) instead of tension")})
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
-            raise ParameterError(f"wire name {self.name!r} must be a non-empty string")
+            raise ParameterError(f"wire name = {self.name!r} is invalid; valid: a non-empty string")
         check_fields(self, f"wire {self.name!r}")
         if not self.x1 > self.x0:
             raise ParameterError(f"wire {self.name!r}: x1 = {self.x1} m must lie beyond x0 = {self.x0} m")
-        ends = tuple(self.ends)
-        if len(ends) != 2 or any(e not in END_KINDS for e in ends):
-            raise ParameterError(f"wire {self.name!r}: ends = {self.ends!r} must be two of {list(END_KINDS)}")
+        where = f"wire {self.name!r}"
+        ends = tuple(check_value(_WIRE_SCHEMA["ends"], "ends", self.ends, where, ParameterError))
         object.__setattr__(self, "ends", ends)
         segs = []
-        for i, s in enumerate(self.tension_segments):
-            if len(s) != 3:
-                raise ParameterError(f"wire {self.name!r}: tension_segments[{i}] = {s!r} must be [x_a, x_b, T]")
-            a, b, T = (_number(f"wire {self.name!r} tension_segments[{i}]", v) for v in s)
+        rows = check_value(_WIRE_SCHEMA["tension_segments"], "tension_segments", self.tension_segments, where,
+                           ParameterError)
+        for i, (s, (a, b, T)) in enumerate(zip(self.tension_segments, rows, strict=True)):
             # inside the stability check the segment's ends move as every position does (`perturbation.POSITION`)
             a, b = perturbation.value(a, key=POSITION), perturbation.value(b, key=POSITION)
             if not (self.x0 <= a < b <= self.x1) or T < 0:
@@ -105,21 +109,25 @@ class Wire:
         return math.sqrt(T / self.mass) if self.mass > 0 else math.inf
 
 
+_WIRE_SCHEMA = {f.name: f.metadata["schema"] for f in dataclasses.fields(Wire) if "schema" in f.metadata}
+
+
 @dataclass(frozen=True)
 class Support:
     """A support at x: ground springs `k` and point masses `m` on named wires."""
 
-    x: float  # perturbed as a position in __post_init__ (a support does not go through check_fields)
+    x: float = param(lo=0.0, hi=1e6, unit="m", doc="position of the support", draw=POSITION)
     k: dict[str, float] = field(default_factory=dict)
     m: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", perturbation.value(_number("support x", self.x, lo=0.0), key=POSITION))
-        for what in ("k", "m"):
+        check_fields(self, "support")
+        for what, lim in (("k", SUPPORT_K), ("m", SUPPORT_M)):
             d = getattr(self, what)
             if not isinstance(d, dict):
                 raise ParameterError(f"support at x = {self.x} m: {what} must map wire names to numbers, got {d!r}")
-            object.__setattr__(self, what, {str(w): _number(f"support at x = {self.x} m {what}_{w}", v, lo=0.0)
+            object.__setattr__(self, what, {str(w): lim.check(f"{what}_{w}", v, ParameterError,
+                                                              f" at the support at x = {self.x} m")
                                             for w, v in d.items()})
 
 
@@ -127,18 +135,17 @@ class Support:
 class Dropper:
     """A dropper at x from `upper` to `lower` (module docstring)."""
 
-    x: float = field(metadata={"draw": POSITION})
-    upper: str
-    lower: str
-    k: float = param(1e5, lo=0.0, lo_open=True, hi=1e12, unit="N/m", doc="axial stiffness")
+    x: float = param(lo=0.0, hi=1e6, unit="m", doc="position of the dropper", draw=POSITION)
+    upper: str = param(kind=str, doc="the wire it hangs from")
+    lower: str = param(kind=str, doc="the wire it holds")
+    k: float = param(lo=0.0, lo_open=True, hi=1e12, unit="N/m", doc="axial stiffness")
     law: str = param("", kind=str, choices=DROPPER_LAWS, doc="slack, linear or '' (the scene's droppers effect)")
     mass: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="dropper body mass (half on each end)")
     clamp_upper: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="clamp mass on the upper wire")
     clamp_lower: float = param(0.0, lo=0.0, hi=100.0, unit="kg", doc="clamp mass on the lower wire")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", _number("dropper x", self.x, lo=0.0))
-        check_fields(self, f"dropper at x = {self.x} m")
+        check_fields(self, f"dropper at x = {self.x!r} m")
         if self.upper == self.lower:
             raise ParameterError(f"dropper at x = {self.x} m joins wire {self.upper!r} to itself")
 
@@ -147,14 +154,13 @@ class Dropper:
 class Clamp:
     """A bilateral spring k between wires a and b at x."""
 
-    x: float = field(metadata={"draw": POSITION})
-    a: str
-    b: str
-    k: float = param(1e7, lo=0.0, lo_open=True, hi=1e15, unit="N/m", doc="clamp stiffness")
+    x: float = param(lo=0.0, hi=1e6, unit="m", doc="position of the clamp", draw=POSITION)
+    a: str = param(kind=str, doc="one wire")
+    b: str = param(kind=str, doc="the other wire")
+    k: float = param(lo=0.0, lo_open=True, hi=1e15, unit="N/m", doc="clamp stiffness")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", _number("clamp x", self.x, lo=0.0))
-        check_fields(self, f"clamp at x = {self.x} m")
+        check_fields(self, f"clamp at x = {self.x!r} m")
         if self.a == self.b:
             raise ParameterError(f"clamp at x = {self.x} m joins wire {self.a!r} to itself")
 
@@ -163,13 +169,12 @@ class Clamp:
 class PointMass:
     """A point mass m on `wire` at x (a registration clamp, an electrical connector)."""
 
-    x: float = field(metadata={"draw": POSITION})
-    wire: str
-    m: float = param(0.0, lo=0.0, hi=1e3, unit="kg", doc="mass")
+    x: float = param(lo=0.0, hi=1e6, unit="m", doc="position of the mass", draw=POSITION)
+    wire: str = param(kind=str, doc="the wire it sits on")
+    m: float = param(lo=0.0, hi=1e3, unit="kg", doc="mass")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", _number("point mass x", self.x, lo=0.0))
-        check_fields(self, f"point mass at x = {self.x} m")
+        check_fields(self, f"point mass at x = {self.x!r} m")
 
 
 @dataclass(frozen=True)
@@ -185,9 +190,10 @@ class Irregularity:
         r = np.asarray(self.r, dtype=float)
         if r.ndim != 1 or r.size < 2 or not np.all(np.isfinite(r)):
             raise ParameterError(f"irregularity {self.source}: the profile must be >= 2 finite heights, got {r.size}")
-        _number("irregularity x0", self.x0)
-        if not (real(self.dx) is not None and self.dx > 0):
-            raise ParameterError(f"irregularity {self.source}: dx = {self.dx!r} must be a positive number of metres")
+        where = f" in the irregularity {self.source}"
+        object.__setattr__(self, "x0", Limit(unit="m").check("x0", self.x0, ParameterError, where))
+        dx = Limit(lo=0.0, lo_open=True, unit="m").check("dx", self.dx, ParameterError, where)
+        object.__setattr__(self, "dx", dx)
         object.__setattr__(self, "r", r)
 
     def __call__(self, x: np.ndarray | float) -> np.ndarray:
@@ -279,11 +285,8 @@ class Line:
             on(c.b, c.x, f"clamp at x = {c.x} m")
         for m in self.masses:
             on(m.wire, m.x, f"point mass at x = {m.x} m")
-        p = real(self.presag)
-        if p is None or not (0.0 <= p < 0.05):
-            raise ParameterError(f"line {self.name!r}: presag = {self.presag!r} (mid-span presag / span length) must "
-                                 "lie in [0, 0.05)")
-        object.__setattr__(self, "presag", float(p))
+        object.__setattr__(self, "presag", PRESAG.check("presag", self.presag, ParameterError,
+                                                        f" of the line {self.name!r}"))
         if self.irregularity is not None and not isinstance(self.irregularity, Irregularity):
             raise ParameterError(f"line {self.name!r}: irregularity must be an Irregularity, got "
                                  f"{type(self.irregularity).__name__}")

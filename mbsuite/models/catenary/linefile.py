@@ -30,44 +30,74 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import MbsuiteError, ParameterError, SceneError
-from ...limits import real
+from ...limits import Limit, limit_of
+from ...schema import Items, Rule, Section, of_dataclass
+from .irregularity import SECTION as IRREGULARITY
 from .irregularity import check_irregularity
-from .line import Clamp, Dropper, Line, PointMass, Support, Wire
+from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, Support, Wire
+from .lines import CompoundParams, StitchParams
 
-WIRE_KEYS = ("name", "role", "mass", "tension", "EI", "x0", "x1", "ends", "tension_segments")
-DROPPER_KEYS = ("x", "upper", "lower", "k", "law", "mass", "clamp_upper", "clamp_lower")
-CLAMP_KEYS = ("x", "a", "b", "k")
-MASS_KEYS = ("x", "wire", "m")
 TABLES = ("supports", "droppers", "clamps", "masses")
-LINE_FILE_KEYS = ("name", "presag", "wires", "irregularity", *TABLES, *(f"{t}_file" for t in TABLES))
 #: most rows of one table (a tension section of 1 600 m has ~30 supports and ~250 droppers)
 MAX_ROWS = 100_000
+#: most wires of one line
+MAX_WIRES = 64
+
+WIRE = of_dataclass(Wire, "wire", doc="a tensioned wire over [x0, x1]; exactly one has role = 'contact'")
+SUPPORT = Section("support", {"x": limit_of(Support, "x")}, required=("x",),
+                  prefixed={"k_": SUPPORT_K, "m_": SUPPORT_M},
+                  doc="a support at x: k_<wire> ground springs and m_<wire> point masses on the named wires")
+DROPPER = of_dataclass(Dropper, "dropper", doc="a dropper from wire upper to wire lower")
+CLAMP = of_dataclass(Clamp, "clamp", doc="a bilateral spring between the w displacements of wires a and b")
+MASS = of_dataclass(PointMass, "point mass", doc="a point mass on a wire (a connector, a registration clamp)")
+ROWS = {"supports": SUPPORT, "droppers": DROPPER, "clamps": CLAMP, "masses": MASS}
 
 
-def _rows(data: Mapping[str, Any], table: str, base: Path, where: str) -> list[dict[str, Any]]:
-    """The rows of `table`: the TOML array of tables or the CSV file `<table>_file` (not both)."""
-    inline, fname = data.get(table), data.get(f"{table}_file")
-    if inline is not None and fname is not None:
-        raise SceneError(f"{where}: give {table} either inline ([[{table}]]) or as {table}_file, not both")
+def _one_source(table: str):
+    def test(d: Mapping[str, Any]) -> str | None:
+        if table in d and f"{table}_file" in d:
+            return f"give {table} either inline ([[{table}]]) or as {table}_file, not both"
+        return None
+    return test
+
+
+def _supports_given(d: Mapping[str, Any]) -> str | None:
+    return None if ("supports" in d or "supports_file" in d) else "no supports: give [[supports]] or supports_file"
+
+
+#: the declaration of a line file (module docstring); the rows of a CSV table are checked by the same row sections
+LINE_FILE = Section("line file", {
+    "name": Limit(kind=str, doc="the line's name (default: the file's stem)"),
+    "presag": dataclasses.replace(PRESAG, default=0.0),
+    "wires": Items(WIRE, min=1, max=MAX_WIRES, doc="the wires ([[wires]] tables)"),
+    **{t: Items(ROWS[t], max=MAX_ROWS, doc=f"the {t} ([[{t}]] tables)") for t in TABLES},
+    **{f"{t}_file": Limit(kind=str, doc=f"CSV file of the {t} (a column per key of [[{t}]])") for t in TABLES},
+    "irregularity": IRREGULARITY,
+}, required=("wires",), rules=(
+    *(Rule(f"{t} inline or as {t}_file, not both", _one_source(t), given=True) for t in TABLES),
+    Rule("supports are given (inline or as supports_file)", _supports_given, given=True),
+), doc="one tension section: wires, supports, droppers, clamps, point masses, presag and an irregularity")
+
+
+def _rows(data: Mapping[str, Any], table: str, base: Path, where: str) -> list[tuple[dict[str, Any], str]]:
+    """The rows of `table` with where each came from: the checked TOML array of tables, or the CSV file
+    `<table>_file` (each row checked by the same section)."""
+    fname = data.get(f"{table}_file")
     if fname is None:
-        rows = inline or []
-        if not isinstance(rows, list) or any(not isinstance(r, dict) for r in rows):
-            raise SceneError(f"{where}: {table} must be an array of tables ([[{table}]]), got {type(rows).__name__}")
-        return [dict(r) for r in rows]
-    if not isinstance(fname, str):
-        raise SceneError(f"{where}: {table}_file = {fname!r} must be a file name")
+        return [(r, f"{where} {table}[{i}]") for i, r in enumerate(data.get(table, []))]
     path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
+    rows = []
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             reader = csv.DictReader(fh)
-            rows = []
             for i, r in enumerate(reader):
                 if i >= MAX_ROWS:
-                    raise SceneError(f"{path}: more than {MAX_ROWS} rows")
+                    raise SceneError(f"{path}: more than {MAX_ROWS:,} rows")
                 if None in r or any(v is None for v in r.values()):
                     raise SceneError(f"{path} row {i + 2}: {len(r)} columns where the header has "
                                      f"{len(reader.fieldnames or [])}")
-                rows.append({k.strip(): _cell(v) for k, v in r.items()})
+                at = f"{path} row {i + 2}"
+                rows.append((ROWS[table].check({k.strip(): _cell(v) for k, v in r.items()}, at), at))
     except OSError as exc:
         raise SceneError(f"{where}: cannot read {table}_file {path}: {exc.strerror or exc}") from exc
     return rows
@@ -82,73 +112,36 @@ def _cell(v: str) -> Any:
         return s
 
 
-def _check_keys(row: Mapping[str, Any], valid: tuple[str, ...], what: str, prefixed: tuple[str, ...] = ()) -> None:
-    bad = sorted(k for k in row if k not in valid and not any(k.startswith(p) for p in prefixed))
-    if bad:
-        extra = f" and {', '.join(p + '<wire>' for p in prefixed)}" if prefixed else ""
-        raise SceneError(f"{what}: unknown key(s) {bad}; valid keys: {list(valid)}{extra}")
-
-
-def _num(v: Any, what: str) -> float:
-    x = real(v)
-    if x is None:
-        raise SceneError(f"{what} = {v!r} must be a number")
-    return float(x)
-
-
 def line_from_dict(data: Mapping[str, Any], base: Path, where: str) -> Line:
-    """A `Line` from the parsed line file `data` (module docstring); `base` resolves relative CSV names, `where`
-    names the file in errors."""
-    if not isinstance(data, Mapping):
-        raise SceneError(f"{where}: a line must be a table, got {type(data).__name__}")
-    _check_keys(data, LINE_FILE_KEYS, where)
+    """A `Line` from the parsed line file `data` (module docstring, `LINE_FILE`); `base` resolves relative CSV and
+    profile names, `where` names the file in errors."""
+    raw, data = data, LINE_FILE.check(data, where)
+    built: dict[str, list[Any]] = {}
+    for table, make in (("supports", _support), ("droppers", Dropper), ("clamps", Clamp), ("masses", PointMass)):
+        built[table] = []
+        for row, at in _rows(data, table, base, where):
+            try:
+                built[table].append(make(**row))
+            except ParameterError as exc:
+                raise SceneError(f"{at}: {exc}") from None
+    wires = []
+    for i, w in enumerate(data["wires"]):
+        try:
+            wires.append(Wire(**w))
+        except ParameterError as exc:
+            raise SceneError(f"{where} wires[{i}]: {exc}") from None
+    if "irregularity" in raw:
+        check_irregularity(_resolved(raw["irregularity"], base), f"{where} [irregularity]")
     try:
-        wires = []
-        for i, w in enumerate(data.get("wires") or []):
-            if not isinstance(w, dict):
-                raise SceneError(f"{where}: wires[{i}] must be a table")
-            _check_keys(w, WIRE_KEYS, f"{where} wires[{i}]")
-            kw = dict(w)
-            if "ends" in kw:
-                kw["ends"] = tuple(kw["ends"]) if isinstance(kw["ends"], list) else kw["ends"]
-            if "tension_segments" in kw:
-                kw["tension_segments"] = tuple(tuple(s) if isinstance(s, list) else s
-                                               for s in kw["tension_segments"])
-            wires.append(Wire(**kw))
-        if not wires:
-            raise SceneError(f"{where}: no wires ([[wires]] tables)")
-        supports = []
-        for i, r in enumerate(_rows(data, "supports", base, where)):
-            _check_keys(r, ("x",), f"{where} supports[{i}]", prefixed=("k_", "m_"))
-            if "x" not in r:
-                raise SceneError(f"{where} supports[{i}]: no x")
-            k = {n[2:]: _num(v, f"{where} supports[{i}] {n}") for n, v in r.items() if n.startswith("k_")}
-            m = {n[2:]: _num(v, f"{where} supports[{i}] {n}") for n, v in r.items() if n.startswith("m_")}
-            supports.append(Support(r["x"], k, m))
-        droppers = []
-        for i, r in enumerate(_rows(data, "droppers", base, where)):
-            _check_keys(r, DROPPER_KEYS, f"{where} droppers[{i}]")
-            droppers.append(Dropper(**r))
-        clamps = []
-        for i, r in enumerate(_rows(data, "clamps", base, where)):
-            _check_keys(r, CLAMP_KEYS, f"{where} clamps[{i}]")
-            clamps.append(Clamp(**r))
-        masses = []
-        for i, r in enumerate(_rows(data, "masses", base, where)):
-            _check_keys(r, MASS_KEYS, f"{where} masses[{i}]")
-            masses.append(PointMass(**r))
-    except TypeError as exc:  # a missing required key: the dataclass says which
-        raise SceneError(f"{where}: {exc}") from None
+        return Line(tuple(wires), tuple(built["supports"]), tuple(built["droppers"]), tuple(built["clamps"]),
+                    tuple(built["masses"]), presag=data["presag"], name=data.get("name", Path(where).stem))
     except ParameterError as exc:
         raise SceneError(f"{where}: {exc}") from None
-    irr = data.get("irregularity")
-    if irr is not None:
-        check_irregularity(_resolved(irr, base), f"{where} [irregularity]")
-    try:
-        return Line(tuple(wires), tuple(supports), tuple(droppers), tuple(clamps), tuple(masses),
-                    presag=data.get("presag", 0.0), name=str(data.get("name", Path(where).stem)))
-    except ParameterError as exc:
-        raise SceneError(f"{where}: {exc}") from None
+
+
+def _support(x: float, **keys: float) -> Support:
+    return Support(x, {k[2:]: v for k, v in keys.items() if k.startswith("k_")},
+                   {k[2:]: v for k, v in keys.items() if k.startswith("m_")})
 
 
 def read_line_file(path: str | Path) -> tuple[Line, dict[str, Any] | None]:
@@ -189,48 +182,48 @@ def is_line_file(path: str | Path) -> bool:
 
 
 # --- the scene's [line] section ----------------------------------------------------------------------------------
-LINE_SECTION_KEYS = ("kind", "file", "presag", "stitch", "compound", "irregularity")
 LINE_KINDS = ("simple", "stitched", "compound", "file")
 
 
-def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any]:
-    """Validator of a scene's `[line]` section: `kind` (simple, stitched, compound; `file` when `file` is given),
-    `file` (a line file, relative to the scene's folder; read and checked here), `presag`, the builder's parameters
-    (`[line.stitch]`, `[line.compound]`: `lines.StitchParams`, `lines.CompoundParams`) and `[line.irregularity]`.
-    The line itself is built when the passage starts (`build_line`), from the scene's parameters."""
-    from .lines import CompoundParams, StitchParams  # here: lines imports the parameters
+def _kind_matches(d: Mapping[str, Any]) -> str | None:
+    kind = d.get("kind", "file" if "file" in d else "simple")
+    if (kind == "file") != ("file" in d):
+        return "file = ... goes with kind = 'file' (and only with it)"
+    for sub, owner in (("stitch", "stitched"), ("compound", "compound")):
+        if sub in d and kind != owner:
+            return f"[line.{sub}] is read only with kind = {owner!r} (kind is {kind!r})"
+    return None
 
-    if not isinstance(value, dict):
-        raise SceneError(f"[line] must be a table with keys {list(LINE_SECTION_KEYS)}, got {value!r}")
-    _check_keys(value, LINE_SECTION_KEYS, "[line]")
-    out = dict(value)
+
+#: the declaration of a scene's [line] section
+LINE_SECTION = Section("[line]", {
+    "kind": Limit(kind=str, choices=LINE_KINDS, doc="simple, stitched or compound (built from [params]), or file "
+                                                    "(absent: file with file = ..., else simple)"),
+    "file": Limit(kind=str, doc="a line file, relative to the scene's folder"),
+    "presag": PRESAG,
+    "stitch": of_dataclass(StitchParams, "[line.stitch]", doc="the stitch wires of kind = 'stitched'"),
+    "compound": of_dataclass(CompoundParams, "[line.compound]", doc="the auxiliary wire of kind = 'compound'"),
+    "irregularity": IRREGULARITY,
+}, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] only with their kind", _kind_matches,
+               given=True),), doc="the line of a catenary scene")
+
+
+def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any]:
+    """Validator of a scene's `[line]` section (`LINE_SECTION`): `kind`, `file` (a line file, relative to the
+    scene's folder; read and checked here), `presag`, the builder's parameters (`[line.stitch]`, `[line.compound]`:
+    `lines.StitchParams`, `lines.CompoundParams`) and `[line.irregularity]`. The line itself is built when the
+    passage starts (`build_line`), from the scene's parameters."""
+    given = set(value) if isinstance(value, Mapping) else set()
+    out = {k: v for k, v in LINE_SECTION.check(value, "[line]").items() if k in given}
     kind = out.setdefault("kind", "file" if "file" in out else "simple")
-    if kind not in LINE_KINDS:
-        raise SceneError(f"[line] kind = {kind!r}; valid: {list(LINE_KINDS)}")
-    if (kind == "file") != ("file" in out):
-        raise SceneError("[line] file = ... goes with kind = 'file' (and only with it)")
     for sub, cls in (("stitch", StitchParams), ("compound", CompoundParams)):
         if sub in out:
-            if kind != ("stitched" if sub == "stitch" else sub):
-                raise SceneError(f"[line.{sub}] is read only with kind = "
-                                 f"{'stitched' if sub == 'stitch' else sub!r} (kind is {kind!r})")
-            if not isinstance(out[sub], dict):
-                raise SceneError(f"[line.{sub}] must be a table")
             try:
                 cls(**out[sub])
-            except TypeError as exc:
-                raise SceneError(f"[line.{sub}]: {exc}") from None
             except MbsuiteError as exc:
                 raise SceneError(f"[line.{sub}]: {exc}") from None
-    if "presag" in out:
-        p = real(out["presag"])
-        if p is None or not 0.0 <= p < 0.05:
-            raise SceneError(f"[line] presag = {out['presag']!r} (mid-span presag / span length) must lie in [0, 0.05)")
-        out["presag"] = float(p)
     if kind == "file":
-        f = Path(out["file"]) if isinstance(out["file"], str) else None
-        if f is None:
-            raise SceneError(f"[line] file = {out['file']!r} must be a file name")
+        f = Path(out["file"])
         if not f.is_absolute() and base is not None:
             f = base / f
         out["file"] = str(f.resolve())
@@ -240,7 +233,7 @@ def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any
         if "presag" in out and line.presag:
             raise SceneError(f"[line] presag and the line file {f} both give a presag; keep one")
     if "irregularity" in out:
-        irr = _resolved(out["irregularity"], base or Path.cwd())
+        irr = _resolved(value["irregularity"], base or Path.cwd())
         check_irregularity(irr, "[line.irregularity]")
         out["irregularity"] = irr
     return out

@@ -50,13 +50,11 @@ class StitchParams:
                            doc="clamps joining the stitch wire's ends to the messenger (bilateral, vertical)")
     dropper_offset: float = param(5.0, lo=0.0, lo_open=True, hi=100.0, unit="m",
                                   doc="the droppers at x_s +- dropper_offset hang from the stitch wire")
-    #: the messenger carries T_mw - T_stitch between the clamps (horizontal equilibrium)
-    messenger_relief: bool = True
+    messenger_relief: bool = param(True, kind=bool, doc="the messenger carries T_mw - T_stitch between the clamps "
+                                                          "(horizontal equilibrium)")
 
     def __post_init__(self) -> None:
         check_fields(self, "stitch parameter")
-        if not isinstance(self.messenger_relief, bool):
-            raise ParameterError(f"stitch messenger_relief = {self.messenger_relief!r} must be true or false")
         if not self.dropper_offset < self.half_length:
             raise ParameterError(f"stitch dropper_offset = {self.dropper_offset} m must lie inside the stitch wire "
                                  f"(half_length = {self.half_length} m)")

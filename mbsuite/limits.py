@@ -75,6 +75,10 @@ class Limit:
     choices: tuple[Any, ...] | None = None
     default: Any = _NO_DEFAULT
 
+    def optional(self) -> Limit:
+        """This limit without its default (a key that may be absent, its absence meaning something else)."""
+        return dataclasses.replace(self, default=_NO_DEFAULT)
+
     @property
     def has_default(self) -> bool:
         """True when a default is declared (the scene loader then fills it in)."""

@@ -16,6 +16,8 @@ from typing import Any, NamedTuple
 
 from ...errors import ParameterError, SceneError
 from ...health import Figure, judge
+from ...limits import Limit
+from ...schema import Items, Rule, Section
 from .pantographs import PANTOGRAPHS, TWO_MASS, Pantograph
 from .params import CatenaryParams
 
@@ -109,8 +111,7 @@ def check_timestep(p: CatenaryParams, dt: float) -> None:
     1 / (2 filter_cutoff) (the 20 Hz EN 50318 contact-force filter needs the record's Nyquist frequency above its
     cut-off; past it the statistics do not exist). A `ParameterError` names `solver.timestep` (CLI `--timestep`), the
     valid range and why; the accuracy bound (`wave_courant`) is `check_wave_resolution`'s."""
-    if not (isinstance(dt, int | float) and not isinstance(dt, bool) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"solver.timestep (--timestep) must be a positive number of seconds, got {dt!r}")
+    dt = Limit(lo=0.0, lo_open=True, unit="s").check("solver.timestep (--timestep)", dt, ParameterError)
     c = p.max_wave_speed
     nyquist, courant = 1.0 / (2.0 * p.filter_cutoff), p.element_length / c
     if not dt < nyquist:
@@ -151,13 +152,10 @@ def check_train(p: CatenaryParams, spacings: Sequence[float], head_width: float 
     if len(spacings) + 1 > MAX_PANTOGRAPHS:
         raise ParameterError(f"{len(spacings) + 1} pantographs; the core takes at most {MAX_PANTOGRAPHS}")
     offsets = [0.0]
+    spacing = dataclasses.replace(SPACING, lo=head_width)
     for i, s in enumerate(spacings):
-        if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s):
-            raise ParameterError(f"spacing[{i}] = {s!r} must be a finite number of metres")
-        if s < head_width:
-            raise ParameterError(f"spacing[{i}] = {s!r} m puts two pantographs closer than a head width "
-                                 f"({head_width} m); valid: >= {head_width} m")
-        offsets.append(offsets[-1] + float(s))
+        offsets.append(offsets[-1] + spacing.check(f"spacing[{i}]", s, ParameterError,
+                                                   " (two pantographs closer than a head width share one head)"))
     lead_end = p.x_end + offsets[-1]
     if lead_end > p.length + 1e-9:
         raise ParameterError(
@@ -207,8 +205,8 @@ class PassageConfig:
         n, ns = len(self.pantographs), len(self.spacings)
         if n != ns + 1:
             raise ParameterError(f"{n} pantographs need {n - 1} spacings, got {ns}")
-        if not (isinstance(speed, int | float) and math.isfinite(speed) and speed > 0):
-            raise ParameterError(f"speed must be a positive number of km/h, got {speed!r}")
+        speed = Limit(lo=0.0, lo_open=True, unit="km/h").check("speed", speed, ParameterError)
+        dt = Limit(lo=0.0, lo_open=True, unit="s").check("solver.timestep (--timestep)", dt, ParameterError)
         check_timestep(p, dt)
         offsets = check_train(p, self.spacings, self.head_width)
         V = speed / 3.6
@@ -219,27 +217,30 @@ class PassageConfig:
 
 
 # --- the scene's [train] section -------------------------------------------------------------------------------------
-TRAIN_KEYS = ("pantographs", "spacings")
+#: the distance between consecutive contact points of a train
+SPACING = Limit(lo=HEAD_WIDTH, hi=1e4, unit="m", doc="distance between consecutive contact points, >= a head width")
+
+
+def _one_fewer(d: Mapping[str, Any]) -> str | None:
+    n, ns = len(d["pantographs"]), len(d["spacings"])
+    return None if ns == n - 1 else f"{n} pantographs need {n - 1} spacings (m), got {ns}"
+
+
+#: the declaration of a scene's `[train]` section; spacing limits against the line are checked when the passage
+#: starts (`check_train`)
+SECTION = Section("[train]", {
+    "pantographs": Items(Limit(kind=str, choices=tuple(PANTOGRAPHS)), min=1, max=MAX_PANTOGRAPHS,
+                         doc="the pantographs, leading first (values of the pantograph effect)"),
+    "spacings": Items(SPACING, max=MAX_PANTOGRAPHS - 1, default=(), unit="m",
+                      doc="distances between consecutive contact points (one fewer than pantographs)"),
+}, required=("pantographs",), rules=(Rule("one spacing fewer than pantographs", _one_fewer),),
+    doc="several pantographs on one train")
 
 
 def validate_train_section(value: Any) -> dict[str, Any]:
-    """Validator of a scene's `[train]` section: `pantographs` (names of the `pantograph` effect's values, leading
-    first) and `spacings` (m between consecutive contact points, one fewer). Spacing limits are checked against the
-    line when the passage starts (`check_train`)."""
-    if not isinstance(value, dict):
-        raise SceneError(f"[train] must be a table with keys {list(TRAIN_KEYS)}, got {value!r}")
-    bad = sorted(set(value) - set(TRAIN_KEYS))
-    if bad:
-        raise SceneError(f"unknown key(s) {bad} in [train]; valid keys: {list(TRAIN_KEYS)}")
-    names = value.get("pantographs")
-    valid = list(PANTOGRAPHS)
-    if not isinstance(names, list) or not names or any(n not in valid for n in names):
-        raise SceneError(f"[train] pantographs must be a non-empty list of {valid}, got {names!r}")
-    sp = value.get("spacings", [])
-    if not isinstance(sp, list) or len(sp) != len(names) - 1:
-        raise SceneError(f"[train] spacings must be a list of {len(names) - 1} distances (m) for {len(names)} "
-                         f"pantographs, got {sp!r}")
-    for i, s in enumerate(sp):
-        if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s) or s < HEAD_WIDTH:
-            raise SceneError(f"[train] spacings[{i}] = {s!r} m: valid spacings are >= a head width ({HEAD_WIDTH} m)")
-    return {"pantographs": list(names), "spacings": [float(s) for s in sp]}
+    """Validator of a scene's `[train]` section (`SECTION`)."""
+    out = SECTION.check(value, "[train]")
+    return {"pantographs": list(out["pantographs"]), "spacings": [float(s) for s in out["spacings"]]}
+
+
+validate_train_section.schema = SECTION

@@ -240,6 +240,7 @@ def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any
 
 
 validate_line_section.wants_base = True  # the scene loader passes the scene file's folder
+validate_line_section.schema = LINE_SECTION
 
 
 #: the simple line's fields of `CatenaryParams`: a [line] of kind 'file' replaces them (setting one is an error)

@@ -31,8 +31,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ...errors import ParameterError
+from ...errors import ParameterError, SceneError
 from ...limits import check_fields, param
+from ...schema import Section
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -85,19 +86,23 @@ class QualityCriteria:
         return lo, hi
 
 
-def validate_section(value: Any) -> dict[str, Any]:
-    """Validator of a scene's `[quality]` section: `system` plus any field of QualityCriteria (the system's defaults
-    fill the rest)."""
-    from ...errors import SceneError
+#: the declaration of a scene's `[quality]` section: `system` plus any field of `QualityCriteria` (absent: the
+#: system's value, `SYSTEMS`)
+SECTION = Section("[quality]", {f.name: f.metadata["limit"].optional() for f in dataclasses.fields(QualityCriteria)},
+                  doc="EN 50367 / TSI Energy criteria; a key left out takes the value of the system (default AC)")
 
-    if not isinstance(value, dict):
-        raise SceneError(f"[quality] must be a table of QualityCriteria fields, got {value!r}")
-    names = [f.name for f in dataclasses.fields(QualityCriteria)]
-    bad = sorted(set(value) - set(names))
-    if bad:
-        raise SceneError(f"unknown key(s) {bad} in [quality]; valid keys: {names}")
-    criteria_from(value)
-    return dict(value)
+
+def validate_section(value: Any) -> dict[str, Any]:
+    """Validator of a scene's `[quality]` section (`SECTION`; the system's defaults fill the rest)."""
+    out = SECTION.check(value, "[quality]")
+    try:
+        criteria_from(out)
+    except ParameterError as exc:
+        raise SceneError(f"[quality]: {exc}") from None
+    return out
+
+
+validate_section.schema = SECTION
 
 
 def criteria_from(section: dict[str, Any] | None) -> QualityCriteria:

@@ -142,6 +142,9 @@ class ModelSpec:
     uses: Mapping[str, Uses] = field(default_factory=dict)
     #: the parameters of a scene when its own sections change them (the catenary's [line]); None: params_cls(**params)
     params_builder: Callable[[Any], Any] | None = None
+    #: the input files a model reads besides scenes (the catenary's line file): name -> `schema.Section` (or a
+    #: `Deferred` naming one); docs, JSON Schemas and the generated input tests walk them
+    input_files: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._check_uses()

@@ -51,6 +51,7 @@ from .accuracy import check_tolerances, declared
 from .errors import MbsuiteError, ParameterError, SceneError
 from .limits import Limit, real
 from .registry import ModelSpec, get_model, models
+from .schema import Items, check_value
 from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver", "accuracy")
@@ -285,6 +286,12 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
                 f"{sorted(spec.inputs[itype])}")
         inp["type"] = itype
         for key, decl in spec.inputs[itype].items():
+            if isinstance(decl, Items):
+                if key in inp:
+                    inp[key] = [list(r) if isinstance(r, tuple) else r for r in
+                                check_value(decl, f"input.{key}", inp[key], f"[input]{where('input', key)}",
+                                            SceneError)]
+                continue
             if not isinstance(decl, Limit):
                 continue
             if key in inp:

@@ -43,6 +43,7 @@ class Items:
     doc: str = ""
     unit: str = ""
     default: Any = None  # filled in when the key is absent and not required (None: left absent)
+    rules: tuple[Rule, ...] = ()  # on the checked list (e.g. times strictly increasing)
 
     def describe(self) -> str:
         """The valid values in words."""
@@ -122,12 +123,12 @@ class Section:
     # --- the docs and the JSON Schema, from the same declaration ------------------------------------------------
     def json_schema(self, top: bool = False) -> dict[str, Any]:
         """A JSON Schema (draft 2020-12) of the section; `top`: with `$schema` and `title`."""
-        props = {k: _json(d) for k, d in self.keys.items()}
+        props = {k: json_of(d) for k, d in self.keys.items()}
         out: dict[str, Any] = {"type": "object", "properties": props, "additionalProperties": False}
         if self.required:
             out["required"] = list(self.required)
         if self.prefixed:
-            out["patternProperties"] = {f"^{p}.+$": _json(lim) for p, lim in self.prefixed.items()}
+            out["patternProperties"] = {f"^{p}.+$": json_of(lim) for p, lim in self.prefixed.items()}
         doc = " ".join([self.doc, *(f"Rule: {r.doc}." for r in self.rules)]).strip()
         if doc:
             out["description"] = doc
@@ -206,20 +207,25 @@ def check_value(decl: Limit | Items | Section, key: str, value: Any, where: str,
                              for j, (lim, v) in enumerate(zip(decl.of, item, strict=True))))
         else:
             out.append(decl.of.check(name, item, error, f" in {where}"))
+    for rule in decl.rules:
+        msg = rule.test(out)
+        if msg:
+            raise error(f"{key} in {where}: {msg}")
     return out
 
 
-def _json(d: Limit | Items | Section) -> dict[str, Any]:
+def json_of(d: Limit | Items | Section) -> dict[str, Any]:
     if isinstance(d, Section):
         return d.json_schema()
     if isinstance(d, Items):
         if isinstance(d.of, tuple):
-            items: dict[str, Any] = {"type": "array", "prefixItems": [_json(lim) for lim in d.of],
+            items: dict[str, Any] = {"type": "array", "prefixItems": [json_of(lim) for lim in d.of],
                                      "minItems": len(d.of), "maxItems": len(d.of)}
         else:
-            items = _json(d.of)
+            items = json_of(d.of)
         out = {"type": "array", "items": items, "minItems": d.min, "maxItems": d.max}
-        return {**out, **({"description": d.doc} if d.doc else {})}
+        doc = " ".join([d.doc, *(f"Rule: {r.doc}." for r in d.rules)]).strip()
+        return {**out, **({"description": doc} if doc else {})}
     lim = d
     out = {}
     if lim.kind is bool:

@@ -139,7 +139,8 @@ def test_a_scene_names_a_line_file_relative_to_its_folder(tmp_path):
     body = ["[[wires]]\nname = 'contact'\nrole = 'contact'\nmass = 1.35\ntension = 20000.0\nEI = 195.0\nx0 = 0.0\n"
             "x1 = 180.0\n", "[[wires]]\nname = 'messenger'\nrole = 'messenger'\nmass = 1.07\ntension = 16000.0\n"
             "EI = 131.7\nx0 = 0.0\nx1 = 180.0\n"]
-    body += [f"[[supports]]\nx = {s.x}\nk_contact = 300.0\nk_messenger = 5e4\n" for s in line.supports]
+    body += [f"[[supports]]\nx = {s.x}\n" + "".join(f"k_{w} = {k!r}\n" for w, k in s.k.items())  # ends: anchors
+             for s in line.supports]
     (tmp_path / "lines" / "short.toml").write_text("droppers_file = 'd.csv'\n" + "\n".join(body))
     (tmp_path / "lines" / "d.csv").write_text("x,upper,lower,k\n" + "".join(
         f"{d.x},messenger,contact,100000\n" for d in line.droppers))
@@ -161,6 +162,7 @@ def test_mbsuite_catenary_runs_a_line_file(tmp_path, capsys):
     src = (LINES / "en50318.toml").read_text()
     keep = [b for b in src.split("\n\n") if "x = " not in b or float(b.split("x = ")[1].split("\n")[0]) <= 180.0]
     text = "\n\n".join(keep).replace("x1 = 600.0", "x1 = 180.0")
+    text = text.replace("x = 180.0\nk_contact = 300.0\nk_messenger = 50000.0", "x = 180.0")  # now the anchors
     f = tmp_path / "three.toml"
     f.write_text(text)
     assert cli_main(["catenary", str(f), "--json"]) == 0

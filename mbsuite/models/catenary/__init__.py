@@ -67,4 +67,5 @@ SPEC = ModelSpec(
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
     params_builder=scene_params,
+    input_files={"line_file": Deferred("mbsuite.models.catenary.linefile:LINE_FILE")},
 )

@@ -580,7 +580,7 @@ def _static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndar
         if g == group[0]:  # the contact wire at each support with a steady arm (a ground spring on it)
             zs = line.design_height(x[supports])
             for i, s in enumerate(slot[0, supports]):
-                if line.contact.name in line.supports[i].k:
+                if line.steady_arm(line.supports[i]):
                     held[int(pos[s])] = float(zs[i])
         Kg = K[idx][:, idx].tocsr()
         Kg.eliminate_zeros()
@@ -608,6 +608,6 @@ def _static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndar
         for j in mine:  # the dropper now loads the wire it hangs from
             f[up[j]] -= T0[j]
         if g == group[0]:
-            arm = np.array([line.contact.name in sp_.k for sp_ in line.supports], dtype=bool)
+            arm = np.array([line.steady_arm(sp_) for sp_ in line.supports], dtype=bool)
             preload = np.where(arm, r[pos[slot[0, supports]]], 0.0)
     return u, T0, preload

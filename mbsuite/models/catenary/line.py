@@ -23,6 +23,7 @@ Conventions (SI units, x along the track from the first pinned end, heights up):
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass, field
@@ -129,6 +130,17 @@ class Support:
             object.__setattr__(self, what, {str(w): lim.check(f"{what}_{w}", v, ParameterError,
                                                               f" at the support at x = {self.x} m")
                                             for w, v in d.items()})
+
+
+def _without_anchor_zeros(s: Support, wires: dict[str, Wire]) -> Support:
+    keep = {what: {w: v for w, v in getattr(s, what).items() if v != 0.0 or not Line.pinned_end(wires[w], s.x)}
+            for what in ("k", "m")}
+    if keep["k"] == s.k and keep["m"] == s.m:
+        return s
+    out = copy.copy(s)  # not re-checked (nor re-perturbed): only entries that act on nothing leave
+    object.__setattr__(out, "k", keep["k"])
+    object.__setattr__(out, "m", keep["m"])
+    return out
 
 
 @dataclass(frozen=True)
@@ -241,9 +253,13 @@ class Line:
             raise ParameterError(f"line {self.name!r} needs exactly one wire with role 'contact', has {len(contact)}"
                                  + (f": {[w.name for w in contact]}" if contact else ""))
         cw = contact[0]
-        if cw.x0 != 0.0 or any(w.x0 < 0 or w.x1 > cw.x1 for w in self.wires):
-            raise ParameterError(f"line {self.name!r}: the contact wire must start at x = 0 and every wire lie on it "
-                                 f"([0, {cw.x1}] m)")
+        if cw.x0 != 0.0:
+            raise ParameterError(f"line {self.name!r}: the contact wire {cw.name!r} has x0 = {cw.x0!r} m; valid: 0 "
+                                 "(it starts the line)")
+        beyond = [w.name for w in self.wires if w.x1 > cw.x1]
+        if beyond:
+            raise ParameterError(f"line {self.name!r}: wire(s) {beyond} end beyond the contact wire (x1 > "
+                                 f"{cw.x1} m); every wire lies on [0, {cw.x1}] m")
         if cw.tension_segments:
             raise ParameterError(f"line {self.name!r}: the contact wire's tension must be uniform (one tension "
                                  "section); tension_segments are for the other wires")
@@ -271,6 +287,16 @@ class Line:
             on(cw.name, s.x, f"a support at x = {s.x} m")
             for w in (*s.k, *s.m):
                 on(w, s.x, f"support at x = {s.x} m")
+            for what, d in (("k", s.k), ("m", s.m)):
+                for w, v in d.items():
+                    if v != 0.0 and self.pinned_end(wires[w], s.x):
+                        raise ParameterError(
+                            f"line {self.name!r}: the support at x = {s.x} m gives {what}_{w} = {v!r} on the pinned "
+                            f"end of wire {w!r}, where w = 0: it would act on nothing (a mass only on the anchor's "
+                            "reaction). Remove it (or 0), or make that end free")
+        # a 0 on a pinned end (a CSV table's empty place) is no spring and no mass: the same line as without it
+        sup = tuple(_without_anchor_zeros(s, wires) for s in sup)
+        object.__setattr__(self, "supports", sup)
         ends: dict[tuple[str, float], float] = {}
         for d in self.droppers:
             on(d.upper, d.x, f"dropper at x = {d.x} m (upper wire)")
@@ -294,6 +320,16 @@ class Line:
             n = sum(w.x0 <= x <= w.x1 for w in self.wires)
             if n > MAX_WIRES_AT_A_NODE:
                 raise ParameterError(f"line {self.name!r}: {n} wires at x = {x} m; at most {MAX_WIRES_AT_A_NODE}")
+
+    @staticmethod
+    def pinned_end(wire: Wire, x: float) -> bool:
+        """True when x (m) is a pinned end of `wire` (to 1e-9 m)."""
+        return any(e == "pinned" and abs(x - xe) <= 1e-9 for e, xe in zip(wire.ends, (wire.x0, wire.x1), strict=True))
+
+    def steady_arm(self, s: Support) -> bool:
+        """True when support `s` holds the contact wire at its design height: a ground spring on it, or its pinned
+        end (the static state's hold; its reaction is the support's pre-load)."""
+        return self.contact.name in s.k or self.pinned_end(self.contact, s.x)
 
     @property
     def contact(self) -> Wire:

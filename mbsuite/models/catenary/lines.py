@@ -24,8 +24,9 @@ def _simple_wires(p: CatenaryParams) -> tuple[Wire, Wire]:
 
 
 def _supports(p: CatenaryParams, **extra: float) -> list[Support]:
-    return [Support(s * p.span_length, {CONTACT: p.k_steady_arm, MESSENGER: p.k_messenger_support, **extra})
-            for s in range(p.n_spans + 1)]
+    """Steady arm and messenger support at every interior support; the end supports hold the wires' pinned ends."""
+    return [Support(s * p.span_length, {CONTACT: p.k_steady_arm, MESSENGER: p.k_messenger_support, **extra}
+                    if 0 < s < p.n_spans else {}) for s in range(p.n_spans + 1)]
 
 
 def simple(p: CatenaryParams, presag: float = 0.0) -> Line:

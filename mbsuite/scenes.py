@@ -51,7 +51,7 @@ from .accuracy import check_tolerances, declared
 from .errors import MbsuiteError, ParameterError, SceneError
 from .limits import Limit, real
 from .registry import ModelSpec, get_model, models
-from .schema import Items, check_value
+from .schema import Items, check_value, toml_error
 from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver", "accuracy")
@@ -386,7 +386,7 @@ def load_scene(ref: str | Path) -> Scene:
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
-            raise SceneError(f"scene file {p} is not valid TOML: {exc}") from exc
+            raise SceneError(f"scene file {p} is not valid TOML: {toml_error(exc, text)}") from exc
         except RecursionError as exc:
             raise SceneError(f"scene file {p} nests arrays or tables too deeply to be a scene") from exc
         data.setdefault("name", p.stem)

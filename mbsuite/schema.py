@@ -22,6 +22,8 @@ extend `limits.Limit`, which every parameter dataclass already declares, and kee
 from __future__ import annotations
 
 import dataclasses
+import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -76,6 +78,8 @@ class Section:
     prefixed: Mapping[str, Limit] = field(default_factory=dict)
     rules: tuple[Rule, ...] = ()
     doc: str = ""
+    #: a valid example (the docs show it; the generated tests and the robustness corpus move each key of it)
+    example: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         bad = [k for k in self.required if k not in self.keys]
@@ -265,3 +269,78 @@ def of_dataclass(cls: type, title: str, *, omit: tuple[str, ...] = (), rules: tu
             required.append(f.name)
     keys.update(extra or {})
     return Section(title, keys, tuple(required), rules=rules, doc=doc)
+
+
+def toml_error(exc: Exception, text: str) -> str:
+    """A TOML parser's message with the line it names quoted (a key given twice reads "Cannot overwrite a value (at
+    line 12, column 7)", which names no key; the quoted line does)."""
+    m = re.search(r"at line (\d+)", str(exc))
+    lines = text.splitlines()
+    if m is None or not 0 < int(m.group(1)) <= len(lines):
+        return str(exc)
+    line = lines[int(m.group(1)) - 1].strip()
+    hint = " (a key or table given twice)" if "overwrite" in str(exc).lower() else ""
+    return f"{exc}: `{line[:200]}`{hint}"
+
+
+# --- generated cases: what the tests and the robustness corpus try on every declared key ------------------------------
+def leaves(section: Section, data: Mapping[str, Any], path: tuple[Any, ...] = (), every_row: bool = True
+           ) -> list[tuple[tuple[Any, ...], Limit | Items | Section, bool]]:
+    """(path into `data`, the declaration there, required) of every declared key: nested sections and the rows of a
+    list of tables are walked (`every_row` False: a row only for the keys no earlier row had); keys `data` leaves out
+    are listed too (a test sets them)."""
+    out = []
+    keys: dict[str, Any] = dict(section.keys)
+    keys.update({k: section.prefixed[p] for k in data for p in section.prefixed
+                 if isinstance(k, str) and k.startswith(p) and k not in section.keys})
+    for key, d in keys.items():
+        here = (*path, key)
+        out.append((here, d, key in section.required))
+        if isinstance(d, Section) and isinstance(data.get(key), Mapping):
+            out += leaves(d, data[key], here, every_row)
+        elif isinstance(d, Items) and isinstance(d.of, Section) and data.get(key):
+            seen: set[Any] = set()
+            for i, item in enumerate(data[key]):
+                rows = [r for r in leaves(d.of, item, (*here, i), every_row) if every_row or r[0][len(here) + 1:]
+                        not in seen]
+                seen |= {r[0][len(here) + 1:] for r in rows}
+                out += rows
+    return out
+
+
+def bad_values(decl: Limit | Items | Section, current: Any = None) -> list[tuple[str, Any]]:
+    """(label, value) of values `decl` refuses: wrong types, bools, NaN, +-inf, complex, below and above its range,
+    huge, a fractional count, an unknown word, a list too long or too short, a bad first item (`current`: the value
+    the example holds there, which a list's bad item replaces)."""
+    if isinstance(decl, Section):
+        return [("text", "text"), ("number", 1.0), ("list", [1.0])]
+    if isinstance(decl, Items):
+        first = current[0] if current else None
+        bad: list[tuple[str, Any]] = [("text", "text"), ("number", 1.0), ("bool", True), ("table", {"a": 1}),
+                                      ("too long", [first] * (decl.max + 1))]
+        if decl.min > 0:
+            bad.append(("empty", []))
+        if isinstance(decl.of, Limit | tuple) and current:
+            inner = decl.of if isinstance(decl.of, Limit) else decl.of[0]
+            for label, v in bad_values(inner, first if isinstance(decl.of, Limit) else first[0]):
+                row = list(current)
+                row[0] = v if isinstance(decl.of, Limit) else [v, *list(first)[1:]]
+                bad.append((f"item {label}", row))
+            if isinstance(decl.of, tuple):
+                bad.append(("short row", [list(first)[:-1], *list(current)[1:]]))
+        return bad
+    lim = decl
+    if lim.kind is bool:
+        return [("number", 1), ("zero", 0), ("text", "true"), ("float", 1.0)]
+    if lim.kind is str:
+        return [("number", 1.0), ("bool", True), ("list", ["a"])] + (
+            [("unknown word", "no-such-value")] if lim.choices is not None else [])
+    bad = [("text", "text"), ("bool", True), ("list", [1.0]), ("table", {"a": 1.0}), ("nan", math.nan),
+           ("inf", math.inf), ("-inf", -math.inf), ("complex", 1 + 1j)]
+    if lim.lo is not None:
+        bad.append(("below", lim.lo if lim.lo_open else lim.lo - 1.0 - abs(lim.lo)))
+    if lim.hi is not None:
+        bad += [("above", lim.hi if lim.hi_open else lim.hi + 1.0 + abs(lim.hi)), ("huge", 1e300)]
+    if lim.kind is int:
+        bad.append(("fraction", (lim.lo or 0) + 2.5))
+    return bad

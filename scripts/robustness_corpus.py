@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import copy
 import json
 import math
 import os
@@ -45,7 +46,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-AREAS = ("scene", "model", "cli", "numerics", "store", "signals", "threads")
+AREAS = ("scene", "model", "cli", "numerics", "store", "signals", "threads", "declared")
 OUTCOMES = ("ok", "clear", "culprit", "unclear", "trace", "silent", "refused", "hang", "crash", "setup")
 PASSING = ("ok", "clear")
 DIR = "@DIR@"  # replaced by the attempt's scratch directory in argv, snippets, setup code, files and environment
@@ -1189,10 +1190,107 @@ print("identical")
 """, "ok", timeout=180)
 
 
+# --------------------------------------------------------------------------------- generated from the declarations
+class Twice:
+    """A value the TOML writer writes twice (a duplicate key)."""
+
+    def __init__(self, value: object) -> None:
+        self.value = value
+
+
+def _toml_scalar(v: object) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_scalar(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml_scalar(x) for x in v) + "]"
+    raise TypeError(type(v))
+
+
+def toml_text(data: dict, head: tuple[str, ...] = ()) -> str:
+    """`data` as TOML: values first, then tables ([a.b]) and arrays of tables ([[a.b]])."""
+    lines, later = [], []
+    for k, v in data.items():
+        name = json.dumps(k)
+        if isinstance(v, dict) and v and all(not isinstance(x, Twice) for x in [v]):
+            later.append((k, v, False))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            later.append((k, v, True))
+        elif isinstance(v, Twice):
+            lines += [f"{name} = {_toml_scalar(v.value)}"] * 2
+        else:
+            lines.append(f"{name} = {_toml_scalar(v)}")
+    for k, v, many in later:
+        path = ".".join(json.dumps(p) for p in (*head, k))
+        for item in (v if many else [v]):
+            lines.append(f"\n[[{path}]]" if many else f"\n[{path}]")
+            lines.append(toml_text(item, (*head, k)))
+    return "\n".join(lines)
+
+
+#: how a user's file reaches a declared input file's loader: the command that reads it
+FILE_COMMANDS = {"catenary.line_file": ("catenary",)}
+
+
+def declared_attempts() -> Iterator[Attempt]:
+    """For every key of every declared section (`mbsuite.scene_schema.sections`), written into a file as a user
+    writes one (a line file, a scene with the section): missing where required, a wrong type, NaN, +-inf, below and
+    above its range, huge, a fractional count, an unknown word, an empty or overlong list, a duplicate key. Each must
+    be a clear error naming the key."""
+    from mbsuite.limits import Limit
+    from mbsuite.scene_schema import sections
+    from mbsuite.schema import Section, bad_values, leaves
+
+    a = "declared"
+    wanted = {"text", "number", "bool", "nan", "inf", "-inf", "below", "above", "huge", "fraction", "unknown word",
+              "empty", "item nan", "item below", "item text", "short row"}
+    for name, sec in sections().items():
+        model, key = name.split(".", 1)
+        for path, decl, required in leaves(sec, sec.example, every_row=False):
+            node, ok = sec.example, True
+            for p in path[:-1]:
+                try:
+                    node = node[p]
+                except (KeyError, IndexError, TypeError):
+                    ok = False
+            if not ok or isinstance(decl, Section) and path[-1] not in node:
+                continue
+            leaf = str(path[-1]) if not isinstance(path[-1], int) else str(path[-2])
+            tag = ".".join(map(str, path))
+            cases = [("missing", None)] if required else []
+            cases += [(lab, v) for lab, v in bad_values(decl, node.get(path[-1])) if lab in wanted]
+            if isinstance(decl, Limit) and path[-1] in node:
+                cases.append(("duplicate", Twice(node[path[-1]])))
+            for label, value in cases:
+                data = copy.deepcopy(dict(sec.example))
+                target = data
+                for p in path[:-1]:
+                    target = target[p]
+                if label == "missing":
+                    del target[path[-1]]
+                else:
+                    target[path[-1]] = value
+                if name in FILE_COMMANDS:
+                    text, cmd = toml_text(data), (*FILE_COMMANDS[name], f"{DIR}/input.toml", "--json")
+                else:
+                    text = f"model = {json.dumps(model)}\n" + toml_text({key: data})
+                    cmd = ("run", f"{DIR}/input.toml", "--json")
+                yield Attempt(f"declared-{name}-{tag}-{label.replace(' ', '-')}", a,
+                              f"{name} {tag}: {label}", "error", cmd, culprit=leaf,
+                              files=(("input.toml", text.encode()),))
+
+
 def corpus() -> list[Attempt]:
     """Every attempt, in a fixed order; names are unique."""
     out = [*scene_attempts(), *solver_value_attempts(), *model_attempts(), *cli_attempts(), *numerics_attempts(),
-           *store_attempts(), *input_attempts(), *thread_attempts()]
+           *store_attempts(), *input_attempts(), *thread_attempts(), *declared_attempts()]
     names = [x.name for x in out]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:

@@ -15,7 +15,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
-import math
 import subprocess
 import sys
 import tomllib
@@ -35,71 +34,28 @@ from mbsuite.models.catenary.linefile import line_from_dict, validate_line_secti
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.registry import models
 from mbsuite.scene_schema import scene_schema, section_of, sections
-from mbsuite.schema import Items, Section
+from mbsuite.schema import Items, Section, bad_values, leaves
 
 ROOT = Path(__file__).resolve().parents[2]
 LINES = ROOT / "mbsuite" / "models" / "catenary" / "lines"
 
-#: a small line with every kind of row and key: two 50 m spans, a stitch wire, tension segments, masses everywhere
-LINE: dict[str, Any] = {
-    "name": "two spans", "presag": 0.0005,
-    "wires": [
-        {"name": "contact", "role": "contact", "mass": 1.35, "tension": 20000.0, "EI": 195.0, "x0": 0.0, "x1": 100.0},
-        {"name": "messenger", "role": "messenger", "mass": 1.07, "tension": 16000.0, "EI": 131.7, "x0": 0.0,
-         "x1": 100.0, "tension_segments": [[42.0, 58.0, 12500.0]]},
-        {"name": "stitch", "role": "stitch", "mass": 0.31, "tension": 3500.0, "EI": 10.0, "x0": 42.0, "x1": 58.0,
-         "ends": ["free", "free"]},
-    ],
-    "supports": [{"x": 0.0},
-                 {"x": 50.0, "k_contact": 300.0, "k_messenger": 5e4, "m_contact": 1.0, "m_messenger": 0.5},
-                 {"x": 100.0}],
-    "droppers": [{"x": x, "upper": "messenger", "lower": "contact", "k": 1e5} for x in (10.0, 25.0, 40.0, 60.0, 75.0,
-                                                                                       90.0)]
-    + [{"x": 46.0, "upper": "stitch", "lower": "contact", "k": 1e5, "mass": 0.08, "clamp_upper": 0.065,
-        "clamp_lower": 0.165, "law": "linear"}],
-    "clamps": [{"x": 42.0, "a": "stitch", "b": "messenger", "k": 1e7},
-               {"x": 58.0, "a": "stitch", "b": "messenger", "k": 1e7}],
-    "masses": [{"x": 30.0, "wire": "contact", "m": 0.6}],
-    "irregularity": {"seed": 3, "rms": 0.002, "wavelength_min": 2.0, "wavelength_max": 40.0, "n_waves": 200},
+#: how a user's input reaches each declared section: its loader (a line file's reader, a scene section's validator)
+LOADERS: dict[str, Callable[[Any], Any]] = {
+    "catenary.line_file": lambda d: line_from_dict(d, LINES, "two_spans.toml"),
+    "catenary.line": lambda d: validate_line_section(d, LINES),
+    "catenary.train": models()["catenary"].sections["train"],
+    "catenary.quality": models()["catenary"].sections["quality"],
 }
-
-#: a valid example of every declared section and the loader a user's input goes through
-EXAMPLES: dict[str, tuple[dict[str, Any], Callable[[Any], Any]]] = {
-    "catenary.line_file": (LINE, lambda d: line_from_dict(d, LINES, "two_spans.toml")),
-    "catenary.line": ({"kind": "stitched", "presag": 0.0005, "stitch": {"half_length": 9.0, "k_clamp": 1e7},
-                       "irregularity": {"seed": 1, "psd": [[0.01, 1e-6], [0.5, 1e-8]], "dx": 0.05}},
-                      lambda d: validate_line_section(d, LINES)),
-    "catenary.train": ({"pantographs": ["reference2mass", "reference2mass"], "spacings": [200.0]},
-                       models()["catenary"].sections["train"]),
-    "catenary.quality": ({"system": "DC3kV", "fm_a": 0.00097, "fm_b": 110.0, "fm_b_lower": 80.0,
-                          "sigma_ratio_max": 0.3, "stat_min_floor": 0.0, "loss_max_pct": 0.2, "nq_max_pct": 0.1,
-                          "arc_min_duration": 0.0, "uplift_max": 0.12}, models()["catenary"].sections["quality"]),
-}
+EXAMPLES = {name: (sec.example, LOADERS[name]) for name, sec in sections().items()}
+LINE = sections()["catenary.line_file"].example
 
 
-def test_every_declared_section_has_an_example():
-    """A new declared section gets an example here, so the generated tests below cover it."""
-    assert sorted(sections()) == sorted(EXAMPLES)
+def test_every_declared_section_has_an_example_and_a_loader():
+    """A new declared section declares an example and gets its loader here, so the generated tests below cover it."""
+    assert sorted(sections()) == sorted(LOADERS)
+    assert all(sec.example is not None for sec in sections().values())
     for example, load in EXAMPLES.values():
         load(copy.deepcopy(example))  # the example itself is legal
-
-
-def _leaves(decl: Section, data: dict[str, Any], path: tuple[Any, ...] = ()) -> Iterator[tuple[tuple, Any, bool]]:
-    """(path into the example, the declaration there, required) of every declared key: nested sections and the first
-    item of a list of tables are walked; keys the example leaves out are visited too (set, not changed)."""
-    keys = dict(decl.keys)
-    keys.update({k: decl.prefixed[p] for k in data for p in decl.prefixed if k.startswith(p) and k not in decl.keys})
-    for key, d in keys.items():
-        here = (*path, key)
-        if isinstance(d, Section) and isinstance(data.get(key), dict):
-            yield here, d, key in decl.required
-            yield from _leaves(d, data[key], here)
-        elif isinstance(d, Items) and isinstance(d.of, Section) and data.get(key):
-            yield here, d, key in decl.required
-            for i, item in enumerate(data[key]):  # every row: a prefixed key or a default may appear in one only
-                yield from _leaves(d.of, item, (*here, i))
-        else:
-            yield here, d, key in decl.required
 
 
 def _set(data: dict[str, Any], path: tuple, value: Any, delete: bool = False) -> dict[str, Any]:
@@ -115,44 +71,13 @@ def _set(data: dict[str, Any], path: tuple, value: Any, delete: bool = False) ->
 
 
 def _bad_values(d: Any, current: Any) -> list[Any]:
-    """Generated bad values for declaration `d` (the example's value `current`)."""
-    if isinstance(d, Section):
-        return ["text", 1.0, [1.0]]
-    if isinstance(d, Items):
-        bad: list[Any] = ["text", 1.0, True, {"a": 1}, [current[0] if current else None] * (d.max + 1)]
-        if d.min > 0:
-            bad.append([])
-        if isinstance(d.of, Limit | tuple) and current:
-            inner = d.of if isinstance(d.of, Limit) else d.of[0]
-            for v in _bad_values(inner, current[0] if isinstance(d.of, Limit) else current[0][0]):
-                row = copy.deepcopy(list(current))
-                if isinstance(d.of, Limit):
-                    row[0] = v
-                else:
-                    row[0] = [v, *list(row[0])[1:]]
-                bad.append(row)
-            if isinstance(d.of, tuple):
-                bad.append([list(current[0])[:-1]])  # a short row
-        return bad
-    lim: Limit = d
-    if lim.kind is bool:
-        return [1, 0, "true", 1.0, None]
-    if lim.kind is str:
-        return [1.0, True, ["a"], None] + (["no-such-value"] if lim.choices is not None else [])
-    bad = ["text", True, False, None, [1.0], {"a": 1.0}, math.nan, math.inf, -math.inf, 1 + 1j]
-    if lim.lo is not None:
-        bad.append(lim.lo - 1.0 - abs(lim.lo) if not lim.lo_open else lim.lo)
-    if lim.hi is not None:
-        bad += [lim.hi + 1.0 + abs(lim.hi) if not lim.hi_open else lim.hi, 1e300]
-    if lim.kind is int:
-        bad.append((lim.lo or 0) + 2.5)
-    return bad
+    return [v for _, v in bad_values(d, current)]
 
 
 def _cases() -> Iterator[Any]:
     for name, (example, _) in EXAMPLES.items():
         sec = sections()[name]
-        for path, d, required in _leaves(sec, example):
+        for path, d, required in leaves(sec, example):
             yield pytest.param(name, path, d, required, id=f"{name}:{'.'.join(map(str, path))}")
 
 
@@ -186,7 +111,7 @@ def test_every_bad_value_of_every_key_is_an_error_naming_it(name, path, decl, re
 
 def test_an_unknown_key_in_every_section_and_row_is_an_error_naming_it():
     for name, (example, load) in EXAMPLES.items():
-        for path, d, _ in _leaves(sections()[name], example):
+        for path, d, _ in leaves(sections()[name], example):
             try:
                 _set(example, (*path, None), None)
             except (KeyError, IndexError, TypeError):
@@ -222,7 +147,7 @@ def test_the_json_schemas_refuse_what_the_loader_refuses():
     the loader; the scene schema refuses an unknown section and an out-of-range parameter."""
     line = jsonschema.Draft202012Validator(sections()["catenary.line_file"].json_schema(top=True))
     n = 0
-    for path, d, required in _leaves(sections()["catenary.line_file"], LINE):
+    for path, d, required in leaves(sections()["catenary.line_file"], LINE):
         node = LINE
         for p in path[:-1]:
             node = node[p]
@@ -292,7 +217,7 @@ def test_every_numeric_key_of_a_line_file_moves_the_fe_or_is_refused_naming_it()
 
     base = signature(base_fe, base_line)
     moved, failed = 0, []
-    for path, d, _ in _leaves(sections()["catenary.line_file"], LINE):
+    for path, d, _ in leaves(sections()["catenary.line_file"], LINE):
         node = LINE
         for p in path[:-1]:
             node = node[p]

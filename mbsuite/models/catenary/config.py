@@ -234,7 +234,8 @@ SECTION = Section("[train]", {
     "spacings": Items(SPACING, max=MAX_PANTOGRAPHS - 1, default=(), unit="m",
                       doc="distances between consecutive contact points (one fewer than pantographs)"),
 }, required=("pantographs",), rules=(Rule("one spacing fewer than pantographs", _one_fewer),),
-    doc="several pantographs on one train")
+    doc="several pantographs on one train",
+    example={"pantographs": ["reference2mass", "reference2mass"], "spacings": [200.0]})
 
 
 def validate_train_section(value: Any) -> dict[str, Any]:

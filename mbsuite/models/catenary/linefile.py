@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import re
 import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -31,7 +32,7 @@ from typing import Any
 
 from ...errors import MbsuiteError, ParameterError, SceneError
 from ...limits import Limit, limit_of
-from ...schema import Items, Rule, Section, of_dataclass
+from ...schema import Items, Rule, Section, of_dataclass, toml_error
 from .irregularity import SECTION as IRREGULARITY
 from .irregularity import check_irregularity
 from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, Support, Wire
@@ -42,6 +43,8 @@ TABLES = ("supports", "droppers", "clamps", "masses")
 MAX_ROWS = 100_000
 #: most wires of one line
 MAX_WIRES = 64
+#: largest line file (bytes)
+MAX_FILE_BYTES = 16_000_000
 
 WIRE = of_dataclass(Wire, "wire", doc="a tensioned wire over [x0, x1]; exactly one has role = 'contact'")
 SUPPORT = Section("support", {"x": limit_of(Support, "x")}, required=("x",),
@@ -65,6 +68,30 @@ def _supports_given(d: Mapping[str, Any]) -> str | None:
     return None if ("supports" in d or "supports_file" in d) else "no supports: give [[supports]] or supports_file"
 
 
+#: an example line file with every kind of row and key (the docs show it, the generated input tests move each key):
+#: two 50 m spans, a stitch wire, tension segments, masses, presag and a random irregularity
+EXAMPLE: dict[str, Any] = {
+    "name": "two spans", "presag": 0.0005,
+    "wires": [
+        {"name": "contact", "role": "contact", "mass": 1.35, "tension": 20000.0, "EI": 195.0, "x0": 0.0, "x1": 100.0},
+        {"name": "messenger", "role": "messenger", "mass": 1.07, "tension": 16000.0, "EI": 131.7, "x0": 0.0,
+         "x1": 100.0, "tension_segments": [[42.0, 58.0, 12500.0]]},
+        {"name": "stitch", "role": "stitch", "mass": 0.31, "tension": 3500.0, "EI": 10.0, "x0": 42.0, "x1": 58.0,
+         "ends": ["free", "free"]},
+    ],
+    "supports": [{"x": 0.0},
+                 {"x": 50.0, "k_contact": 300.0, "k_messenger": 5e4, "m_contact": 1.0, "m_messenger": 0.5},
+                 {"x": 100.0}],
+    "droppers": [{"x": x, "upper": "messenger", "lower": "contact", "k": 1e5} for x in (10.0, 25.0, 40.0, 60.0, 75.0,
+                                                                                       90.0)]
+    + [{"x": 46.0, "upper": "stitch", "lower": "contact", "k": 1e5, "mass": 0.08, "clamp_upper": 0.065,
+        "clamp_lower": 0.165, "law": "linear"}],
+    "clamps": [{"x": 42.0, "a": "stitch", "b": "messenger", "k": 1e7},
+               {"x": 58.0, "a": "stitch", "b": "messenger", "k": 1e7}],
+    "masses": [{"x": 30.0, "wire": "contact", "m": 0.6}],
+    "irregularity": {"seed": 3, "rms": 0.002, "wavelength_min": 2.0, "wavelength_max": 40.0, "n_waves": 200},
+}
+
 #: the declaration of a line file (module docstring); the rows of a CSV table are checked by the same row sections
 LINE_FILE = Section("line file", {
     "name": Limit(kind=str, doc="the line's name (default: the file's stem)"),
@@ -76,7 +103,8 @@ LINE_FILE = Section("line file", {
 }, required=("wires",), rules=(
     *(Rule(f"{t} inline or as {t}_file, not both", _one_source(t), given=True) for t in TABLES),
     Rule("supports are given (inline or as supports_file)", _supports_given, given=True),
-), doc="one tension section: wires, supports, droppers, clamps, point masses, presag and an irregularity")
+), doc="one tension section: wires, supports, droppers, clamps, point masses, presag and an irregularity",
+    example=EXAMPLE)
 
 
 def _rows(data: Mapping[str, Any], table: str, base: Path, where: str) -> list[tuple[dict[str, Any], str]]:
@@ -149,11 +177,20 @@ def read_line_file(path: str | Path) -> tuple[Line, dict[str, Any] | None]:
     by `irregularity.build`)."""
     p = Path(path)
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        size = p.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise SceneError(f"line file {p} is {size:,} bytes; at most {MAX_FILE_BYTES:,} (long tables go in CSV "
+                             "files)")
+        text = p.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
     except OSError as exc:
         raise SceneError(f"cannot read line file {p}: {exc.strerror or exc}") from exc
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SceneError(f"line file {p} is not valid TOML: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"line file {p} is not UTF-8 text (byte {exc.start}): TOML files are UTF-8") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"line file {p} is not valid TOML: {toml_error(exc, text)}") from exc
+    except RecursionError as exc:
+        raise SceneError(f"line file {p} nests arrays or tables too deeply to be a line") from exc
     if "model" in data:
         raise SceneError(f"{p} is a scene (it has model = ...), not a line file")
     line = line_from_dict(data, p.parent, str(p))
@@ -175,9 +212,17 @@ def is_line_file(path: str | Path) -> bool:
     if p.suffix != ".toml" or not p.is_file():
         return False
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+        with open(p, "rb") as fh:
+            head = fh.read(MAX_FILE_BYTES + 1)
+        text = head.decode("utf-8", errors="replace")
+        data = tomllib.loads(text) if len(head) <= MAX_FILE_BYTES else None
+    except OSError:
         return False
+    except (tomllib.TOMLDecodeError, RecursionError):
+        data = None
+    if data is None:  # not readable as TOML: a line file if it says so (its reader then names what is wrong)
+        return re.search(r"^\s*\[\[\s*wires\s*\]\]", text, re.M) is not None and \
+            re.search(r"^\s*model\s*=", text, re.M) is None
     return "wires" in data and "model" not in data
 
 
@@ -205,7 +250,9 @@ LINE_SECTION = Section("[line]", {
     "compound": of_dataclass(CompoundParams, "[line.compound]", doc="the auxiliary wire of kind = 'compound'"),
     "irregularity": IRREGULARITY,
 }, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] only with their kind", _kind_matches,
-               given=True),), doc="the line of a catenary scene")
+               given=True),), doc="the line of a catenary scene",
+    example={"kind": "stitched", "presag": 0.0005, "stitch": {"half_length": 9.0, "k_clamp": 1e7},
+             "irregularity": {"seed": 1, "psd": [[0.01, 1e-6], [0.5, 1e-8]], "dx": 0.05}})
 
 
 def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any]:

@@ -89,7 +89,10 @@ class QualityCriteria:
 #: the declaration of a scene's `[quality]` section: `system` plus any field of `QualityCriteria` (absent: the
 #: system's value, `SYSTEMS`)
 SECTION = Section("[quality]", {f.name: f.metadata["limit"].optional() for f in dataclasses.fields(QualityCriteria)},
-                  doc="EN 50367 / TSI Energy criteria; a key left out takes the value of the system (default AC)")
+                  doc="EN 50367 / TSI Energy criteria; a key left out takes the value of the system (default AC)",
+                  example={"system": "DC3kV", "fm_a": 0.00097, "fm_b": 110.0, "fm_b_lower": 80.0,
+                           "sigma_ratio_max": 0.3, "stat_min_floor": 0.0, "loss_max_pct": 0.2, "nq_max_pct": 0.1,
+                           "arc_min_duration": 0.0, "uplift_max": 0.12})
 
 
 def validate_section(value: Any) -> dict[str, Any]:

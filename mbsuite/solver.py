@@ -42,21 +42,9 @@ class SolverSettings:
         through `where(key)` (a phrase with a leading space; `where()` for a check across settings), where its value
         came from. Returns the settings with every number as a Python float (any real number type is accepted)."""
         w = where or (lambda key=None: "")
-        for name in ("engine", "integrator", "method"):
-            v = getattr(self, name)
-            if not isinstance(v, str):
-                raise SceneError(f"solver.{name} = {v!r}{w(name)} must be a string")
-        if self.engine not in engines:
-            raise SceneError(f"solver.engine = {self.engine!r}{w('engine')} is not available; valid engines: "
-                             f"{list(engines)}")
-        if self.integrator not in INTEGRATORS:
-            raise SceneError(f"solver.integrator = {self.integrator!r}{w('integrator')}; valid integrators: "
-                             f"{list(INTEGRATORS)}")
-        if self.method not in SCIPY_METHODS:
-            raise SceneError(f"solver.method = {self.method!r}{w('method')}; valid methods: {list(SCIPY_METHODS)}")
-        if not isinstance(self.allow_inaccurate, bool):
-            raise SceneError(f"solver.allow_inaccurate = {self.allow_inaccurate!r}{w('allow_inaccurate')} must be "
-                             "true or false")
+        words = {"engine": Limit(kind=str, choices=tuple(engines), doc="the path that runs the scene"), **SOLVER_WORDS}
+        for name, lim in words.items():
+            lim.check(f"solver.{name}", getattr(self, name), SceneError, w(name))
         s = dataclasses.replace(self, **{name: lim.check(f"solver.{name}", getattr(self, name), SceneError, w(name))
                                          for name, lim in SOLVER_LIMITS.items()})
         if s.t_settle >= s.duration:
@@ -81,6 +69,13 @@ class SolverSettings:
                              f"({s.duration} s){w()}")
         return s
 
+
+#: the valid words of the solver's word settings (`engine`'s are the model's paths)
+SOLVER_WORDS = {
+    "integrator": Limit(kind=str, choices=INTEGRATORS, doc="MuJoCo's integrator"),
+    "method": Limit(kind=str, choices=SCIPY_METHODS, doc="scipy's method on the reference path"),
+    "allow_inaccurate": Limit(kind=bool, doc="keep a result whose health figures exceed their bounds (loudly)"),
+}
 
 # the valid range of every numeric solver setting (the error message and the docs read this table)
 SOLVER_LIMITS = {

@@ -30,6 +30,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import copy
+import dataclasses
 import json
 import math
 import os
@@ -1285,6 +1286,30 @@ def declared_attempts() -> Iterator[Attempt]:
                 yield Attempt(f"declared-{name}-{tag}-{label.replace(' ', '-')}", a,
                               f"{name} {tag}: {label}", "error", cmd, culprit=leaf,
                               files=(("input.toml", text.encode()),))
+    # every model's [params] and [input] keys and the [solver] settings, each in a scene file (the scene files of
+    # the original corpus above try -inf, huge values, bools and the rest on a sample of them)
+    from mbsuite.registry import models
+    from mbsuite.solver import SOLVER_LIMITS, SOLVER_WORDS
+
+    per_key = {"text", "nan", "inf", "below", "above", "fraction", "unknown word", "number"}
+    for model, spec in models().items():
+        keys = [("params", f.name, f.metadata["limit"]) for f in dataclasses.fields(spec.params_cls)
+                if "limit" in f.metadata]
+        keys += [("input", k, d) for keys_ in spec.inputs.values() for k, d in keys_.items() if isinstance(d, Limit)]
+        if model == "pantograph":  # one model's scene for the settings every model shares
+            keys += [("solver", k, d) for k, d in {**SOLVER_LIMITS, **SOLVER_WORDS}.items()]
+        for section, key, decl in keys:
+            itype = next((t for t, ks in spec.inputs.items() if key in ks), None) if section == "input" else None
+            good = decl.default if decl.has_default else None
+            cases = [(lab, v) for lab, v in bad_values(decl) if lab in per_key]
+            if good is not None and not isinstance(good, list | tuple):
+                cases.append(("duplicate", Twice(good)))
+            for label, value in cases:
+                table = {key: value, **({"type": itype} if itype else {})}
+                text = f"model = {json.dumps(model)}\n" + toml_text({section: table})
+                yield Attempt(f"declared-{model}.{section}-{key}-{label.replace(' ', '-')}", a,
+                              f"{model} {section}.{key}: {label}", "error", ("run", f"{DIR}/input.toml", "--json"),
+                              culprit=key, files=(("input.toml", text.encode()),))
 
 
 def corpus() -> list[Attempt]:

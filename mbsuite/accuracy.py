@@ -33,6 +33,7 @@ from typing import Any
 
 from .errors import SceneError
 from .health import Figure
+from .limits import Limit
 from .solver import SOLVER_LIMITS
 
 #: safety factors of the grid-convergence index (Roache 1998): three levels in the asymptotic range, else two levels
@@ -198,18 +199,16 @@ def estimate(levels: list[Mapping[str, float]], headlines: tuple[Headline, ...],
     return out
 
 
+#: a tolerance of the scene's `[accuracy]` section (headline name = tolerance, in the headline's unit)
+TOLERANCE = Limit(lo=0.0, lo_open=True, unit="in the headline's unit", doc="tolerance of a headline output")
+
+
 def check_tolerances(section: Any, where: str = "") -> dict[str, float]:
     """The scene's `[accuracy]` section: headline name -> positive finite tolerance (names are checked against the
     model's headlines by `declared`)."""
     if not isinstance(section, Mapping):
         raise SceneError(f"[accuracy]{where} must be a table of headline = tolerance")
-    out = {}
-    for k, v in section.items():
-        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
-            raise SceneError(f"accuracy.{k} = {v!r}{where} must be a positive finite number (the tolerance, in the "
-                             "headline's unit)")
-        out[str(k)] = float(v)
-    return out
+    return {str(k): TOLERANCE.check(f"accuracy.{k}", v, SceneError, where) for k, v in section.items()}
 
 
 def declared(scene: Any) -> tuple[Headline, ...]:

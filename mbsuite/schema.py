@@ -276,9 +276,12 @@ def toml_error(exc: Exception, text: str) -> str:
     line 12, column 7)", which names no key; the quoted line does)."""
     m = re.search(r"at line (\d+)", str(exc))
     lines = text.splitlines()
-    if m is None or not 0 < int(m.group(1)) <= len(lines):
+    if m is not None and 0 < int(m.group(1)) <= len(lines):
+        line = lines[int(m.group(1)) - 1].strip()
+    elif "end of document" in str(exc) and any(x.strip() for x in lines):
+        line = next(x for x in reversed(lines) if x.strip()).strip()  # the last line
+    else:
         return str(exc)
-    line = lines[int(m.group(1)) - 1].strip()
     hint = " (a key or table given twice)" if "overwrite" in str(exc).lower() else ""
     return f"{exc}: `{line[:200]}`{hint}"
 

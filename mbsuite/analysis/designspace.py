@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import copy
 import functools
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -19,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import MbsuiteError
+from ..limits import Limit
+from ..schema import Rule, Section
 
 if TYPE_CHECKING:
     from ..scenes import Scene
@@ -38,19 +39,28 @@ class Factor:
     hi: float
 
     def __post_init__(self) -> None:
-        for name in ("lo", "hi"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating) or not math.isfinite(v):
-                raise MbsuiteError(f"range of {self.label}: {name} = {v!r} is invalid; valid: a finite number")
-            object.__setattr__(self, name, float(v))
-        if not self.lo < self.hi:
-            raise MbsuiteError(f"range of {self.label}: lower bound {self.lo:g} must lie below the upper bound "
-                               f"{self.hi:g}")
+        data = {f: getattr(self, f) for f in FACTOR_INPUTS.keys}
+        for name, v in FACTOR_INPUTS.check(data, f"the range of {self.label}", MbsuiteError).items():
+            object.__setattr__(self, name, v)
 
     @property
     def label(self) -> str:
         """`section.key`, the factor's name in points, tables and files."""
         return f"{self.section}.{self.key}"
+
+
+def _ordered(c: dict[str, Any]) -> str | None:
+    return None if c["lo"] < c["hi"] else (f"lower bound {c['lo']:g} must lie below the upper bound {c['hi']:g} "
+                                           "(lo < hi)")
+
+
+#: a study range (`Factor`): the bounds in the varied key's own SI unit, lo < hi
+FACTOR_INPUTS = Section("study range (Factor)", {
+    "section": Limit(kind=str, doc="scene section (input, params, solver, effects or a model's own)"),
+    "key": Limit(kind=str, doc="key in the section (dotted into a model's own section)"),
+    "lo": Limit(doc="lower bound (the key's SI unit)"),
+    "hi": Limit(doc="upper bound (the key's SI unit)"),
+}, required=("section", "key", "lo", "hi"), rules=(Rule("lo < hi", _ordered),))
 
 
 def parse_factor(text: str, sections: Sequence[str], flag: str = "--vary") -> Factor:

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import MbsuiteError
+from ..limits import Limit, real
 from .designspace import Factor, evaluate, factors_for, headline_units, point_scene, scene_evaluator
 
 if TYPE_CHECKING:
@@ -44,6 +45,14 @@ if TYPE_CHECKING:
 
 AGGREGATES = ("worst", "mean")
 BAND_SYSTEMS = ("AC", "DC3kV", "DC1.5kV")
+#: the numbers `run` and `pareto` take, declared once (`Limit.check`: numpy scalars too; bools, NaN, inf refused)
+BOUND = Limit(doc="a bound on a headline output (its unit)")
+LIMITS = {"penalty": Limit(lo=0.0, lo_open=True, doc="objective units per unit of constraint violation"),
+          "tol": Limit(lo=0.0, lo_open=True, doc="scipy's relative convergence tolerance"),
+          "maxiter": Limit(lo=1, hi=10_000, kind=int, doc="generations of differential evolution"),
+          "popsize": Limit(lo=2, hi=1000, kind=int, doc="members per factor"),
+          "seed": Limit(lo=0, hi=2**32 - 1, kind=int, doc="seed of the optimiser"),
+          "level": Limit(doc="a level of the traded output (its unit)")}
 
 
 @dataclass(frozen=True)
@@ -61,10 +70,9 @@ class Bound:
         if self.band is not None and self.band not in BAND_SYSTEMS:
             raise MbsuiteError(f"constraint band {self.band!r} is unknown; valid: {', '.join(BAND_SYSTEMS)}")
         for name in ("lo", "hi"):
-            v = getattr(self, name)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, int | float | np.number)
-                                  or not math.isfinite(v)):
-                raise MbsuiteError(f"constraint on {self.output}: {name} = {v!r} is invalid; valid: a finite number")
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, BOUND.check(f"constraint on {self.output}: {name}",
+                                                           getattr(self, name), MbsuiteError))
         if self.band is None and self.lo is None and self.hi is None:
             raise MbsuiteError(f"constraint on {self.output}: give a lower bound, an upper bound or both")
         if self.lo is not None and self.hi is not None and self.lo > self.hi:
@@ -300,17 +308,13 @@ class _Problem:
         return [a + self.penalty * v for a, v, _ in self.evaluate(xs)]
 
 
-def _check(objective: Any, aggregate: str, penalty: Any, maxiter: Any, popsize: Any, seed: Any) -> None:
+def _check(objective: Any, aggregate: str, **numbers: Any) -> dict[str, Any]:
+    """`numbers` (penalty, tol, maxiter, popsize, seed) checked against `LIMITS`, as Python floats and ints."""
     if not isinstance(objective, str) or not objective:
         raise MbsuiteError(f"optimise objective {objective!r} is invalid; valid: an output name (e.g. sigma)")
     if aggregate not in AGGREGATES:
         raise MbsuiteError(f"optimise aggregate {aggregate!r} is unknown; valid: {', '.join(AGGREGATES)}")
-    if isinstance(penalty, bool) or not isinstance(penalty, int | float | np.number) or not 0 < penalty < math.inf:
-        raise MbsuiteError(f"optimise penalty = {penalty!r} is invalid; valid: (0, inf) per unit of violation")
-    for name, v, lo, hi in (("maxiter", maxiter, 1, 10_000), ("popsize", popsize, 2, 1000),
-                            ("seed", seed, 0, 2**32 - 1)):
-        if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
-            raise MbsuiteError(f"optimise {name} = {v!r} is invalid; valid: an integer in [{lo}, {hi}]")
+    return {k: LIMITS[k].check(f"optimise {k}", v, MbsuiteError) for k, v in numbers.items()}
 
 
 def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: Sequence[Factor | str], *,
@@ -328,7 +332,8 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
 
     from ..scenes import Scene
 
-    _check(objective, aggregate, penalty, maxiter, popsize, seed)
+    checked = _check(objective, aggregate, penalty=penalty, tol=tol, maxiter=maxiter, popsize=popsize, seed=seed)
+    penalty, tol, maxiter, popsize, seed = (checked[k] for k in ("penalty", "tol", "maxiter", "popsize", "seed"))
     scene = target if isinstance(target, Scene) else None
     facs = factors_for(scene, factors)
     cons = [parse_bound(c) if isinstance(c, str) else c for c in constraints]
@@ -392,9 +397,9 @@ def _start(scene: Scene | None, facs: list[Factor], start: Mapping[str, float] |
                 node = node.get(k) if isinstance(node, Mapping) else None
             if node is None:
                 node = _declared_default(scene, f)
-            if isinstance(node, bool) or not isinstance(node, int | float):
+            if real(node) is None:
                 return None
-            vals.append(float(node))
+            vals.append(float(real(node)))
         x = np.array(vals)
     else:
         return None
@@ -556,8 +561,8 @@ def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factor
     `kwargs` go to `run` (constraints, over, maxiter, popsize, seed, workers, options)."""
     from ..scenes import Scene
 
-    lv = [float(x) for x in levels]
-    if not lv or not all(math.isfinite(x) for x in lv):
+    lv = [LIMITS["level"].check("pareto level", x, MbsuiteError) for x in levels]
+    if not lv:
         raise MbsuiteError(f"pareto levels {levels!r}: give one or more finite numbers")
     base = [parse_bound(c) if isinstance(c, str) else c for c in kwargs.pop("constraints", ())]
     runs = [run(target, factors, objective=objective, constraints=[*base, Bound(against, lo=x)], **kwargs)

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import MbsuiteError
+from ..limits import Limit
 from .designspace import Factor, evaluate, factors_for, headline_units, output_names, scene_evaluator
 
 if TYPE_CHECKING:
@@ -36,6 +37,11 @@ if TYPE_CHECKING:
 
 METHODS = ("morris", "sobol")
 MAX_N = 2**16
+#: the numbers `run` takes, declared once (`Limit.check`: numpy scalars too; bools, NaN, inf refused)
+LIMITS = {"n": Limit(lo=2, hi=MAX_N, kind=int, doc="morris trajectories or sobol base sample"),
+          "seed": Limit(lo=0, hi=2**32 - 1, kind=int, doc="seed of the sample and the bootstrap"),
+          "levels": Limit(lo=2, hi=MAX_N, kind=int, doc="morris grid levels"),
+          "conf_level": Limit(lo=0.0, hi=1.0, lo_open=True, hi_open=True, doc="confidence level of the intervals")}
 
 
 def ishigami(point: Mapping[str, float], a: float = 7.0, b: float = 0.1) -> dict[str, float]:
@@ -185,18 +191,13 @@ class SensitivityResult:
 def _check(method: str, n: Any, seed: Any, levels: Any, conf_level: Any) -> tuple[int, int, int, float]:
     if method not in METHODS:
         raise MbsuiteError(f"sensitivity method {method!r} is unknown; valid: {', '.join(METHODS)}")
-    for name, v, lo in (("n", n, 2), ("seed", seed, 0), ("levels", levels, 2)):
-        if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= (MAX_N if name != "seed"
-                                                                                         else 2**32 - 1):
-            raise MbsuiteError(f"sensitivity {name} = {v!r} is invalid; valid: an integer >= {lo}")
+    given = {"n": n, "seed": seed, "levels": levels, "conf_level": conf_level}
+    n, seed, levels, conf_level = (LIMITS[k].check(f"sensitivity {k}", v, MbsuiteError) for k, v in given.items())
     if method == "sobol" and int(n) & (int(n) - 1):
         raise MbsuiteError(f"sensitivity n = {n} is invalid for sobol; valid: a power of two (Sobol' sequence)")
     if method == "morris" and int(levels) % 2:
         raise MbsuiteError(f"sensitivity levels = {levels} is invalid for morris; valid: an even number")
-    if isinstance(conf_level, bool) or not isinstance(conf_level, int | float | np.number) \
-            or not 0.0 < float(conf_level) < 1.0:
-        raise MbsuiteError(f"sensitivity conf_level = {conf_level!r} is invalid; valid: (0, 1)")
-    return int(n), int(seed), int(levels), float(conf_level)
+    return n, seed, levels, conf_level
 
 
 def sample(method: str, factors: Sequence[Factor], n: int, seed: int, levels: int = 4) -> np.ndarray:

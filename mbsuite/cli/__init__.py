@@ -11,6 +11,8 @@ once).
 
 Every command that reads a scene also takes a `summary.json` an earlier command wrote (the scene it ran), and the
 model analyses take `--set SECTION.KEY=VALUE` and `--vary SECTION.KEY=VALUES` (a parameter study of the analysis).
+Every flag that changes the scene is composed by one rule before the command runs (`options.overrides`): a key set
+twice, or a key and a key inside it, is an error naming both flags.
 
 The package: `parser.py` (the parser, the model groups), `commands.py` (the generic commands), `sweep.py` (`mbsuite
 sweep`), `study.py` (`--set`/`--vary` on the analyses), `options.py` (options several commands share), `output.py`
@@ -24,6 +26,7 @@ import sys
 from collections.abc import Sequence
 
 from ..errors import MbsuiteError
+from .options import overrides
 from .output import check_out, fail, quiet_stdout
 from .parser import UsageError, build_parser, parser_for
 
@@ -45,6 +48,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     as_json = bool(getattr(args, "json", False))
     try:
         check_out(getattr(args, "out", None))
+        overrides(args)  # the one rule over every flag that changes the scene, before anything loads or runs
         args.func(args)
     except MbsuiteError as exc:
         return fail(str(exc), as_json, type(exc).__name__)

@@ -4,18 +4,25 @@ options, calls the suite's API and hands the result to `emit`; none of them does
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from pathlib import Path
 
 from .. import registry
 from ..errors import MbsuiteError
+from ..limits import Limit
 from ..results import Report, format_table
 from ..scenes import load_scene
 from .options import MAX_REPEATS, load, scene_of
 from .output import emit, wrap
 from .study import apply_sets
+
+#: the numbers of the generic commands' flags, declared once (`Limit.check` names the flag)
+FLAGS = {"--width": Limit(lo=16, hi=8192, kind=int, unit="pixels", doc="image width or height"),
+         "--repeats": Limit(lo=1, hi=MAX_REPEATS, kind=int, doc="runs per setting; the wall time is their median"),
+         "--draws": Limit(lo=1, hi=MAX_REPEATS, kind=int, doc="perturbed copies per eps"),
+         "--eps": Limit(lo=0.0, hi=1e-3, lo_open=True, hi_open=True, doc="a relative perturbation"),
+         "--duration": Limit(lo=0.0, lo_open=True, unit="s", doc="shortened run")}
 
 ANALYSES = ("run", "equilibrium", "modes", "freqresp", "view", "render")
 
@@ -88,8 +95,7 @@ def cmd_render(args: argparse.Namespace) -> None:
     if path.suffix.lower() != ".png":
         raise MbsuiteError(f"--out {args.image}: give a .png file")
     for flag, v in (("--width", args.width), ("--height", args.height)):
-        if not 16 <= v <= 8192:
-            raise MbsuiteError(f"{flag} {v} is invalid; valid: integer in [16, 8192] (pixels)")
+        FLAGS["--width"].check(flag, v, MbsuiteError)
     scene = apply_sets(load(args), args.set_values)
     if scene.spec.mujoco_model is None:
         raise MbsuiteError(f"model '{scene.model}' has no MuJoCo model to render")
@@ -128,9 +134,7 @@ def cmd_workprecision(args: argparse.Namespace) -> None:
     from ..analysis.workprecision import workprecision
 
     scene = scene_of(args.scene)
-    if not 1 <= args.repeats <= MAX_REPEATS:
-        raise MbsuiteError(f"--repeats {args.repeats} is invalid; valid: integer in [1, {MAX_REPEATS}] (runs per "
-                           "setting; the wall time is their median)")
+    FLAGS["--repeats"].check("--repeats", args.repeats, MbsuiteError)
     progress = print_progress if args.verbose else None
     emit(workprecision(scene, repeats=args.repeats, quick=args.quick, progress=progress), args, scene.to_dict())
 
@@ -191,12 +195,10 @@ def cmd_perturb(args: argparse.Namespace) -> None:
     except ValueError as exc:
         raise MbsuiteError(f"--eps {args.eps!r} is not a comma list of numbers, e.g. 1e-12,1e-9") from exc
     for e in epsilons:
-        if not (math.isfinite(e) and 0.0 < e < 1e-3):
-            raise MbsuiteError(f"--eps {e!r} is invalid; valid: (0, 1e-3) (a relative perturbation)")
-    if not 1 <= args.draws <= MAX_REPEATS:
-        raise MbsuiteError(f"--draws {args.draws} is invalid; valid: integer in [1, {MAX_REPEATS}]")
-    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
-        raise MbsuiteError(f"--duration {args.duration!r} is invalid; valid: (0, inf) s")
+        FLAGS["--eps"].check("--eps", e, MbsuiteError)
+    FLAGS["--draws"].check("--draws", args.draws, MbsuiteError)
+    if args.duration is not None:
+        FLAGS["--duration"].check("--duration", args.duration, MbsuiteError)
     scenes = []
     if not args.hardcases_only:
         names = args.target or sorted(registry.models())

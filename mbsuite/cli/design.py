@@ -9,9 +9,17 @@ import argparse
 from typing import Any
 
 from ..errors import MbsuiteError
+from ..limits import Limit
+from ..schema import Items, check_value
 from .options import check_workers, load, sweep_options
 from .output import emit
 from .study import apply_sets
+
+#: `--start SECTION.KEY=VALUE`: one number, in the key's SI unit (its range is the factor's, checked by the study)
+START_VALUE = Items(Limit(doc="start value of a varied key"), min=1, max=1, doc="--start: one number (the key's unit)")
+#: `--pareto a,b,c`: the levels of the `--against` output the front is traced at (its unit)
+PARETO_LEVELS = Items(Limit(doc="a level of the --against output"), min=1, max=1000,
+                      doc="--pareto: levels of the --against output (its unit)")
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> None:
@@ -54,10 +62,8 @@ def start_design(scene: Any, texts: list[str] | None) -> dict[str, float] | None
     out = {}
     for text in texts:
         section, key, value = split_key(text, "--start", (*SECTIONS, *scene.spec.sections))
-        vals = parse_values(value)
-        if len(vals) != 1 or not isinstance(vals[0], float):
-            raise MbsuiteError(f"--start {text!r}: give one number")
-        out[f"{section}.{key}"] = vals[0]
+        (out[f"{section}.{key}"],) = check_value(START_VALUE, f"--start {section}.{key}", parse_values(value),
+                                                 "the command line", MbsuiteError)
     return out
 
 
@@ -81,9 +87,8 @@ def cmd_optimise(args: argparse.Namespace) -> None:
     if args.pareto:
         from ..analysis.sweep import parse_values
 
-        levels = parse_values(args.pareto)
-        if not all(isinstance(v, float) for v in levels):
-            raise MbsuiteError(f"--pareto {args.pareto!r}: levels must be numbers")
+        levels = check_value(PARETO_LEVELS, "--pareto", parse_values(args.pareto),
+                             "the command line", MbsuiteError)
         res = optimise.pareto(scene, args.vary or [], against=args.against, levels=levels, **common)
         emit(res.report(), args, scene.to_dict())
         return

@@ -1,11 +1,22 @@
 """Options several commands share, added to a parser and read back checked: the scene and its solver overrides
-(`add_scene_options`, `load`), where a sweep runs (`add_sweep_options`, `sweep_options`), worker and repeat counts.
-Model command groups use them too."""
+(`add_scene_options`, `load`), where a sweep runs (`add_sweep_options`, `sweep_options`), worker and repeat counts,
+and the one rule that composes the flags changing a scene (`overrides`). Model command groups use them too.
+
+The rule (`overrides`, applied by `mbsuite.cli.main` to every command before it runs): every flag that changes the
+scene a command reads is declared below, either as `SECTION.KEY=VALUE` entries (`--set`, `--vary`, `--over`) or as a
+flag that sets one scene key (`--speed` sets input.speed, `--engine` solver.engine, ...). All of a command's flags
+are read into one mapping dotted key -> `Override` (the flag and its value); a key given twice (by one flag or two,
+even with the same value) or a key together with a key inside it (`pantograph.params` and `pantograph.params.F0`) is
+an error naming both flags. A dotted key reaches into a scene section by one function (`resolve`: the section must
+be the scene's, the rest of the key is nested into it as the design studies do), so every command takes every key
+the scene has."""
 
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from ..analysis.sweep.options import EXECUTORS, MAX_POINTS
 from ..errors import MbsuiteError
@@ -13,6 +24,102 @@ from ..errors import MbsuiteError
 if TYPE_CHECKING:
     from ..analysis.sweep import SweepOptions
     from ..scenes import Scene
+
+#: the scene sections every model has (a model adds its own: `ModelSpec.sections`)
+SCENE_SECTIONS = ("input", "params", "solver", "effects")
+#: flags of `SECTION.KEY=VALUE` entries (repeatable): argparse dest -> flag
+ENTRY_FLAGS = {"set_values": "--set", "vary": "--vary", "over": "--over"}
+#: flags that set one scene key: argparse dest -> (flag, the dotted key it sets); given when not None and not False
+SCENE_FLAGS = {"engine": ("--engine", "solver.engine"), "max_steps": ("--max-steps", "solver.max_steps"),
+               "allow_inaccurate": ("--allow-inaccurate", "solver.allow_inaccurate"),
+               "timestep": ("--timestep", "solver.timestep"), "duration": ("--duration", "solver.duration"),
+               "element_length": ("--element-length", "params.element_length"),
+               "speed": ("--speed", "input.speed"), "spacings": ("--spacings", "train.spacings")}
+#: `--start SECTION.KEY=VALUE` (optimise): a start value per key, composed on its own (each key once)
+START_FLAG = ("start", "--start")
+
+
+@dataclass(frozen=True)
+class Override:
+    """One scene key a flag sets: the flag, the dotted key, its value (the text after `=` of an entry, else the
+    flag's value) and how the command line gave it (`text`, for messages)."""
+
+    flag: str
+    key: str
+    value: Any
+    text: str
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def parse_override(flag: str, text: str) -> Override:
+    """`SECTION.KEY=VALUE` (KEY may be dotted: `pantograph.params.F0`) as an `Override` of `flag`; an error naming the
+    flag and the text unless every part of the key is a non-empty name."""
+    key, sep, value = str(text).partition("=")
+    parts = [p.strip() for p in key.split(".")]
+    if not sep or len(parts) < 2 or not all(parts):
+        what = "VALUE" if flag in ("--set", "--start") else "VALUES"
+        raise MbsuiteError(f"{flag} {text!r}: expected SECTION.KEY={what} (e.g. params.mh=14; a KEY may reach into a "
+                           "model's section: pantograph.params.F0=100)")
+    return Override(flag, ".".join(parts), value, f"{flag} {text}")
+
+
+def compose(items: Iterable[Override]) -> dict[str, Override]:
+    """The rule: dotted key -> its `Override`; a key given twice (even with the same value), or a key and a key
+    inside it, is an error naming both flags."""
+    out: dict[str, Override] = {}
+    for new in items:
+        for old in out.values():
+            if old.key == new.key:
+                same = " (to the same value)" if str(old.value).strip() == str(new.value).strip() else ""
+                raise MbsuiteError(f"{old} and {new} both set {new.key}{same}; give one")
+            outer, inner = (old, new) if new.key.startswith(old.key + ".") else (new, old)
+            if inner.key.startswith(outer.key + "."):
+                raise MbsuiteError(f"{old} and {new} both set {inner.key} ({outer.key} holds it); give one")
+        out[new.key] = new
+    return out
+
+
+def overrides(args: argparse.Namespace) -> dict[str, Override]:
+    """Every scene override of a command line (`ENTRY_FLAGS`, `SCENE_FLAGS`) composed by the one rule (`compose`),
+    and `--start` composed on its own; an error naming both flags of any conflict."""
+    items = [parse_override(flag, text) for dest, flag in ENTRY_FLAGS.items()
+             for text in getattr(args, dest, None) or []]
+    for dest, (flag, key) in SCENE_FLAGS.items():
+        v = getattr(args, dest, None)
+        if v is not None and v is not False:
+            shown = flag if v is True else f"{flag} {' '.join(map(str, v)) if isinstance(v, list) else v}"
+            items.append(Override(flag, key, v, shown))
+    compose(parse_override(START_FLAG[1], t) for t in getattr(args, START_FLAG[0], None) or [])
+    return compose(items)
+
+
+def scene_sections(scene: Scene) -> tuple[str, ...]:
+    """The sections a key of `scene` may name: every model's and the model's own."""
+    return (*SCENE_SECTIONS, *scene.spec.sections)
+
+
+def resolve(scene: Scene, values: Mapping[Override, Any]) -> dict[str, Any]:
+    """The one resolution of dotted keys into scene sections: `Scene.replace` sections setting each override's key
+    to its value (`designspace.sections_for`: a dotted key's enclosing tables copied from the scene so that only the
+    named value changes); an error naming the flag if a key's section is not one of the scene's."""
+    from ..analysis.designspace import sections_for
+
+    for o in values:
+        section_of(o, scene_sections(scene))
+    return sections_for(scene.to_dict(), {o.key: v for o, v in values.items()})
+
+
+def section_of(o: Override, sections: tuple[str, ...]) -> tuple[str, str]:
+    """(section, the rest of the key) of an override; an error naming the flag unless the section is in
+    `sections`."""
+    section, _, name = o.key.partition(".")
+    if section not in sections:
+        example = "params.mh=14" if "params" in sections else "option.gamma=0.3"
+        raise MbsuiteError(f"{o}: expected SECTION.KEY={'VALUE' if o.flag in ('--set', '--start') else 'VALUES'} "
+                           f"with SECTION in {', '.join(sections)} (e.g. {example})")
+    return section, name
 
 MAX_REPEATS = 100
 SCENE_HELP = "scene TOML path, model name (default scene), model/scene or a summary.json (the scene it ran)"
@@ -38,7 +145,8 @@ def add_error_estimate(p: argparse.ArgumentParser) -> None:
 
 def load(args: argparse.Namespace) -> Scene:
     """The command's scene with the command-line solver overrides applied (and validated); `--engine` may name a
-    path by its key or its label (`mbsuite list`)."""
+    path by its key or its label (`mbsuite list`). The command line's overrides are composed first (`overrides`)."""
+    overrides(args)
     scene = scene_of(args.scene)
     solver: dict = {}
     engine = getattr(args, "engine", None)
@@ -84,14 +192,16 @@ def add_sweep_options(p: argparse.ArgumentParser) -> None:
 def sweep_options(args: argparse.Namespace) -> SweepOptions:
     """The `SweepOptions` of `--executor/--scheduler/--store/--max-points` (checked here, once)."""
     from ..analysis.sweep import SweepOptions
+    from ..analysis.sweep.options import check_max_points
 
     max_points = getattr(args, "max_points", None)
     return SweepOptions(executor=getattr(args, "executor", None), scheduler=getattr(args, "scheduler", None),
-                        store=getattr(args, "store", None), max_points=MAX_POINTS if max_points is None else max_points)
+                        store=getattr(args, "store", None),
+                        max_points=MAX_POINTS if max_points is None else check_max_points(max_points, "--max-points"))
 
 
-def check_workers(workers: int) -> int:
-    """`--workers N`: processes or threads, 0 = all cores."""
-    if workers < 0:
-        raise MbsuiteError(f"--workers {workers} must be >= 0 (0: all cores)")
-    return workers
+def check_workers(workers: Any) -> int:
+    """`--workers N`: processes or threads, 0 = all cores (an integer, numpy's too)."""
+    from ..limits import Limit
+
+    return Limit(lo=0, kind=int, doc="processes or threads, 0 = all cores").check("--workers", workers, MbsuiteError)

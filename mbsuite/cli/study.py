@@ -20,12 +20,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import MbsuiteError
+from .options import SCENE_SECTIONS
 
 if TYPE_CHECKING:
     from ..results import Report
     from ..scenes import Scene
 
-SECTIONS = ("input", "params", "solver", "effects")
+SECTIONS = SCENE_SECTIONS
 MAX_LIST = 16  # a list of numbers longer than this is a curve or a time series, not a quantity of the study
 
 
@@ -54,30 +55,29 @@ def add_study_options(p: argparse.ArgumentParser, scene: bool = True) -> None:
 
 
 def split_key(text: str, flag: str, sections: tuple[str, ...]) -> tuple[str, str, str]:
-    """`SECTION.KEY=VALUE` as (section, key, value text); an error naming the flag and the valid sections."""
-    key, sep, value = text.partition("=")
-    section, dot, name = key.strip().partition(".")
-    if not sep or not dot or not name or section not in sections:
-        example = "params.mh=14" if "params" in sections else "option.gamma=0.3"
-        raise MbsuiteError(f"{flag} {text!r}: expected SECTION.KEY={'VALUE' if flag == '--set' else 'VALUES'} with "
-                           f"SECTION in {', '.join(sections)} (e.g. {example})")
-    return section, name, value
+    """`SECTION.KEY=VALUE` as (section, key, value text), read by the one override reader (`options.parse_override`:
+    KEY may be dotted into a model's section); an error naming the flag and the valid sections."""
+    from .options import parse_override, section_of
+
+    o = parse_override(flag, text)
+    return (*section_of(o, sections), o.value)
 
 
 def apply_sets(scene: Scene, sets: list[str] | None) -> Scene:
     """The scene with every `--set SECTION.KEY=VALUE` applied (values parsed as `mbsuite sweep` parses them; a
-    comma list is a list); errors name the key, the value and the command line."""
+    comma list is a list; a dotted KEY reaches into a model's section: `pantograph.params.F0=100`), composed and
+    resolved by the one rule (`options.compose`, `options.resolve`); errors name the key, the value and the command
+    line."""
     from ..analysis.sweep import parse_values
+    from .options import compose, parse_override, resolve
 
     if not sets:
         return scene
-    sections: dict[str, dict[str, Any]] = {}
-    for text in sets:
-        section, name, value = split_key(text, "--set", (*SECTIONS, *scene.spec.sections))
-        values = parse_values(value)
-        sections.setdefault(section, {})[name] = values[0] if len(values) == 1 else values
-    flags = ", ".join(sets)
-    return scene.replace(origin=f"on the command line (--set {flags})", **sections)
+    values = {}
+    for o in compose(parse_override("--set", text) for text in sets).values():
+        parsed = parse_values(o.value)
+        values[o] = parsed[0] if len(parsed) == 1 else parsed
+    return scene.replace(origin=f"on the command line (--set {', '.join(sets)})", **resolve(scene, values))
 
 
 def flatten(data: Any, prefix: str = "") -> dict[str, float]:
@@ -128,8 +128,10 @@ def run_or_study(args: argparse.Namespace, scene: Scene | None, target: str, *, 
     """Emit the command's report for `scene` (with `--set` applied; None: a command without a scene) or, with
     `--vary`, the study over the grid. `units`: the SI unit of a quantity by its last name (`f_n` -> Hz).
     `parallel_inside`: the analysis runs its own workers, so the study's points run one after another."""
+    from .options import overrides
     from .output import emit
 
+    overrides(args)  # the one rule over every override flag (main applies it too)
     if scene is not None:
         scene = apply_sets(scene, getattr(args, "set_values", None))
     out = getattr(args, "emit", None) or emit
@@ -145,16 +147,19 @@ def study_axes(args: argparse.Namespace, scene: Scene | None, max_points: int) -
     """(section, key, values) of each `--vary`: scene sections, or `option` (a command without a scene: one of its
     options by name); the grid's size checked before it is built."""
     from ..analysis.sweep import check_grid, parse_values
+    from .options import overrides, scene_sections, section_of
 
-    sections = SECTIONS if scene is not None else ("option",)
+    sections = scene_sections(scene) if scene is not None else ("option",)
     meta = {"command", "executor", "scheduler", "max_points", "workers", "max_n"}
     options = {k for k in point_options(args) if k not in meta and not k.endswith("_command")}
     axes = []
-    for text in args.vary:
-        section, name, values = split_key(text, "--vary", sections)
+    for o in overrides(args).values():
+        if o.flag != "--vary":
+            continue
+        section, name = section_of(o, sections)
         if section == "option" and name not in options:
-            raise MbsuiteError(f"--vary {text!r}: this command has no option {name!r}; valid: {sorted(options)}")
-        axes.append((section, name, parse_values(values, max_points=max_points)))
+            raise MbsuiteError(f"{o}: this command has no option {name!r}; valid: {sorted(options)}")
+        axes.append((section, name, parse_values(o.value, max_points=max_points)))
     check_grid([len(a[2]) for a in axes], max_points=max_points, what="--vary grid")
     return axes
 
@@ -163,6 +168,7 @@ def study(args: argparse.Namespace, scene: Scene | None, target: str, *, units: 
           parallel_inside: bool = False) -> Report:
     """Run `target` at every point of the `--vary` grid (every scene point validated before anything runs) and
     report."""
+    from ..analysis.designspace import sections_for
     from ..analysis.sweep import run_sweep
     from .options import check_workers, sweep_options
 
@@ -170,13 +176,12 @@ def study(args: argparse.Namespace, scene: Scene | None, target: str, *, units: 
     axes = study_axes(args, scene, options.max_points)
     combos = list(itertools.product(*[a[2] for a in axes]))
     points = []
-    for combo in combos:
-        sections: dict = {}
-        for (section, name, _), v in zip(axes, combo, strict=True):
-            sections.setdefault(section, {})[name] = v
+    scene_d = scene.to_dict() if scene is not None else None
+    for combo in combos:  # a dotted key nested into its section as by every command (options.resolve)
+        sections = sections_for(scene_d or {}, {f"{s}.{n}": v for (s, n, _), v in zip(axes, combo, strict=True)})
         if scene is not None:
             scene.replace(origin="on the command line (--vary)", **sections)  # validate every point first
-        points.append((scene.to_dict() if scene is not None else None, sections))
+        points.append((scene_d, sections))
     workers = 1 if parallel_inside else check_workers(getattr(args, "workers", 0) or 0)
     fn = functools.partial(study_point, target, point_options(args))
     results = run_sweep(fn, points, workers=workers, desc="study", options=options,

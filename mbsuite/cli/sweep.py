@@ -9,6 +9,7 @@ import itertools
 from pathlib import Path
 from typing import Any
 
+from ..analysis.designspace import sections_for
 from ..analysis.sweep import check_grid, parse_values, run_sweep, scene_point
 from ..errors import MbsuiteError
 from ..results import Report, format_table, write_csv
@@ -16,17 +17,14 @@ from ..scenes import Scene
 from .options import check_workers, load, sweep_options
 from .output import emit
 
-SECTIONS = ("input", "params", "solver", "effects")
 
+def grid_axes(args: argparse.Namespace, scene: Scene, max_points: int) -> list[tuple[str, str, list]]:
+    """(section, key, values) of each `--vary SECTION.KEY=VALUES` (read by the one rule, `options.overrides`; a
+    KEY may reach into a section of the scene's model), the grid's size checked before it is built."""
+    from .options import overrides, scene_sections, section_of
 
-def grid_axes(vary: list[str] | None, max_points: int) -> list[tuple[str, str, list]]:
-    """(section, key, values) of each `--vary SECTION.KEY=VALUES`, the grid's size checked before it is built."""
-    from .study import split_key
-
-    axes = []
-    for spec in vary or []:
-        section, name, vals = split_key(spec, "--vary", SECTIONS)
-        axes.append((section, name, parse_values(vals, max_points=max_points)))
+    axes = [(*section_of(o, scene_sections(scene)), parse_values(o.value, max_points=max_points))
+            for o in overrides(args).values() if o.flag == "--vary"]
     if not axes:
         raise MbsuiteError("give at least one --vary SECTION.KEY=VALUES")
     check_grid([len(a[2]) for a in axes], max_points=max_points, what="--vary grid")
@@ -41,15 +39,14 @@ def cmd_sweep(args: argparse.Namespace) -> None:
     scene = apply_sets(load(args), getattr(args, "set_values", None))
     check_workers(args.workers)
     options = sweep_options(args)
-    axes = grid_axes(args.vary, options.max_points)
+    axes = grid_axes(args, scene, options.max_points)
     combos = list(itertools.product(*[a[2] for a in axes]))
     points, engines = [], set()
-    for combo in combos:
-        sections: dict = {}
-        for (section, name, _), v in zip(axes, combo, strict=True):
-            sections.setdefault(section, {})[name] = v
-        engines.add(scene.replace(**sections).solver.engine)  # validate every point before anything runs
-        points.append((scene.to_dict(), sections))
+    scene_d = scene.to_dict()
+    for combo in combos:  # a dotted key nested into its section as by every command (options.resolve)
+        sections = sections_for(scene_d, {f"{s}.{n}": v for (s, n, _), v in zip(axes, combo, strict=True)})
+        engines.add(scene.replace(origin="on the command line (--vary)", **sections).solver.engine)  # validated
+        points.append((scene_d, sections))
     # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
     auto = "threads" if engines == {"mujoco"} else "local"
     estimate = getattr(args, "error_estimate", False)

@@ -7,19 +7,28 @@ evaluations equal to 1e-15. Anything else callable can be tabulated with `Table.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..limits import Limit, param
+from ..schema import Items, Rule, Section, of_dataclass
+
+#: the longest table a signal may hold (a run's tabulation grid: two instants per step of `solver.max_steps`)
+TABLE_MAX = 100_000_000
 
 
-def _finite(name: str, **values: float) -> None:
-    for k, v in values.items():
-        if not (isinstance(v, int | float) and math.isfinite(v)):
-            raise ParameterError(f"{name} signal: {k} must be a finite number, got {v!r}")
+def _check(obj: Any, section: Section) -> None:
+    """Check the fields of signal `obj` by its declaration `section` (a ParameterError naming the field, its value,
+    what is valid and the unit) and store the Python numbers it holds."""
+    data = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+    for k, v in section.check(data, section.title, ParameterError).items():
+        object.__setattr__(obj, k, tuple(v) if isinstance(v, list) else v)
 
 
 class Signal:
@@ -48,11 +57,11 @@ class Signal:
 class Constant(Signal):
     """c."""
 
-    value: float
+    value: float = param(doc="the constant value")
     kind = 0
 
     def __post_init__(self) -> None:
-        _finite("constant", value=self.value)
+        _check(self, CONSTANT_INPUTS)
 
     def values(self, t):
         """The formula in the class docstring at the times `t` (vectorised)."""
@@ -67,13 +76,13 @@ class Constant(Signal):
 class Step(Signal):
     """offset + height for t >= t0 (Modelica `Blocks.Sources.Step`)."""
 
-    height: float = 1.0
-    offset: float = 0.0
-    t0: float = 0.0
+    height: float = param(1.0, doc="step height")
+    offset: float = param(0.0, doc="value before t0")
+    t0: float = param(0.0, unit="s", doc="time of the step")
     kind = 1
 
     def __post_init__(self) -> None:
-        _finite("step", height=self.height, offset=self.offset, t0=self.t0)
+        _check(self, STEP_INPUTS)
 
     def values(self, t):
         """The formula in the class docstring at the times `t` (vectorised)."""
@@ -88,16 +97,15 @@ class Step(Signal):
 class Sine(Signal):
     """offset + amplitude sin(2 pi f (t - t0) + phase) for t >= t0, offset before (Modelica `Blocks.Sources.Sine`)."""
 
-    amplitude: float = 1.0
-    frequency: float = 1.0
-    phase: float = 0.0
-    offset: float = 0.0
-    t0: float = 0.0
+    amplitude: float = param(1.0, doc="amplitude")
+    frequency: float = param(1.0, unit="Hz", doc="frequency")
+    phase: float = param(0.0, unit="rad", doc="phase at t0")
+    offset: float = param(0.0, doc="offset")
+    t0: float = param(0.0, unit="s", doc="start time")
     kind = 2
 
     def __post_init__(self) -> None:
-        _finite("sine", amplitude=self.amplitude, frequency=self.frequency, phase=self.phase, offset=self.offset,
-                t0=self.t0)
+        _check(self, SINE_INPUTS)
 
     def values(self, t):
         """The formula in the class docstring at the times `t` (vectorised)."""
@@ -113,16 +121,14 @@ class Sine(Signal):
 class Ramp(Signal):
     """offset before t0, rising linearly by `height` over `duration`, then held (Modelica `Blocks.Sources.Ramp`)."""
 
-    height: float = 1.0
-    duration: float = 1.0
-    offset: float = 0.0
-    t0: float = 0.0
+    height: float = param(1.0, doc="rise")
+    duration: float = param(1.0, lo=0.0, unit="s", doc="rise time (0: a step)")
+    offset: float = param(0.0, doc="value before t0")
+    t0: float = param(0.0, unit="s", doc="start of the rise")
     kind = 3
 
     def __post_init__(self) -> None:
-        _finite("ramp", height=self.height, duration=self.duration, offset=self.offset, t0=self.t0)
-        if self.duration < 0:
-            raise ParameterError(f"ramp signal: duration must be >= 0, got {self.duration!r}")
+        _check(self, RAMP_INPUTS)
 
     def values(self, t):
         """The formula in the class docstring at the times `t` (vectorised)."""
@@ -141,22 +147,16 @@ class Pulse(Signal):
     """offset + amplitude during the first `width` (fraction 0..1) of each `period` from t0, for `n` periods (0 =
     unlimited) (Modelica `Blocks.Sources.Pulse`, width given as a fraction)."""
 
-    amplitude: float = 1.0
-    width: float = 0.5
-    period: float = 1.0
-    offset: float = 0.0
-    t0: float = 0.0
-    n: int = 0
+    amplitude: float = param(1.0, doc="pulse height")
+    width: float = param(0.5, lo=0.0, hi=1.0, unit="1", doc="fraction of each period the pulse is on")
+    period: float = param(1.0, lo=0.0, lo_open=True, unit="s", doc="period")
+    offset: float = param(0.0, doc="value outside the pulses")
+    t0: float = param(0.0, unit="s", doc="start of the first pulse")
+    n: int = param(0, lo=0, kind=int, doc="number of periods (0: unlimited)")
     kind = 4
 
     def __post_init__(self) -> None:
-        _finite("pulse", amplitude=self.amplitude, width=self.width, period=self.period, offset=self.offset,
-                t0=self.t0)
-        if isinstance(self.n, bool) or not isinstance(self.n, int | float) or self.n != int(self.n):
-            raise ParameterError(f"pulse signal: n = {self.n!r} must be a whole number >= 0 (the number of periods; "
-                                 "0: unlimited)")
-        if not (0.0 <= self.width <= 1.0 and self.period > 0 and self.n >= 0):
-            raise ParameterError(f"pulse signal: need 0 <= width <= 1, period > 0, n >= 0; got {self}")
+        _check(self, PULSE_INPUTS)
 
     def values(self, t):
         """The formula in the class docstring at the times `t` (vectorised)."""
@@ -176,19 +176,22 @@ class Pulse(Signal):
 class Table(Signal):
     """Piecewise linear through (times[i], values[i]), held outside (Modelica `CombiTimeTable`, linear, hold)."""
 
-    times: tuple[float, ...]
-    points: tuple[float, ...]
+    times: tuple[float, ...] = dataclasses.field(metadata={"schema": Items(
+        Limit(unit="s"), min=1, max=TABLE_MAX, doc="times, non-decreasing", unit="s", rules=(Rule(
+            "times non-decreasing", lambda ts: next((f"times must be non-decreasing: times[{i}] = {ts[i]!r} < "
+                                                     f"times[{i - 1}] = {ts[i - 1]!r}"
+                                                     for i in range(1, len(ts)) if ts[i] < ts[i - 1]), None)),))})
+    points: tuple[float, ...] = dataclasses.field(metadata={"schema": Items(
+        Limit(), min=1, max=TABLE_MAX, doc="values at the times")})
     kind = 5
 
     def __post_init__(self) -> None:
-        try:
-            ts, ys = np.asarray(self.times, float), np.asarray(self.points, float)
-        except (TypeError, ValueError) as exc:
-            raise ParameterError(f"table signal: times and values must be numbers ({exc})") from exc
-        if ts.ndim != 1 or ts.size < 1 or ts.shape != ys.shape or not np.all(np.isfinite(ts)) or \
-                not np.all(np.isfinite(ys)) or np.any(np.diff(ts) < 0):
-            raise ParameterError("table signal: times and values must be equal-length finite sequences with "
-                                 "non-decreasing times")
+        for k in ("times", "points"):  # numpy arrays as the lists they hold (a 2-d array: rows, refused)
+            v = getattr(self, k)
+            if isinstance(v, np.ndarray) and v.ndim >= 1:
+                object.__setattr__(self, k, v.tolist())
+        if not _plain_table(self.times, self.points):
+            _check(self, TABLE_INPUTS)
 
     @classmethod
     def sample(cls, fn: Callable[[float], float], times: Sequence[float]) -> Table:
@@ -203,3 +206,29 @@ class Table(Signal):
     def params(self):
         """The parameters in the order the C evaluator reads them."""
         return (len(self.times), *self.times, *self.points)
+
+
+def _plain_table(times: Any, points: Any) -> bool:
+    """True for what `TABLE_INPUTS` accepts as given, checked vectorised (a tabulated run has millions of points):
+    equal-length tuples of 1 to `TABLE_MAX` finite Python floats, times non-decreasing. Anything else goes through
+    the declaration's check (which converts or names what is wrong)."""
+    if not (isinstance(times, tuple) and isinstance(points, tuple) and 1 <= len(times) == len(points) <= TABLE_MAX):
+        return False
+    if not all(type(x) is float for x in times) or not all(type(x) is float for x in points):
+        return False
+    ts, ys = np.array(times), np.array(points)
+    return bool(np.all(np.isfinite(ts)) and np.all(np.isfinite(ys)) and not np.any(np.diff(ts) < 0))
+
+
+def _same_length(c: dict[str, Any]) -> str | None:
+    n, m = len(c["times"]), len(c["points"])
+    return None if n == m else f"times ({n} values) and points ({m} values) must have equal lengths"
+
+
+#: the declared parameters of each signal (`mbsuite.schema.Section`s, checked in `__post_init__`)
+CONSTANT_INPUTS = of_dataclass(Constant, "constant signal")
+STEP_INPUTS = of_dataclass(Step, "step signal")
+SINE_INPUTS = of_dataclass(Sine, "sine signal")
+RAMP_INPUTS = of_dataclass(Ramp, "ramp signal")
+PULSE_INPUTS = of_dataclass(Pulse, "pulse signal")
+TABLE_INPUTS = of_dataclass(Table, "table signal", rules=(Rule("times and points of equal length", _same_length),))

@@ -121,5 +121,24 @@ def test_design_takes_any_real_number_type():
     kp, ki = D.gains(np.float32(0.0023), Fraction(1, 14), np.float64(2.5e-4), np.float32(0.15), np.int64(400))
     assert type(kp) is float and ki == pytest.approx(0.0023 * 14 / 2, rel=1e-6)
     for bad in ("200", True, 1 + 2j, np.array([1.0, 2.0])):
-        with pytest.raises(ParameterError, match="P must be a real number"):
+        with pytest.raises(ParameterError, match=r"P = .* is not a number; valid: \(0, inf\) W"):
             D.srmin(bad, 1.0, 1.0, 1.0)
+
+
+def test_a_scene_run_away_from_its_design_record_is_refused_naming_both_keys():
+    """A design scene whose [params] K (or input.value) was edited by hand while its [design] record stayed: the
+    record's derived K = what the inputs give, the params' K off by 1e-6 relative -> SceneError naming params.K and
+    [design.derived] K; off by 1e-12 (rounding of a TOML round trip) it loads; the scene as written loads."""
+    scene = design_scene(DesignInputs(P=200.0, Sr_min=15.0, w_max=400.0, V_m=100.0, tau_c=8.0, w_op=300.0))
+    scene_from_dict(scene).build_params()
+    K = scene["params"]["K"]
+    for rel, ok in ((1e-12, True), (1e-6, False)):
+        edited = {**scene, "params": {**scene["params"], "K": K * (1 + rel)}}
+        if ok:
+            scene_from_dict(edited)
+        else:
+            with pytest.raises(SceneError, match=r"params\.K = .* is not the design's \[design\.derived\] K"):
+                scene_from_dict(edited)
+    edited = {**scene, "input": {**scene["input"], "value": 301.0}}
+    with pytest.raises(SceneError, match=r"input\.value = 301\.0 is not the design's \[design\.derived\] w_op"):
+        scene_from_dict(edited)

@@ -45,6 +45,7 @@ LOADERS: dict[str, Callable[[Any], Any]] = {
     "catenary.line": lambda d: validate_line_section(d, LINES),
     "catenary.train": models()["catenary"].sections["train"],
     "catenary.quality": models()["catenary"].sections["quality"],
+    "drives.design": models()["drives"].sections["design"],
 }
 EXAMPLES = {name: (sec.example, LOADERS[name]) for name, sec in sections().items()}
 LINE = sections()["catenary.line_file"].example

@@ -23,13 +23,12 @@ def check_executor(executor: str, scheduler: Any) -> None:
         raise SceneError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
 
 
-def check_max_points(max_points: Any) -> int:
-    """`max_points` as an int, or a `SceneError` unless it is an integer >= 1."""
-    import numpy as np
+def check_max_points(max_points: Any, name: str = "max_points") -> int:
+    """`max_points` as an int, or a `SceneError` naming `name` (the CLI: `--max-points`) unless it is an integer >= 1
+    (`mbsuite.limits`: numpy integers too; 2.5, bools, NaN and inf refused)."""
+    from ...limits import Limit  # not at import: the light command-line parser reads this module
 
-    if isinstance(max_points, bool) or not isinstance(max_points, int | np.integer) or max_points < 1:
-        raise SceneError(f"max_points = {max_points!r} is invalid; valid: an integer >= 1")
-    return int(max_points)
+    return Limit(lo=1, kind=int, doc="most points of one sweep").check(name, max_points, SceneError)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -24,7 +24,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import ParameterError
-from ...limits import limit_of
+from ...limits import Limit, limit_of
+from ...schema import Items, Section
 from .params import CatenaryParams
 
 if TYPE_CHECKING:
@@ -66,6 +67,22 @@ def evaluate(job: tuple[dict, float, dict[str, float]]) -> dict[str, Any]:
     return out
 
 
+def _as_list(v: Any) -> Any:
+    """A numpy array or range as the list it holds (anything else as given, for the declaration to check)."""
+    return v.tolist() if isinstance(v, np.ndarray) else list(v) if isinstance(v, range) else v
+
+
+#: the inputs of a design grid: speeds (km/h) and, per varied `CatenaryParams` field, its values (that field's range)
+GRID_INPUTS = Section("catenary design grid", {
+    "speeds": Items(Limit(lo=0.0, hi=1000.0, lo_open=True, hi_open=True, unit="km/h", doc="train speed"), min=1,
+                    unit="km/h", doc="train speeds"),
+    "vary": Section("varied catenary parameters", {
+        f.name: Items(f.metadata["limit"].optional(), min=1, unit=f.metadata["limit"].unit, doc=f.metadata["limit"].doc)
+        for f in dataclasses.fields(CatenaryParams) if "limit" in f.metadata},
+        doc="parameter name = list of values (a CatenaryParams field)"),
+}, required=("speeds", "vary"))
+
+
 def design_grid(scene, speeds: Sequence[float], vary: Mapping[str, Sequence[float]], *, workers: int = 0,
                 progress: bool | None = None, **sweep_kw: Any) -> dict[str, Any]:
     """Evaluate the grid speeds x vary[name1] x vary[name2] ... (`evaluate` at each point) with `run_sweep`;
@@ -73,15 +90,10 @@ def design_grid(scene, speeds: Sequence[float], vary: Mapping[str, Sequence[floa
     fields; every combination is validated before anything runs (a bad value is a `ParameterError` naming it)."""
     from ...analysis.sweep import run_sweep
 
-    fields = {f.name for f in dataclasses.fields(CatenaryParams)}
-    bad = sorted(set(vary) - fields)
-    if bad:
-        raise ParameterError(f"unknown catenary parameter(s) {bad} in the design grid; valid: {sorted(fields)}")
-    if not speeds:
-        raise ParameterError("the design grid needs at least one speed (km/h)")
-    for v in speeds:
-        if isinstance(v, bool) or not isinstance(v, int | float) or not 0 < v < 1000:
-            raise ParameterError(f"design grid speed {v!r} km/h: valid speeds are in (0, 1000) km/h")
+    checked = GRID_INPUTS.check({"speeds": _as_list(speeds),
+                                 "vary": {k: _as_list(v) for k, v in vary.items()} if isinstance(vary, Mapping)
+                                 else vary}, "the catenary design grid", ParameterError)
+    speeds, vary = checked["speeds"], {k: checked["vary"][k] for k in vary}  # the caller's order: the plot's axes
     names = list(vary)
     base = scene.build_params()
     combos = list(itertools.product(*[list(vary[n]) for n in names])) if names else [()]

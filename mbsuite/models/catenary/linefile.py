@@ -221,8 +221,8 @@ def is_line_file(path: str | Path) -> bool:
     except (tomllib.TOMLDecodeError, RecursionError):
         data = None
     if data is None:  # not readable as TOML: a line file if it says so (its reader then names what is wrong)
-        return re.search(r"^\s*\[\[\s*wires\s*\]\]", text, re.M) is not None and \
-            re.search(r"^\s*model\s*=", text, re.M) is None
+        return re.search(r"^\s*\[\[\s*[\"']?wires[\"']?\s*\]\]", text, re.M) is not None and \
+            re.search(r"^\s*[\"']?model[\"']?\s*=", text, re.M) is None
     return "wires" in data and "model" not in data
 
 

@@ -15,17 +15,10 @@ from ...accuracy import AccuracySpec
 from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
-from ...schema import Items, Rule
 from ...solver import SolverSettings
 from . import accuracy
 from .params import PARAM_SETS, DriveParams
-from .scene_run import SIGNALS
-
-
-def _increasing(rows: list) -> str | None:
-    bad = next((i for i in range(1, len(rows)) if not rows[i][0] > rows[i - 1][0]), None)
-    return None if bad is None else (f"times must be strictly increasing: row {bad} t = {rows[bad][0]!r} s <= row "
-                                     f"{bad - 1} t = {rows[bad - 1][0]!r} s")
+from .scene_run import PROFILE, SIGNALS
 
 SPEC = ModelSpec(
     name="drives",
@@ -55,10 +48,7 @@ SPEC = ModelSpec(
         # `value` has no fixed default: without it (and without a profile) the parameter set's `ref` is the reference
         "reference": {"value": Limit(lo=-1e5, hi=1e5, unit="rad/s",
                                      doc="constant speed reference (default: the parameter set's ref)"),
-                      "profile": Items((Limit(lo=0.0, hi=1e5, unit="s", doc="t (s)"),
-                                        Limit(lo=-1e5, hi=1e5, unit="rad/s", doc="r (rad/s)")), min=1,
-                                       max=100_000, rules=(Rule("t strictly increasing", _increasing),),
-                                       doc="[[t, r], ...] piecewise-linear speed reference")},
+                      "profile": PROFILE},
         "none": {},
     },
     outputs=SIGNALS,
@@ -72,6 +62,7 @@ SPEC = ModelSpec(
                           what="MuJoCo: hinge rotors, real equality locks switched by a native stepper"),
     },
     sections={"design": Deferred("mbsuite.models.drives.design_scene:validate_section")},
+    params_builder=Deferred("mbsuite.models.drives.design_scene:scene_params"),
     cases="mbsuite.models.drives.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),

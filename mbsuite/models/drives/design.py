@@ -12,9 +12,7 @@ For w_l < V_m the residual extension (5.8) is clamped at x_s = 0 ([DERIVED]; rep
 
 from __future__ import annotations
 
-import decimal
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,28 +20,74 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...errors import ParameterError
+from ...limits import Limit, positive
+from ...schema import Rule, Section
+
+#: every input of the design tools, declared once (SI units); each tool's `Section` below takes its keys from here
+INPUT_LIMITS: dict[str, Limit] = {
+    "P": positive("W", "design power"),
+    "Sr_min": positive("1/s", "lowest switching rate (Eq 5.1)"),
+    "w_min": Limit(lo=0.0, unit="rad/s", doc="lowest load speed"),
+    "w_max": positive("rad/s", "highest load speed"),
+    "w_rip": positive("rad/s", "allowed speed ripple"),
+    "V_m": positive("rad/s", "motor speed"),
+    "J_s": positive("kg m^2", "spring-system inertia"),
+    "J_l": positive("kg m^2", "load inertia"),
+    "tau_c": positive("N m", "clutch torque"),
+    "K": positive("N m/rad", "spring rate"),
+    "x_max": positive("rad", "largest spring twist"),
+    "fatigue": Limit(lo=0.0, lo_open=True, hi=1.0, unit="1", doc="fatigue factor: allowed stress / sigma_uts"),
+    "sigma_uts": positive("Pa", "ultimate tensile stress"),
+    "E": positive("Pa", "Young's modulus"),
+    "U": positive("1", "spring energy utilisation factor"),
+    "t_s": positive("s", "energy-cycle period 1/Sr"),
+    "B_total": Limit(lo=0.0, unit="N m s/rad", doc="total viscous loss coefficient"),
+    "tau_l": Limit(lo=0.0, unit="N m", doc="Coulomb load torque"),
+    "w0": Limit(unit="rad/s", doc="operating speed (nonzero)"),
+    "Kp": positive("J/(rad/s)^2", "proportional gain"),
+    "Ki": Limit(lo=0.0, unit="J/(rad/s)^2/s", doc="integral gain"),
+}
 
 
-def _real(name: str, v: Any) -> float:
-    """`v` as a float: any real number (int, float, numpy scalar or 0-d array, Fraction, Decimal); a bool, string,
-    complex or array is a ParameterError naming `name`."""
-    if isinstance(v, np.ndarray) and v.ndim == 0:
-        v = v[()]
-    if isinstance(v, bool | np.bool_) or not isinstance(v, numbers.Real | decimal.Decimal):
-        raise ParameterError(f"{name} must be a real number, got {v!r}")
-    return float(v)
+def _below(lo: str, hi: str, why: str) -> Rule:
+    def test(c: dict[str, Any]) -> str | None:
+        return None if c[lo] < c[hi] else f"{lo} = {c[lo]:g} rad/s must be below {hi} = {c[hi]:g} rad/s ({why})"
+    return Rule(f"{lo} < {hi} ({why})", test)
 
 
-def _pos(name: str, v: Any) -> float:
-    x = _real(name, v)
-    if not (math.isfinite(x) and x > 0):
-        raise ParameterError(f"{name} must be a positive number, got {v!r}")
-    return x
+W0_NONZERO = Rule("w0 nonzero (the operating speed)",
+                  lambda c: None if c["w0"] != 0 else f"w0 (operating speed) = {c['w0']!r} rad/s must be nonzero")
+
+
+def _tool(title: str, keys: tuple[str, ...], rules: tuple[Rule, ...] = (), **own: Limit) -> Section:
+    """The inputs of one design tool: `keys` from `INPUT_LIMITS` (or `own`), all required."""
+    return Section(title, {k: own.get(k, INPUT_LIMITS.get(k)) for k in keys}, required=keys, rules=rules)
+
+
+SRMIN_INPUTS = _tool("srmin (Eq 5.1)", ("P", "w_min", "w_rip", "J_l"),
+                     w_min=positive("rad/s", "lowest load speed (divides Eq 5.1)"))
+DESIGN_POINT_INPUTS = _tool("CADJS design point (Eqs 5.9-5.13)", ("P", "Sr_min", "w_min", "w_max", "V_m", "J_s"),
+                            (_below("w_min", "w_max", "the load speed range"),))
+CLUTCH_TORQUE_INPUTS = _tool("CADJS at a clutch torque", ("P", "Sr_min", "w_min", "w_max", "V_m", "tau_c"),
+                             (_below("w_min", "w_max", "the load speed range"),))
+SPRING_INPUTS = _tool("springsz (Eqs 5.14-5.21)", ("K", "x_max", "fatigue", "sigma_uts", "E", "U"))
+PLANT_INPUTS = _tool("discrete controller model (Eqs 5.25-5.37)", ("J_l", "t_s", "B_total", "tau_l", "w0"),
+                     (W0_NONZERO,))
+B_TOTAL_INPUTS = _tool("B_total (Eq 5.38)", ("P", "w0", "tau_l"), (W0_NONZERO,))
+GAIN_INPUTS = _tool("closed-loop gains", ("Kp", "Ki"))
+
+
+def _checked(section: Section, **values: Any) -> tuple[float, ...]:
+    """`values` checked by `section` (a ParameterError naming the key, its value, the valid range and the unit), as
+    Python floats in the order given."""
+    out = section.check(values, section.title, ParameterError)
+    return tuple(out[k] for k in values)
 
 
 def srmin(P: float, w_min: float, w_rip: float, J_l: float) -> float:
     """Eq 5.1: Sr_min = P / (w_min w_rip J_l)."""
-    return _pos("P", P) / (_pos("w_min", w_min) * _pos("w_rip", w_rip) * _pos("J_l", J_l))
+    P, w_min, w_rip, J_l = _checked(SRMIN_INPUTS, P=P, w_min=w_min, w_rip=w_rip, J_l=J_l)
+    return P / (w_min * w_rip * J_l)
 
 
 def _W(w_l: float, V_m: float) -> float:
@@ -114,13 +158,8 @@ class Design:
 
 def design_point(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, J_s: float) -> Design:
     """One CADJS point: K at (w_min, Sr_min) (5.11), Sr_max at w_max (5.13), x_max (5.9) and tau_c = K x_max (5.10)."""
-    P, Sr_min, w_max, V_m, J_s = (_pos(nm, v) for nm, v in (("P", P), ("Sr_min", Sr_min), ("w_max", w_max),
-                                                              ("V_m", V_m), ("J_s", J_s)))
-    w_min = _real("w_min", w_min)
-    if not (math.isfinite(w_min) and w_min >= 0):
-        raise ParameterError(f"w_min must be a number >= 0, got {w_min!r}")
-    if not w_min < w_max:
-        raise ParameterError(f"w_min = {w_min:g} rad/s must be below w_max = {w_max:g} rad/s (the load speed range)")
+    P, Sr_min, w_min, w_max, V_m, J_s = _checked(DESIGN_POINT_INPUTS, P=P, Sr_min=Sr_min, w_min=w_min, w_max=w_max,
+                                                 V_m=V_m, J_s=J_s)
     K = k_from_js(P, Sr_min, w_min, V_m, J_s)
     Sr = sr_from_kjs(P, w_max, V_m, K, J_s)
     x = x_f(P, Sr, w_max, V_m, K, J_s)
@@ -135,6 +174,8 @@ def cadjs(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, J_s=N
 
 def at_clutch_torque(P: float, Sr_min: float, w_min: float, w_max: float, V_m: float, tau_c: float) -> Design:
     """The CADJS family read at a given clutch torque (how Tables 5.2 and 6.2 were read off the plots)."""
+    P, Sr_min, w_min, w_max, V_m, tau_c = _checked(CLUTCH_TORQUE_INPUTS, P=P, Sr_min=Sr_min, w_min=w_min,
+                                                   w_max=w_max, V_m=V_m, tau_c=tau_c)
     f = lambda js: design_point(P, Sr_min, w_min, w_max, V_m, js).tau_c - tau_c  # noqa: E731
     lo, hi = 1e-8, 1e-1
     if f(lo) > 0 or f(hi) < 0:
@@ -155,11 +196,8 @@ def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = S
     to (5.20)). The thesis prints no material data. The defaults are not a material: E = 209 GPa is implied by the
     Table 6.3 spring ([DERIVED]) and sigma_uts = 1.465 GPa is a *calibration*, backed out of the recommended volume
     1.58e-4 m^3 for the 100 W design (Sec. 6.3) - so that volume is reproduced by construction, not predicted."""
-    K, x_max, sigma_uts, E, U = (_pos(nm, v) for nm, v in (("K", K), ("x_max", x_max), ("sigma_uts", sigma_uts),
-                                                           ("E", E), ("U", U)))
-    fatigue = _real("fatigue factor", fatigue)
-    if not 0 < fatigue <= 1:
-        raise ParameterError(f"fatigue factor must be in (0, 1], got {fatigue!r}")
+    K, x_max, fatigue, sigma_uts, E, U = _checked(SPRING_INPUTS, K=K, x_max=x_max, fatigue=fatigue,
+                                                  sigma_uts=sigma_uts, E=E, U=U)
     sf = fatigue * sigma_uts
     d = (32 * K * K * x_max * x_max / (U * sf * sf * math.pi**2)) ** (1 / 6)
     DN = d**4 * E / (64 * K)
@@ -168,20 +206,13 @@ def springsz(K: float, x_max: float, fatigue: float = 0.25, sigma_uts: float = S
 
 
 # ---- discrete controller model and gains -----------------------------------------------------------------------------
-def _plant_args(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> None:
-    _pos("J_l", J_l)
-    _pos("t_s", t_s)
-    for nm, v in (("B_total", B_total), ("tau_l", tau_l)):
-        if not (math.isfinite(_real(nm, v)) and v >= 0):
-            raise ParameterError(f"{nm} must be a number >= 0, got {v!r}")
-    if not (math.isfinite(_real("w0", w0)) and w0 != 0):
-        raise ParameterError(f"w0 (operating speed) must be a nonzero number, got {w0!r}")
+def _plant_args(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tuple[float, ...]:
+    return _checked(PLANT_INPUTS, J_l=J_l, t_s=t_s, B_total=B_total, tau_l=tau_l, w0=w0)
 
 
 def plant_AB(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tuple[float, float]:
     """Eq 5.25: G(z) = A / (z - 1 + B), A = 2/J_l, B = t_s/J_l (2 B_total + tau_l / x0^(1/2)), x0 = w0^2."""
-    _plant_args(J_l, t_s, B_total, tau_l, w0)
-    J_l, t_s, B_total, tau_l, w0 = (float(x) for x in (J_l, t_s, B_total, tau_l, w0))
+    J_l, t_s, B_total, tau_l, w0 = _plant_args(J_l, t_s, B_total, tau_l, w0)
     return 2.0 / J_l, t_s / J_l * (2 * B_total + tau_l / abs(w0))
 
 
@@ -189,8 +220,7 @@ def gains(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tu
     """Eqs 5.32-5.37: K_p = J_l/2 - t_s (B_total + tau_l / (2 x0^(1/2))) (one pole at the origin) and the largest
     K_I = J_l / (2 t_s) keeping the other pole on the positive real axis. A non-positive K_p (dissipation per cycle
     above the load's kinetic energy: open loop unstable, (5.27)) is an error."""
-    _plant_args(J_l, t_s, B_total, tau_l, w0)
-    J_l, t_s, B_total, tau_l, w0 = (float(x) for x in (J_l, t_s, B_total, tau_l, w0))
+    J_l, t_s, B_total, tau_l, w0 = _plant_args(J_l, t_s, B_total, tau_l, w0)
     kp = J_l / 2 - t_s * (B_total + tau_l / (2 * abs(w0)))
     if kp <= 0:
         raise ParameterError(f"no positive K_p: t_s (B_total + tau_l/(2|w0|)) = {J_l / 2 - kp:.4g} >= J_l/2 = "
@@ -200,8 +230,7 @@ def gains(J_l: float, t_s: float, B_total: float, tau_l: float, w0: float) -> tu
 
 def b_total(P: float, w0: float, tau_l: float) -> float:
     """Eq 5.38: B_total = (P/w0 - tau_l) / w0 (all power not spent on the load is viscous loss at w0)."""
-    _pos("P", P)
-    _plant_args(1.0, 1.0, 0.0, tau_l, w0)
+    P, w0, tau_l = _checked(B_TOTAL_INPUTS, P=P, w0=w0, tau_l=tau_l)
     bt = (P / abs(w0) - tau_l) / abs(w0)
     if bt < 0:
         raise ParameterError(f"B_total = (P/|w0| - tau_l)/|w0| = {bt:.4g} < 0: the load torque {tau_l} N m takes more "
@@ -213,9 +242,8 @@ def closed_loop_poles(Kp: float, Ki: float, J_l: float, t_s: float, B_total: flo
                       ) -> np.ndarray:
     """Roots of Eq 5.31: z^2 + z (B - 2 + Kp A / C) + 1 - B - Kp A, C = Kp / (Kp + Ki t_s)."""
     A, B = plant_AB(J_l, t_s, B_total, tau_l, w0)
-    _pos("Kp", Kp)
-    if not (math.isfinite(Ki) and Ki >= 0):
-        raise ParameterError(f"Ki must be a number >= 0, got {Ki!r}")
+    Kp, Ki = _checked(GAIN_INPUTS, Kp=Kp, Ki=Ki)
+    t_s = float(t_s)
     C = Kp / (Kp + Ki * t_s)
     return np.roots([1.0, B - 2 + Kp * A / C, 1 - B - Kp * A])
 

@@ -28,58 +28,89 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import ParameterError, SceneError
+from ...limits import Limit, param, positive
+from ...schema import Rule, Section, of_dataclass
 from . import design as D
-from .params import PARAM_SETS
+from .params import PARAM_SETS, DriveParams
 
 #: the parameter sets whose motor, bearings, delays and controller rate a design scene may take (step-up/step-down)
 BASE_SETS = ("design_100w", "proto_100w", "proto_50w", "example_500w")
 
 
+def _one_point(c: dict[str, Any]) -> str | None:
+    if (c.get("tau_c") is None) == (c.get("J_s") is None):
+        return (f"a design point needs exactly one of tau_c (clutch torque) and J_s (spring-system inertia); got "
+                f"tau_c = {c.get('tau_c')!r}, J_s = {c.get('J_s')!r}")
+    return None
+
+
+def _band(c: dict[str, Any]) -> str | None:
+    if not c["w_min"] < c["w_max"]:
+        return f"w_min = {c['w_min']!r} rad/s must be below w_max = {c['w_max']!r} rad/s (the load speed range)"
+    if c.get("w_op") is not None and not c["w_min"] <= c["w_op"] <= c["w_max"]:
+        return (f"w_op = {c['w_op']!r} rad/s must lie in the design's speed band [w_min, w_max] = "
+                f"[{c['w_min']!r}, {c['w_max']!r}] rad/s")
+    return None
+
+
+def _settle(c: dict[str, Any]) -> str | None:
+    if c.get("t_settle") is not None and not c["t_settle"] < c["duration"]:
+        return f"t_settle = {c['t_settle']!r} s must be below duration = {c['duration']!r} s"
+    return None
+
+
+def _optional(unit: str, doc: str) -> Any:
+    """A positive quantity that may be left out (None: the scene derives it, `derived`)."""
+    return param(None, lo=0.0, lo_open=True, unit=unit, doc=doc)
+
+
+def _tool_input(key: str, *default: Any) -> Any:
+    """A field declared by the design tools' `design.INPUT_LIMITS[key]` (one declaration per key), with `default`
+    when given (None: optional)."""
+    lim = D.INPUT_LIMITS[key]
+    if not default:
+        return dataclasses.field(metadata={"limit": lim})
+    return dataclasses.field(default=default[0], metadata={"limit": dataclasses.replace(lim, default=default[0])})
+
+
 @dataclass(frozen=True)
 class DesignInputs:
     """The inputs of a drive design (SI units). `Sr_min`, `w_min`, `w_max`, `V_m`, `P` are CADJS's (Eqs 5.9-5.13);
-    give `tau_c` (clutch torque, N m: the family read at it, as Tables 5.2/6.2) or `J_s` (kg m^2) to pick the point."""
+    give `tau_c` (clutch torque, N m: the family read at it, as Tables 5.2/6.2) or `J_s` (kg m^2) to pick the point.
+    Checked by `DESIGN_INPUTS` (each value against its declared range, then the rules)."""
 
-    P: float  # W: design power
-    Sr_min: float  # 1/s: lowest switching rate (Eq 5.1, `design srmin`)
-    w_max: float  # rad/s: highest load speed
-    V_m: float  # rad/s: motor speed
-    w_min: float = 0.0  # rad/s: lowest load speed
-    tau_c: float | None = None  # N m: clutch torque of the design point
-    J_s: float | None = None  # kg m^2: spring-system inertia of the design point (instead of tau_c)
-    J_l: float | None = None  # kg m^2: load inertia (default: the base set's)
-    w_op: float | None = None  # rad/s: operating speed the scene's PI tracks (default (w_min + w_max) / 2)
-    tau_l: float | None = None  # N m: Coulomb load torque (default P / w_op)
-    P_motor: float | None = None  # W: largest motor power, at V_m (default 1.5 P: the drive's losses)
-    base: str = "design_100w"  # parameter set for bearings, delays, controller rate, motor inertia
-    duration: float = 6.0  # s: simulated time
-    t_settle: float | None = None  # s: start of the statistics window (default duration / 2)
+    P: float = _tool_input("P")  # W
+    Sr_min: float = _tool_input("Sr_min")  # 1/s (Eq 5.1, `design srmin`)
+    w_max: float = _tool_input("w_max")  # rad/s
+    V_m: float = _tool_input("V_m")  # rad/s
+    w_min: float = _tool_input("w_min", 0.0)  # rad/s
+    tau_c: float | None = _tool_input("tau_c", None)  # N m: the design point (or J_s)
+    J_s: float | None = _tool_input("J_s", None)  # kg m^2: the design point (or tau_c)
+    J_l: float | None = _tool_input("J_l", None)  # kg m^2 (default: the base set's)
+    w_op: float | None = _optional("rad/s", "operating speed the scene's PI tracks (default (w_min + w_max) / 2)")
+    tau_l: float | None = _optional("N m", "Coulomb load torque (default P / w_op)")
+    P_motor: float | None = _optional("W", "largest motor power, at V_m (default 1.5 P: the drive's losses)")
+    base: str = param("design_100w", kind=str, choices=BASE_SETS,
+                      doc="parameter set for bearings, delays, controller rate, motor inertia")
+    duration: float = param(6.0, lo=0.0, lo_open=True, unit="s", doc="simulated time")
+    t_settle: float | None = _optional("s", "start of the statistics window (default duration / 2)")
 
     def __post_init__(self) -> None:
         # any real number type (numpy scalars, 0-d arrays, Fraction) is stored as the float it holds
-        for nm in ("P", "Sr_min", "w_max", "V_m", "duration"):
-            object.__setattr__(self, nm, D._pos(nm, getattr(self, nm)))
-        object.__setattr__(self, "w_min", D._real("w_min", self.w_min))
-        for nm in ("tau_c", "J_s", "J_l", "w_op", "tau_l", "P_motor", "t_settle"):
-            if getattr(self, nm) is not None:
-                object.__setattr__(self, nm, D._pos(nm, getattr(self, nm)))
-        if (self.tau_c is None) == (self.J_s is None):
-            raise ParameterError(f"a design point needs exactly one of tau_c (clutch torque) and J_s (spring-system "
-                                 f"inertia); got tau_c = {self.tau_c!r}, J_s = {self.J_s!r}")
-        if not 0 <= self.w_min < self.w_max:
-            raise ParameterError(f"w_min = {self.w_min!r} rad/s must be >= 0 and below w_max = {self.w_max!r} rad/s")
-        if self.w_op is not None and not self.w_min <= self.w_op <= self.w_max:
-            raise ParameterError(f"w_op = {self.w_op!r} rad/s must lie in the design's speed band [w_min, w_max] = "
-                                 f"[{self.w_min!r}, {self.w_max!r}] rad/s")
-        if self.base not in BASE_SETS:
-            raise ParameterError(f"base = {self.base!r} is not a step-up/step-down parameter set; valid: "
-                                 f"{list(BASE_SETS)}")
-        if self.t_settle is not None and self.t_settle >= self.duration:
-            raise ParameterError(f"t_settle = {self.t_settle!r} s must be below duration = {self.duration!r} s")
+        given = {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+        for k, v in DESIGN_INPUTS.check(given, "design inputs", ParameterError).items():
+            object.__setattr__(self, k, v)
 
     def to_dict(self) -> dict[str, Any]:
         """The inputs that were given (None left out), as recorded in a scene's `[design]` section."""
         return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+
+
+#: the inputs of a drive design: the `[design.inputs]` table of a design scene, `DesignInputs` in Python
+DESIGN_INPUTS = of_dataclass(DesignInputs, "drive design inputs (design.inputs)", rules=(
+    Rule("exactly one of tau_c and J_s (the design point)", _one_point),
+    Rule("0 <= w_min < w_max; w_op, when given, in [w_min, w_max]", _band),
+    Rule("t_settle, when given, below duration", _settle)))
 
 
 def design_of(inp: DesignInputs) -> D.Design:
@@ -132,29 +163,90 @@ def design_scene(inp: DesignInputs, name: str = "") -> dict[str, Any]:
     }
 
 
-def validate_section(section: Any) -> dict[str, Any]:
-    """The `[design]` section of a scene: a record of the design it came from (`inputs`: the `DesignInputs` given,
-    `derived`: the values the scene took from it). The run reads `[params]`; this checks that the inputs form a valid
-    design and that `derived` is what they give (to 1e-9), so a scene edited by hand cannot carry a stale record."""
-    if not isinstance(section, dict) or set(section) - {"inputs", "derived"} or "inputs" not in section:
-        raise SceneError(f"[design] = {section!r} must hold an [design.inputs] table (the DesignInputs) and optionally "
-                         "[design.derived]")
-    fields = {f.name for f in dataclasses.fields(DesignInputs)}
-    bad = sorted(set(section["inputs"]) - fields)
-    if bad:
-        raise SceneError(f"unknown key(s) {bad} in [design.inputs]; valid keys: {sorted(fields)}")
+#: the values a design scene takes from its design (`derived`), each with the `[design.inputs]` keys it comes from
+DERIVED_FROM: dict[str, tuple[str, ...]] = {
+    **{k: ("P", "Sr_min", "w_min", "w_max", "V_m", "tau_c", "J_s")
+       for k in ("J_s", "K", "tau_c", "x_max", "Sr_max", "capacity")},
+    "J_l": ("J_l", "base"), "w_op": ("w_op", "w_min", "w_max"), "tau_l": ("tau_l", "P", "w_op"),
+    "Sr_op": ("P", "w_op", "V_m", "tau_c", "J_s"), "B_total": ("P", "w_op", "tau_l"),
+    "Kp": ("J_l", "P", "w_op", "tau_l", "V_m", "tau_c", "J_s"), "Ki": ("J_l", "P", "w_op", "V_m", "tau_c", "J_s"),
+    "tau_0": ("P_motor", "P", "V_m"), "tau_slope": ("P_motor", "P", "V_m"),
+}
+#: relative tolerance of a recorded derived value against what its inputs give
+DERIVED_RTOL = 1e-9
+
+#: the `[design.derived]` table: what the scene took from its design (each checked against its inputs); a value that
+#: is also a design-tool input keeps that declaration (`design.INPUT_LIMITS`)
+DERIVED_VALUES = Section("design values derived from the inputs (design.derived)", {
+    **{k: D.INPUT_LIMITS[k] for k in ("J_s", "K", "tau_c", "x_max", "J_l", "tau_l", "B_total", "Kp", "Ki")},
+    "Sr_max": positive("1/s", "highest switching rate (at w_max, Eq 5.13)"),
+    "capacity": positive("J", "spring capacity 1/2 K x_max^2"),
+    "w_op": positive("rad/s", "operating speed"),
+    "Sr_op": positive("1/s", "switching rate at w_op (Eq 5.13)"),
+    "tau_0": positive("N m", "motor stall torque 2 P_m / V_m"),
+    "tau_slope": Limit(hi=0.0, hi_open=True, unit="N m s/rad", doc="motor torque slope -P_m / V_m^2"),
+})
+
+
+def _consistent(c: dict[str, Any]) -> str | None:
+    """None when every recorded derived value is what the recorded inputs give (to `DERIVED_RTOL`)."""
     try:
-        inp = DesignInputs(**section["inputs"])
-        v = derived(inp)
-    except (ParameterError, TypeError) as exc:
-        raise SceneError(f"[design.inputs]: {exc}") from exc
-    for k, x in (section.get("derived") or {}).items():
-        if k not in v:
-            raise SceneError(f"unknown key {k!r} in [design.derived]; valid keys: {sorted(v)}")
-        if not isinstance(x, int | float) or not math.isclose(x, v[k], rel_tol=1e-9, abs_tol=1e-300):
-            raise SceneError(f"[design.derived] {k} = {x!r} is not what [design.inputs] give ({v[k]!r}); remove "
-                             "[design.derived] or write the scene again (mbsuite drive design cadjs ... --scene-out)")
-    return {"inputs": inp.to_dict(), "derived": v}
+        v = derived(DesignInputs(**c["inputs"]))
+    except ParameterError as exc:
+        return f"[design.inputs] give no design: {exc}"
+    for k, x in (c.get("derived") or {}).items():
+        if not math.isclose(x, v[k], rel_tol=DERIVED_RTOL, abs_tol=1e-300):
+            return (f"[design.derived] {k} = {x!r} is not what [design.inputs] "
+                    f"({', '.join(i for i in DERIVED_FROM[k] if c['inputs'].get(i) is not None)}) give: {k} = {v[k]!r} "
+                    f"(relative tolerance {DERIVED_RTOL:g}); remove [design.derived] or write the scene again "
+                    "(mbsuite drive design cadjs ... --scene-out)")
+    return None
+
+
+#: the `[design]` section of a scene: the design inputs and, optionally, the values derived from them
+DESIGN_SECTION = Section("drive design record ([design])", {"inputs": DESIGN_INPUTS, "derived": DERIVED_VALUES},
+                         required=("inputs",), rules=(Rule(
+                             f"every [design.derived] value is what [design.inputs] give (relative tolerance "
+                             f"{DERIVED_RTOL:g})", _consistent),),
+                         doc="a record of the design the scene came from; the run reads [params]",
+                         example={"inputs": {"P": 200.0, "Sr_min": 15.0, "w_max": 400.0, "V_m": 100.0, "tau_c": 8.0,
+                                             "w_op": 300.0}})
+
+
+def validate_section(section: Any) -> dict[str, Any]:
+    """The `[design]` section of a scene (`DESIGN_SECTION`): a record of the design it came from (`inputs`: the
+    `DesignInputs` given, `derived`: the values the scene took from it). The run reads `[params]`; this checks that
+    the inputs form a valid design and that `derived` is what they give (to `DERIVED_RTOL`), so a scene edited by
+    hand cannot carry a stale record."""
+    checked = DESIGN_SECTION.check(section, "[design]", SceneError)
+    inp = DesignInputs(**checked["inputs"])
+    return {"inputs": inp.to_dict(), "derived": derived(inp)}
+
+
+validate_section.schema = DESIGN_SECTION
+
+#: the scene values a design sets: [params] key (or "input.value") -> its [design.derived] key
+SCENE_FROM_DESIGN = {"J_s": "J_s", "K": "K", "tau_c1": "tau_c", "tau_c2": "tau_c", "spring_max": "x_max", "J_l": "J_l",
+                     "tau_l": "tau_l", "Kp": "Kp", "Ki": "Ki", "tau_0": "tau_0", "tau_slope": "tau_slope",
+                     "input.value": "w_op"}
+
+
+def scene_params(scene: Any) -> DriveParams:
+    """The `DriveParams` of a drives scene (`ModelSpec.params_builder`). A scene that carries a `[design]` record
+    must run what it records: each [params] value (and input.value) a design sets must equal its [design.derived]
+    value (to `DERIVED_RTOL`), else a SceneError names both keys."""
+    design = scene.sections.get("design")
+    if design is not None:
+        v = design["derived"]
+        for key, dkey in SCENE_FROM_DESIGN.items():
+            have = scene.input.get("value") if key == "input.value" else scene.params.get(key)
+            if have is not None and not math.isclose(have, v[dkey], rel_tol=DERIVED_RTOL, abs_tol=0.0):
+                name = key if key.startswith("input.") else f"params.{key}"
+                raise SceneError(f"{name} = {have!r} is not the design's [design.derived] {dkey} = {v[dkey]!r} "
+                                 f"(relative tolerance {DERIVED_RTOL:g}): a scene edited by hand away from its design; "
+                                 "remove [design] or write the scene again (mbsuite drive design cadjs ... "
+                                 "--scene-out)")
+    return DriveParams(**dict(scene.params))
 
 
 def _toml_value(v: Any) -> str:

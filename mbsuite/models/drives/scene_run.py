@@ -4,7 +4,6 @@ mode changes, the energy-residual health figure). The paths themselves: `equatio
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -13,8 +12,10 @@ import numpy as np
 from ... import perturbation
 from ...errors import SceneError
 from ...health import Figure
+from ...limits import Limit
 from ...results import SimResult, assemble
 from ...scenes import Scene
+from ...schema import Items, Rule, check_value
 from . import coupled_clutches as cc
 from . import drive, msl
 from .accuracy import window_efficiency
@@ -44,26 +45,23 @@ DRIVE_ENERGY_BOUND = 1e-4
 REF_BOUND = 1e5
 
 
+def _increasing(rows: list) -> str | None:
+    bad = next((i for i in range(1, len(rows)) if not rows[i][0] > rows[i - 1][0]), None)
+    return None if bad is None else (f"times must be strictly increasing: row {bad} t = {rows[bad][0]!r} s <= row "
+                                     f"{bad - 1} t = {rows[bad - 1][0]!r} s")
+
+
+#: `input.profile`: the piecewise-linear speed reference, [[t, r], ...] (the scene's declaration of the key)
+PROFILE = Items((Limit(lo=0.0, hi=1e5, unit="s", doc="t (s)"),
+                 Limit(lo=-REF_BOUND, hi=REF_BOUND, unit="rad/s", doc="r (rad/s)")), min=1, max=100_000,
+                rules=(Rule("t strictly increasing", _increasing),),
+                doc="[[t, r], ...] piecewise-linear speed reference")
+
+
 def check_profile(profile: Any) -> np.ndarray:
-    """`input.profile` as an (n, 2) float array: a non-empty list of [t, r] pairs of finite numbers (t in s, r in
-    rad/s with |r| <= 1e5), t strictly increasing. Anything else is a `SceneError` naming `input.profile`, the
-    offending row and the valid form."""
-    form = "a non-empty list of [t (s), r (rad/s)] pairs of finite numbers, t strictly increasing, |r| <= 1e5"
-    if not isinstance(profile, list | tuple) or not profile:
-        raise SceneError(f"input.profile = {profile!r} is not {form}")
-    for i, row in enumerate(profile):
-        if (not isinstance(row, list | tuple) or len(row) != 2
-                or any(isinstance(v, bool) or not isinstance(v, int | float) for v in row)):
-            raise SceneError(f"input.profile[{i}] = {row!r} is not a [t, r] pair of numbers; input.profile must be "
-                             f"{form}")
-        if not all(math.isfinite(v) for v in row):
-            raise SceneError(f"input.profile[{i}] = {row!r} is not finite; input.profile must be {form}")
-        if abs(row[1]) > REF_BOUND:
-            raise SceneError(f"input.profile[{i}] reference {row[1]!r} rad/s is outside [-1e5, 1e5] rad/s")
-        if i and not row[0] > profile[i - 1][0]:
-            raise SceneError(f"input.profile times must be strictly increasing; input.profile[{i}] t = {row[0]!r} "
-                             f"<= input.profile[{i - 1}] t = {profile[i - 1][0]!r}")
-    return np.asarray(profile, float)
+    """`input.profile` as an (n, 2) float array, checked by its declaration `PROFILE` (a `SceneError` naming
+    `input.profile`, the offending row, its value and the valid form)."""
+    return np.asarray(check_value(PROFILE, "input.profile", profile, "[input]", SceneError), float).reshape(-1, 2)
 
 
 def reference_signal(inp: dict[str, Any], default: float):

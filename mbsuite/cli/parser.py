@@ -70,6 +70,23 @@ class Parser(argparse.ArgumentParser):
         """A usage error as an exception (exit 2 with the message), not argparse's exit."""
         raise UsageError(f"{message} (usage: {self.prog} --help)")
 
+    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+        """argparse's parse, refusing an option that takes one value given twice (argparse keeps the last): the
+        command line's overrides compose by one rule (`options.compose`), and a flag repeated is a conflict too."""
+        tokens = [a for a in (args if args is not None else []) if isinstance(a, str)]
+        if "--" in tokens:
+            tokens = tokens[:tokens.index("--")]
+        single = (argparse._StoreAction, argparse._StoreConstAction, argparse._StoreTrueAction,
+                  argparse._StoreFalseAction)
+        for action in self._actions:
+            if not isinstance(action, single) or not action.option_strings:
+                continue
+            given = [t for t in tokens if t in action.option_strings
+                     or any(t.startswith(o + "=") for o in action.option_strings if o.startswith("--"))]
+            if len(given) > 1:
+                self.error(f"{action.option_strings[-1]} given {len(given)} times; it takes one value: give it once")
+        return super().parse_known_args(args, namespace)
+
 
 def build_parser(models: bool = True) -> argparse.ArgumentParser:
     """The `mbsuite` argument parser: the generic commands plus each model's own command group (`models=False`: the

@@ -191,3 +191,16 @@ def test_bad_counts_on_the_command_line_name_the_flag_before_anything_runs(monke
     monkeypatch.setattr(sweep_api, "run_sweep", ran)
     rc, _, err = _cli(argv, capsys)
     assert rc == 2 and named in err and "internal error" not in err, err
+
+
+@pytest.mark.parametrize("argv, flag", [(["catenary", "catenary/en50318", "--speed", "250", "--speed", "300"], "--speed"),
+                                        (["run", "pantograph", "--engine", "mujoco", "--engine=reference"], "--engine"),
+                                        (["run", "pantograph", "--allow-inaccurate", "--allow-inaccurate"],
+                                         "--allow-inaccurate")])
+def test_a_one_value_flag_given_twice_is_an_error_naming_it(argv, flag, capsys):
+    """argparse keeps the last of a repeated flag; the rule refuses it before anything loads."""
+    from mbsuite.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{flag} given 2 times" in err, err

@@ -193,7 +193,8 @@ def test_bad_counts_on_the_command_line_name_the_flag_before_anything_runs(monke
     assert rc == 2 and named in err and "internal error" not in err, err
 
 
-@pytest.mark.parametrize("argv, flag", [(["catenary", "catenary/en50318", "--speed", "250", "--speed", "300"], "--speed"),
+@pytest.mark.parametrize("argv, flag", [(["catenary", "catenary/en50318", "--speed", "250", "--speed", "300"],
+                                         "--speed"),
                                         (["run", "pantograph", "--engine", "mujoco", "--engine=reference"], "--engine"),
                                         (["run", "pantograph", "--allow-inaccurate", "--allow-inaccurate"],
                                          "--allow-inaccurate")])

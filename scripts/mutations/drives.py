@@ -129,4 +129,14 @@ MUTATIONS: tuple[Mutation, ...] = (
              "                tk = min(max(tk, 0.0), self.max_tk)", "                tk = min(tk, self.max_tk)",
              "the anti-windup t_k PI stores a negative storage time (lower clamp at 0 dropped): it winds up below",
              "tests/drives/test_non_default.py"),
+    Mutation("drives_design_record_tolerance_loose", "mbsuite/models/drives/design_scene.py",
+             "        if not math.isclose(x, v[k], rel_tol=DERIVED_RTOL, abs_tol=1e-300):",
+             "        if not math.isclose(x, v[k], rel_tol=1e-3, abs_tol=1e-300):",
+             "a [design] record whose derived values are 0.1 % off what its inputs give passes as consistent",
+             "tests/suite/test_declared_inputs.py"),
+    Mutation("drives_scene_away_from_its_design_accepted", "mbsuite/models/drives/design_scene.py",
+             "            if have is not None and not math.isclose(have, v[dkey], rel_tol=DERIVED_RTOL, abs_tol=0.0):",
+             "            if False:",
+             "a design scene whose [params] were edited away from its [design] record runs what the record does not "
+             "say", "tests/drives/test_design_scene.py"),
 )

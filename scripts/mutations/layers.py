@@ -79,4 +79,13 @@ MUTATIONS: tuple[Mutation, ...] = (
              "            return np.array(data, dtype=dt)",
              "arrays come back from the store flattened (a 2 x 3 result read as 6 values)",
              "tests/suite/test_store.py"),
+    Mutation("schema_unknown_key_dropped", "mbsuite/schema.py",
+             "        unknown = [k for k in data if k not in self.keys and not self._prefix(k)]",
+             "        unknown: list[Any] = []",
+             "a declared section silently drops a key it does not declare (a typo in a line file or a scene section "
+             "runs on the default)", "tests/suite/test_declarations.py"),
+    Mutation("cli_override_repeated_key_kept", "mbsuite/cli/options.py",
+             "            if old.key == new.key:", "            if old.key == new.key and False:",
+             "the command line keeps the last of two overrides of one key (--set and --vary, or --vary twice): one "
+             "is dropped silently", "tests/suite/test_overrides.py"),
 )

@@ -718,3 +718,22 @@ def test_slack_dropper_in_compression_in_the_static_state_is_an_error_naming_it(
     assert not fe.slack_mask("linear").any()  # linear droppers may push
     line.write_text(LINE_FILE.format(**{**GOOD, "presag": 0.0005}))
     assert np.all(assemble(load_scene(str(tmp_path / "scene.toml")).build_params()).T0 > 0)
+
+
+def test_a_spring_or_mass_on_a_pinned_end_is_refused_naming_it():
+    """At a wire's pinned end w = 0: a ground spring there acts on nothing and a mass only on the anchor's reaction.
+    A non-zero one is refused naming the support, the key and the wire; a 0 (a CSV table's empty place) reads as
+    absent, the same line as without it."""
+    cw = Wire("contact", "contact", 1.35, 20000.0, 195.0, 0.0, 60.0)
+    mw = Wire("messenger", "messenger", 1.07, 16000.0, 131.7, 0.0, 60.0)
+    mid = Support(30.0, {"contact": 300.0, "messenger": 5e4})
+    drop = (Dropper(15.0, "messenger", "contact", 1e5), Dropper(45.0, "messenger", "contact", 1e5))
+    for k, m in (({"contact": 300.0}, {}), ({}, {"messenger": 0.5})):
+        with pytest.raises(ParameterError, match=r"support at x = 60.0 m gives (k_contact = 300.0|m_messenger = 0.5) "
+                                                 r"on the pinned end of wire '(contact|messenger)'"):
+            Line((cw, mw), (Support(0.0), mid, Support(60.0, k, m)), drop)
+    zero = Line((cw, mw), (Support(0.0), mid, Support(60.0, {"contact": 0.0}, {"messenger": 0.0})), drop)
+    assert zero == Line((cw, mw), (Support(0.0), mid, Support(60.0)), drop)
+    free = Wire("stitch", "stitch", 0.31, 3500.0, 10.0, 20.0, 40.0, ends=("free", "free"))
+    Line((cw, mw, free), (Support(0.0), mid, Support(60.0)), drop,
+         clamps=(Clamp(20.0, "stitch", "messenger", 1e7), Clamp(40.0, "stitch", "messenger", 1e7)))

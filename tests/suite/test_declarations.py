@@ -315,3 +315,19 @@ def test_the_declared_robustness_corpus_ends_in_clear_errors(tmp_path):
     report = json.loads(out.read_text())
     bad = [(o["name"], o["outcome"], o["last_line"][:200]) for o in report["outcomes"] if o["outcome"] != "clear"]
     assert report["attempts"] > 1000 and not bad, bad[:20]
+
+
+def test_a_profile_too_fine_or_too_many_waves_is_refused_before_anything_is_allocated():
+    """The size guards of an irregularity, by hand: dx = 1 mm over 100 km is 1e8 grid points (> 2e7, 800 MB); 1e5
+    waves on 1.2e4 points (dx = 0.05 m over 600 m) is 1.2e9 multiply-adds (within 2e10), on 1e6 points (50 km) 1e11
+    (refused); each error names the input and the estimate."""
+    from mbsuite.errors import SceneError
+
+    rand = {"seed": 1, "rms": 0.001, "wavelength_min": 1.0, "wavelength_max": 50.0}
+    d = irregularity.SECTION.check({**rand, "dx": 0.001}, "t")
+    with pytest.raises(SceneError, match=r"dx = 0.001 m over the line's 100000 m is 100,000,001 grid points"):
+        irregularity.size_of(d, 1e5, "t")
+    d = irregularity.SECTION.check({**rand, "n_waves": 100_000}, "t")
+    assert irregularity.size_of(d, 600.0, "t") == 12_001
+    with pytest.raises(SceneError, match=r"n_waves = 100,000 on 1,000,001 grid points .* 1e\+11 multiply-adds"):
+        irregularity.size_of(d, 5e4, "t")

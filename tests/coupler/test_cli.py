@@ -104,7 +104,7 @@ def test_figures_draw_on_given_axes():
 
 @pytest.mark.parametrize("argv, msg", [
     (["coupler", "jacobian", "--gamma", "0.9"], "gamma"),
-    (["coupler", "jacobian", "--ey", "-0.1"], "e_y"),
+    (["coupler", "jacobian", "--ey", "-0.1"], "--ey = -0.1 is invalid"),
     (["coupler", "fpp", "--ey", "0.02", "--alpha-bx", "0.06"], "cross"),
     (["coupler", "jacobian", "--R", "0"], "R"),
 ])

@@ -12,6 +12,7 @@ from pathlib import Path
 from ...cli.options import add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import ParameterError, SceneError
+from ...limits import Limit, limit_of
 from ...results import Report, format_table
 from ...scenes import Scene
 from . import analysis
@@ -28,29 +29,27 @@ def mbsuite_run(scene, error_estimate: bool = False):
     return run(scene, error_estimate=error_estimate)
 
 
-def _finite_value(name: str, s: str) -> float:
-    """The option `name`'s value `s` as a finite float (argparse type; ArgumentTypeError naming the option)."""
+def _finite_value(name: str, limit: Limit, s: str) -> float:
+    """The option `name`'s value `s` checked by its declared `limit` (argparse type; ArgumentTypeError naming the
+    option, the value and what is valid)."""
     try:
-        v = float(s)
+        return limit.check(name, float(s), argparse.ArgumentTypeError)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{name} must be a number, got {s!r}") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"{name} must be finite, got {s!r}")
-    return v
+        raise argparse.ArgumentTypeError(f"{name} = {s!r} is not a number; valid: {limit.describe()}") from None
 
 
-def _finite(name: str) -> partial:
-    """The argparse type of a finite number for option `name`."""
-    return partial(_finite_value, name)
+def _finite(name: str, field: str | None = None) -> partial:
+    """The argparse type of option `name`: the `Limit` of `CouplerParams` field `field`, or any finite number."""
+    return partial(_finite_value, name, (limit_of(CouplerParams, field) if field else None) or Limit(unit="rad"))
 
 
 def _geometry_args(p: argparse.ArgumentParser) -> None:
     """--gamma, --ey, --R with the defaults of `CouplerParams` (one default for the Python API and the CLI)."""
     d = CouplerParams()
-    p.add_argument("--gamma", type=_finite("--gamma"), default=d.gamma,
+    p.add_argument("--gamma", type=_finite("--gamma", "gamma"), default=d.gamma,
                    help=f"platform proportion angle [rad] (default 17 deg = {GAMMA_17DEG:.5f}, reproduces Eq 15)")
-    p.add_argument("--ey", type=_finite("--ey"), default=d.e_y, help=f"axial shift e_y [R] (default {d.e_y:g})")
-    p.add_argument("--R", type=_finite("--R"), default=d.R, help=f"joint-circle radius (default {d.R:g})")
+    p.add_argument("--ey", type=_finite("--ey", "e_y"), default=d.e_y, help=f"axial shift e_y [R] (default {d.e_y:g})")
+    p.add_argument("--R", type=_finite("--R", "R"), default=d.R, help=f"joint-circle radius (default {d.R:g})")
 
 
 #: units of the geometry options (a --vary option.NAME study's axes)

@@ -71,8 +71,11 @@ def test_scene_holds_the_design(tmp_path, capsys):
 ])
 def test_scene_out_refuses_what_is_not_one_design(tmp_path, capsys, extra, needle):
     argv = list(ARGS)
-    for i in range(0, len(extra), 2):  # a flag given again replaces the first (argparse: last wins)
-        argv += extra[i:i + 2]
+    for i in range(0, len(extra), 2):  # the flag's value replaced (a flag given twice is an error of its own)
+        if extra[i] in argv:
+            argv[argv.index(extra[i]) + 1] = extra[i + 1]
+        else:
+            argv += extra[i:i + 2]
     path = tmp_path / "x.toml"
     assert main(["drive", "design", "cadjs", *argv, "--scene-out", str(path)]) == 2
     assert needle in capsys.readouterr().err

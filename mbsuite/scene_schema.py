@@ -98,6 +98,9 @@ def sections() -> dict[str, Section]:
             sec = section_of(validator)
             if sec is not None:
                 out[f"{name}.{key}"] = sec
+            v = validator.resolve() if isinstance(validator, Deferred) else validator
+            for sub, s in getattr(v, "schemas", {}).items():  # a section of several kinds: one declaration each
+                out[f"{name}.{sub}"] = s
         for key, sec in spec.input_files.items():
             out[f"{name}.{key}"] = section_of(sec)
     return out

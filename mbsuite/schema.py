@@ -28,6 +28,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from .errors import SceneError
 from .limits import Limit
 
@@ -37,7 +39,8 @@ MAX_ITEMS = 100_000
 
 @dataclass(frozen=True)
 class Items:
-    """A list of `of` (a `Limit`, a `Section` or a tuple of `Limit`s: fixed-length rows) of `min` ... `max` items."""
+    """A list of `of` (a `Limit`, a `Section`, an `Items` (a list of lists) or a tuple of `Limit`s: fixed-length
+    rows) of `min` ... `max` items."""
 
     of: Any
     min: int = 0
@@ -54,6 +57,8 @@ class Items:
             return f"{n}tables ({self.of.title})"
         if isinstance(self.of, tuple):
             return f"{n}rows [{', '.join(lim.doc or lim.describe() for lim in self.of)}]"
+        if isinstance(self.of, Items):
+            return f"{n}lists, each {self.of.describe()}"
         return f"{n}values, each {self.of.describe()}"
 
 
@@ -194,6 +199,8 @@ def check_value(decl: Limit | Items | Section, key: str, value: Any, where: str,
         return decl.check(value, f"{where} [{key}]", error)
     if isinstance(decl, Limit):
         return decl.check(key, value, error, f" in {where}")
+    if isinstance(value, np.ndarray) and value.ndim >= 1:
+        value = value.tolist()  # a numpy user's array: its numbers
     if isinstance(value, str) or not isinstance(value, list | tuple):
         raise error(f"{key} = {value!r} in {where} must be a list: {decl.describe()}")
     if not decl.min <= len(value) <= decl.max:
@@ -203,6 +210,8 @@ def check_value(decl: Limit | Items | Section, key: str, value: Any, where: str,
         name = f"{key}[{i}]"
         if isinstance(decl.of, Section):
             out.append(decl.of.check(item, f"{where} {name}", error))
+        elif isinstance(decl.of, Items):
+            out.append(check_value(decl.of, name, item, where, error))
         elif isinstance(decl.of, tuple):
             if isinstance(item, str) or not isinstance(item, list | tuple) or len(item) != len(decl.of):
                 raise error(f"{name} = {item!r} in {where} must be a row of {len(decl.of)} values "

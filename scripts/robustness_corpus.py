@@ -1238,6 +1238,10 @@ def toml_text(data: dict, head: tuple[str, ...] = ()) -> str:
 
 #: how a user's file reaches a declared input file's loader: the command that reads it
 FILE_COMMANDS = {"catenary.line_file": ("catenary",)}
+#: declarations of one kind of a scene section: the scene tables that hold them
+PART_OF = {"catenary.pantograph_lumped": lambda d: {"effects": {"pantograph": "lumped"}, "pantograph": {"params": d}},
+           "catenary.pantograph_transfer": lambda d: {"effects": {"pantograph": "transfer"},
+                                                      "pantograph": {"params": d}}}
 
 
 def declared_attempts() -> Iterator[Attempt]:
@@ -1280,6 +1284,9 @@ def declared_attempts() -> Iterator[Attempt]:
                     target[path[-1]] = value
                 if name in FILE_COMMANDS:
                     text, cmd = toml_text(data), (*FILE_COMMANDS[name], f"{DIR}/input.toml", "--json")
+                elif name in PART_OF:
+                    text = f"model = {json.dumps(model)}\n" + toml_text(PART_OF[name](data))
+                    cmd = ("run", f"{DIR}/input.toml", "--json")
                 else:
                     text = f"model = {json.dumps(model)}\n" + toml_text({key: data})
                     cmd = ("run", f"{DIR}/input.toml", "--json")

@@ -13,6 +13,7 @@ import json
 import sys
 from pathlib import Path
 
+from mbsuite.deferred import Deferred
 from mbsuite.limits import limits_table
 from mbsuite.registry import models
 from mbsuite.scene_schema import scene_schema, section_of
@@ -46,6 +47,9 @@ def files() -> dict[Path, str]:
             sec = section_of(validator)
             if sec is not None:
                 pages.append(f"### [{key}]\n\n" + sec.markdown())
+            for sub in getattr(validator.resolve() if isinstance(validator, Deferred) else validator, "schemas",
+                               {}).values():
+                pages.append(f"### [{key}] ({sub.title})\n\n" + sub.markdown())
         for key, decl in spec.input_files.items():
             sec = section_of(decl)
             out[OUT / f"{name}.{key}.json"] = json.dumps(sec.json_schema(top=True), indent=1) + "\n"

@@ -93,19 +93,19 @@ def test_lumped_pantograph_signals_and_energy_are_the_chain():
 
 @pytest.mark.parametrize("kind, section, match", [
     ("lumped", None, "takes its parameters"),
-    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [1.0]}}, "missing \\['F0'\\]"),
-    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [1.0], "F0": 1.0, "x": 2}}, "unknown \\['x'\\]"),
+    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [1.0]}}, "F0 missing; required: F0"),
+    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [1.0], "F0": 1.0, "x": 2}}, "unknown key\\(s\\) \\['x'\\]"),
     ("lumped", {"params": {"m": [1.0, 2.0], "k": [1.0], "c": [1.0], "F0": 1.0}}, "one length"),
     ("lumped", {"params": {"m": [-1.0], "k": [1.0], "c": [1.0], "F0": 1.0}}, "m\\[0\\]"),
     ("lumped", {"params": {"m": [1.0, 1.0], "k": [0.0, 1.0], "c": [1.0, 1.0], "F0": 1.0}}, "k\\[0\\]"),
-    ("lumped", {"params": {"m": "heavy", "k": [1.0], "c": [1.0], "F0": 1.0}}, "list of numbers"),
-    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [float("nan")], "F0": 1.0}}, "finite"),
+    ("lumped", {"params": {"m": "heavy", "k": [1.0], "c": [1.0], "F0": 1.0}}, "m = 'heavy' .* must be a list"),
+    ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [float("nan")], "F0": 1.0}}, "c\\[0\\] = nan .* is invalid"),
     ("lumped", {"params": {"m": [1.0], "k": [1.0], "c": [1.0], "F0": True}}, "F0"),
     ("lumped", {"effects": {"coulomb": False}, "params": {}}, "no effects"),
     ("lumped", {"param": {}}, "unknown key"),
     ("transfer", {"params": {"A": [[1.0, 2.0]], "B": [1.0], "C": [1.0], "F0": 1.0}}, "square"),
     ("transfer", {"params": {"A": [[1.0, 2.0], [3.0]], "B": [1.0], "C": [1.0], "F0": 1.0}}, "square"),
-    ("transfer", {"params": {"A": [[-1.0]], "B": [1.0, 2.0], "C": [1.0], "F0": 1.0}}, "B and C"),
+    ("transfer", {"params": {"A": [[-1.0]], "B": [1.0, 2.0], "C": [1.0], "F0": 1.0}}, "B, C of its size"),
     ("transfer", {"params": {"A": [[-1.0]], "B": [1.0], "C": [1.0]}}, "missing"),
 ])
 def test_bad_pantograph_section_is_refused_by_name(kind, section, match):
@@ -120,7 +120,7 @@ def test_section_validator_tells_the_linear_pantographs_apart():
     tp = {"params": _two_mass_transfer().section()}
     assert validate_section(lp)["params"]["m"] == [P.m1, P.m2]
     assert validate_section(tp)["params"]["F0"] == pytest.approx(P.F0 * P.k1 / (P.k1 + P.k2))
-    with pytest.raises(SceneError, match="B and C"):
+    with pytest.raises(SceneError, match="B, C of its size"):
         validate_section({"params": {**tp["params"], "B": [1.0]}})
     # two stages are the 2-mass pantograph's model: made one, stepped in the compiled loop; three are not
     two = build("lumped", P, section=lp)

@@ -46,6 +46,8 @@ LOADERS: dict[str, Callable[[Any], Any]] = {
     "catenary.train": models()["catenary"].sections["train"],
     "catenary.quality": models()["catenary"].sections["quality"],
     "drives.design": models()["drives"].sections["design"],
+    "catenary.pantograph_lumped": lambda d: models()["catenary"].sections["pantograph"]({"params": d}),
+    "catenary.pantograph_transfer": lambda d: models()["catenary"].sections["pantograph"]({"params": d}),
 }
 EXAMPLES = {name: (sec.example, LOADERS[name]) for name, sec in sections().items()}
 LINE = sections()["catenary.line_file"].example

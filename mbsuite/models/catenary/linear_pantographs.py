@@ -25,7 +25,6 @@ one. `mbsuite pantograph fit-lumped` writes both from the Eppinger model's linea
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -33,39 +32,111 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError, SceneError, SolverError
+from ...limits import Limit
+from ...schema import Items, Rule, Section
 
 #: the `pantograph` effect's values of the linear pantographs
 LUMPED, TRANSFER = "lumped", "transfer"
 #: the keys of `[pantograph] params` each takes
-LUMPED_KEYS, TRANSFER_KEYS = ("m", "k", "c", "F0"), ("A", "B", "C", "F0")
+LUMPED_KEYS = ("m", "k", "c", "F0", "negative_base_spring")
+TRANSFER_KEYS = ("A", "B", "C", "F0", "negative_static_stiffness")
 #: the largest state a transfer-function pantograph may have (its step solves an n x n system once per time step)
 MAX_STATES = 40
 #: the largest number of stages of a lumped pantograph
 MAX_STAGES = 20
+#: the frequencies (Hz) on which a transfer-function pantograph's passivity is checked (besides its poles')
+PASSIVITY_GRID = np.geomspace(1e-3, 1e3, 601)
 
 
-def _number(v: Any, what: str) -> float:
-    """A finite real number (numpy scalars and 0-d arrays accepted), else ParameterError naming `what`."""
-    if isinstance(v, bool | str) or not isinstance(v, int | float | np.number | np.ndarray) or np.ndim(v) != 0:
-        raise ParameterError(f"{what} must be a number, got {v!r}")
-    x = float(v)
-    if not math.isfinite(x):
-        raise ParameterError(f"{what} must be finite, got {v!r}")
-    return x
+def _lumped_rules(d: Mapping[str, Any]) -> str | None:
+    m, k, c = d["m"], d["k"], d["c"]
+    if not len(m) == len(k) == len(c):
+        return f"m, k, c need one length (one entry per stage), got {len(m)}, {len(k)}, {len(c)}"
+    bad = next((i for i, x in enumerate(k[:-1]) if not x > 0), None)
+    if bad is not None:
+        return f"k[{bad}] = {k[bad]!r} N/m must be > 0: only the last spring, to the base, may be <= 0"
+    if k[-1] < 0 and not d["negative_base_spring"]:
+        return (f"the base spring k[{len(k) - 1}] = {k[-1]!r} N/m is negative (a static uplift that rises as the head "
+                "falls: the pantograph alone is statically unstable, held by the wire): state it with "
+                "negative_base_spring = true")
+    if d["negative_base_spring"] and not k[-1] < 0:
+        return f"negative_base_spring = true, but the base spring k[{len(k) - 1}] = {k[-1]!r} N/m is not negative"
+    den = 1.0 + k[-1] * sum(1.0 / x for x in k[:-1])
+    if not den > 0:
+        return (f"the base spring k[{len(k) - 1}] = {k[-1]!r} N/m outweighs the chain above it (1 + k_n sum 1/k_i = "
+                f"{den:.3g} <= 0): the static force F0 / (1 + k_n sum 1/k_i) is not positive")
+    return None
 
 
-def _ndim(v: Any) -> int:
+def _transfer_rules(d: Mapping[str, Any]) -> str | None:
+    A, B, C = d["A"], d["B"], d["C"]
+    n = len(A)
+    if any(len(r) != n for r in A) or len(B) != n or len(C) != n:
+        return (f"A must be square and B, C of its size: A rows {[len(r) for r in A]}, B {len(B)}, C {len(C)} "
+                f"entries")
+    A, B, C = np.array(A, float), np.array(B, float), np.array(C, float)
+    poles = np.linalg.eigvals(A)
+    scale = max(1.0, float(np.max(np.abs(poles))))
+    oscillating = [p for p in poles if abs(p.imag) > 1e-9 * scale and p.real >= 0]
+    if oscillating:
+        return (f"unstable: pole(s) {[complex(round(p.real, 6), round(p.imag, 6)) for p in oscillating]} 1/s of A "
+                "have a real part >= 0 (an oscillation that grows; a pantograph's modes decay)")
+    rising = [float(p.real) for p in poles if abs(p.imag) <= 1e-9 * scale and p.real >= 0]
     try:
-        return int(np.ndim(v))
-    except ValueError:  # a ragged list
-        return -1
+        g0 = float(-C @ np.linalg.solve(A, B))
+    except np.linalg.LinAlgError:
+        return "A is singular: G(0) does not exist (a pantograph free to drift: give it a static stiffness)"
+    if rising and not (d["negative_static_stiffness"] and g0 < 0 and len(rising) == 1):
+        return (f"unstable: real pole(s) {[round(p, 6) for p in rising]} 1/s >= 0; a pantograph alone is unstable "
+                "only through a negative static stiffness (one real pole, G(0) < 0), stated with "
+                f"negative_static_stiffness = true (here G(0) = {g0:.4g} m/N)")
+    if d["negative_static_stiffness"] and not g0 < 0:
+        return f"negative_static_stiffness = true, but G(0) = {g0:.4g} m/N is not negative"
+    f = np.concatenate([PASSIVITY_GRID, np.abs(poles.imag) / (2 * np.pi)])
+    f = np.unique(f[f > 0])
+    G = np.array([C @ np.linalg.solve(2j * np.pi * x * np.eye(n) - A, B) for x in f])
+    worst = int(np.argmax(G.imag / np.maximum(np.abs(G), 1e-300)))
+    if G.imag[worst] > 1e-9 * abs(G[worst]):
+        return (f"not passive: Im G = {G.imag[worst]:.3g} m/N > 0 at {f[worst]:.4g} Hz (the head would give energy "
+                "to the wire there: negative damping)")
+    return None
 
 
-def _vector(v: Any, what: str) -> tuple[float, ...]:
-    """A list of finite real numbers, else ParameterError naming `what`."""
-    if isinstance(v, str | bytes | Mapping) or not isinstance(v, Sequence | np.ndarray) or _ndim(v) != 1:
-        raise ParameterError(f"{what} must be a list of numbers, got {v!r}")
-    return tuple(_number(x, f"{what}[{i}]") for i, x in enumerate(v))
+def _lim(lo: float | None = None, hi: float | None = None, unit: str = "", doc: str = "", **kw: Any) -> Limit:
+    return Limit(lo=lo, hi=hi, unit=unit, doc=doc, **kw)
+
+
+#: the declaration of a lumped pantograph's `[pantograph] params`
+LUMPED_SECTION = Section("[pantograph] params (lumped)", {
+    "m": Items(_lim(0.0, 1e4, "kg", "stage mass", lo_open=True), min=1, max=MAX_STAGES, unit="kg",
+               doc="stage masses, stage 1 the head"),
+    "k": Items(_lim(-1e9, 1e9, "N/m", "stage spring"), min=1, max=MAX_STAGES, unit="N/m",
+               doc="springs: k_i joins stage i to stage i + 1, the last to the base (only it may be <= 0)"),
+    "c": Items(_lim(0.0, 1e9, "N s/m", "stage damper"), min=1, max=MAX_STAGES, unit="N s/m",
+               doc="dampers, beside the springs (>= 0: passive)"),
+    "F0": _lim(0.0, 1e4, "N", "static uplift on the last stage", lo_open=True),
+    "negative_base_spring": Limit(kind=bool, default=False,
+                                  doc="states a negative base spring (a fitted pantograph's: uplift rising as the "
+                                      "head falls)"),
+}, required=("m", "k", "c", "F0"), rules=(
+    Rule("m, k, c of one length; k_i > 0 but the base spring's; a negative base spring stated; a positive static "
+         "force", _lumped_rules),),
+    doc="an n-stage lumped pantograph", example={"m": [8.0, 12.0, 20.0], "k": [9000.0, 4000.0, 300.0],
+                                                 "c": [30.0, 60.0, 120.0], "F0": 100.0})
+#: the declaration of a transfer-function pantograph's `[pantograph] params`
+TRANSFER_SECTION = Section("[pantograph] params (transfer function)", {
+    "A": Items(Items(_lim(-1e12, 1e12, "1/s"), min=1, max=MAX_STATES), min=1, max=MAX_STATES,
+               doc="state matrix (square, rows of A)"),
+    "B": Items(_lim(-1e12, 1e12), min=1, max=MAX_STATES, doc="input vector (per N of upward force)"),
+    "C": Items(_lim(-1e12, 1e12), min=1, max=MAX_STATES, doc="output vector (m of head per unit state)"),
+    "F0": _lim(0.0, 1e4, "N", "contact force at the working height against a rigid wire", lo_open=True),
+    "negative_static_stiffness": Limit(kind=bool, default=False,
+                                       doc="states G(0) < 0 and its one real unstable pole (a fitted pantograph's)"),
+}, required=("A", "B", "C", "F0"), rules=(
+    Rule("A square, B and C of its size; stable (every oscillating pole decays; one real pole >= 0 only with "
+         "negative_static_stiffness); passive (Im G(j w) <= 0)", _transfer_rules),),
+    doc="a transfer-function pantograph G(s) = C (sI - A)^-1 B",
+    example={"A": [[0.0, 1.0], [-500.0, -2.0]], "B": [0.0, 0.1], "C": [1.0, 0.0], "F0": 90.0})
 
 
 def chain_receptance(m: Sequence[float], k: Sequence[float], c: Sequence[float], freqs: np.ndarray) -> np.ndarray:
@@ -89,24 +160,12 @@ class LumpedParams:
     k: tuple[float, ...]
     c: tuple[float, ...]
     F0: float
+    negative_base_spring: bool = False
 
     def __post_init__(self) -> None:
-        m, k, c = (_vector(getattr(self, n), n) for n in ("m", "k", "c"))
-        if not 1 <= len(m) <= MAX_STAGES or len(k) != len(m) or len(c) != len(m):
-            raise ParameterError(f"a lumped pantograph needs m, k, c of one length (1 to {MAX_STAGES} stages), got "
-                                 f"{len(m)}, {len(k)}, {len(c)}")
-        for name, vals, lo in (("m", m, 1e-6), ("c", c, 0.0)):
-            for i, x in enumerate(vals):
-                if x < lo:
-                    raise ParameterError(f"lumped pantograph {name}[{i}] = {x!r}: must be >= {lo:g}")
-        for i, x in enumerate(k[:-1]):
-            if x <= 0:
-                raise ParameterError(f"lumped pantograph k[{i}] = {x!r}: must be > 0 (only the last, to the base, "
-                                     "may be <= 0)")
-        object.__setattr__(self, "m", m)
-        object.__setattr__(self, "k", k)
-        object.__setattr__(self, "c", c)
-        object.__setattr__(self, "F0", _number(self.F0, "lumped pantograph F0"))
+        d = LUMPED_SECTION.check({f: getattr(self, f) for f in LUMPED_KEYS}, "lumped pantograph", ParameterError)
+        for f in LUMPED_KEYS:
+            object.__setattr__(self, f, tuple(d[f]) if isinstance(d[f], list) else d[f])
 
     @property
     def stages(self) -> int:
@@ -139,7 +198,8 @@ class LumpedParams:
 
     def section(self) -> dict[str, Any]:
         """The scene's `[pantograph] params` of this pantograph."""
-        return {"m": list(self.m), "k": list(self.k), "c": list(self.c), "F0": self.F0}
+        return {"m": list(self.m), "k": list(self.k), "c": list(self.c), "F0": self.F0,
+                **({"negative_base_spring": True} if self.negative_base_spring else {})}
 
 
 @dataclass(frozen=True)
@@ -151,28 +211,21 @@ class TransferParams:
     B: tuple[float, ...]
     C: tuple[float, ...]
     F0: float
+    negative_static_stiffness: bool = False
 
     def __post_init__(self) -> None:
-        A = self.A
-        if isinstance(A, str | Mapping) or not isinstance(A, Sequence | np.ndarray) or not len(A):
-            raise ParameterError(f"transfer-function pantograph A must be a square list of lists, got {A!r}")
-        rows = tuple(_vector(r, f"transfer-function pantograph A[{i}]") for i, r in enumerate(A))
-        n = len(rows)
-        if not 1 <= n <= MAX_STATES or any(len(r) != n for r in rows):
-            raise ParameterError(f"transfer-function pantograph A must be square, 1 to {MAX_STATES} states, got "
-                                 f"{[len(r) for r in rows]}")
-        B = _vector(self.B, "transfer-function pantograph B")
-        C = _vector(self.C, "transfer-function pantograph C")
-        if len(B) != n or len(C) != n:
-            raise ParameterError(f"transfer-function pantograph B and C need {n} entries (A is {n} x {n}), got "
-                                 f"{len(B)} and {len(C)}")
-        object.__setattr__(self, "A", rows)
-        object.__setattr__(self, "B", B)
-        object.__setattr__(self, "C", C)
-        object.__setattr__(self, "F0", _number(self.F0, "transfer-function pantograph F0"))
+        A = self.A.tolist() if isinstance(self.A, np.ndarray) else self.A
+        d = TRANSFER_SECTION.check({**{f: getattr(self, f) for f in TRANSFER_KEYS}, "A": A},
+                                   "transfer-function pantograph", ParameterError)
+        object.__setattr__(self, "A", tuple(tuple(r) for r in d["A"]))
+        for f in ("B", "C"):
+            object.__setattr__(self, f, tuple(d[f]))
+        object.__setattr__(self, "F0", d["F0"])
+        object.__setattr__(self, "negative_static_stiffness", d["negative_static_stiffness"])
 
     @classmethod
-    def from_tf(cls, num: Sequence[float], den: Sequence[float], F0: float) -> TransferParams:
+    def from_tf(cls, num: Sequence[float], den: Sequence[float], F0: float,
+                negative_static_stiffness: bool = False) -> TransferParams:
         """The controllable realisation of G(s) = num(s) / den(s) (coefficients highest power first, s in rad/s;
         strictly proper)."""
         from scipy.signal import tf2ss
@@ -182,7 +235,7 @@ class TransferParams:
             raise ParameterError("a transfer-function pantograph needs a strictly proper G(s) (numerator degree below "
                                  "the denominator's)")
         A, B, C, D = tf2ss(num, den)
-        return cls(tuple(map(tuple, A)), tuple(B[:, 0]), tuple(C[0]), F0)
+        return cls(tuple(map(tuple, A)), tuple(B[:, 0]), tuple(C[0]), F0, negative_static_stiffness)
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C) as arrays."""
@@ -200,7 +253,8 @@ class TransferParams:
 
     def section(self) -> dict[str, Any]:
         """The scene's `[pantograph] params` of this pantograph."""
-        return {"A": [list(r) for r in self.A], "B": list(self.B), "C": list(self.C), "F0": self.F0}
+        return {"A": [list(r) for r in self.A], "B": list(self.B), "C": list(self.C), "F0": self.F0,
+                **({"negative_static_stiffness": True} if self.negative_static_stiffness else {})}
 
 
 class LinearPantograph:
@@ -246,6 +300,16 @@ class LinearPantograph:
         except np.linalg.LinAlgError:
             raise SolverError(f"the {self.name} pantograph has no static equilibrium against a wire of stiffness "
                               f"{k_wire:g} N/m (its model is singular there)") from None
+        if k_wire > 0:  # pressed on the wire: the pantograph and the wire's static stiffness together must be stable
+            poles = np.linalg.eigvals(self.A - k_wire * np.outer(self.B, self.c))
+            worst = poles[np.argmax(poles.real)]
+            if worst.real >= -1e-12 * max(1.0, float(np.max(np.abs(poles)))):
+                raise ParameterError(f"the {self.name} pantograph pressed on the wire (static stiffness {k_wire:.4g} "
+                                     f"N/m) is unstable: pole {complex(worst):.4g} 1/s; its parameters describe no "
+                                     "pantograph that can run under this line")
+            if not z[n] > 0:
+                raise ParameterError(f"the {self.name} pantograph's static contact force on the wire is {z[n]:.4g} "
+                                     "N (not positive): it would leave the wire at rest (F0 and the springs)")
         self.x = z[:n]
         return float(z[n])
 
@@ -331,14 +395,10 @@ def params_of(kind: str, value: Any) -> LumpedParams | TransferParams:
         raise SceneError(f"the {kind} pantograph has no effects: remove [pantograph] effects = "
                          f"{dict(value['effects'])!r}")
     params = value.get("params")
-    if not isinstance(params, Mapping):
-        raise SceneError(f"the {kind} pantograph needs [pantograph] params = {{{', '.join(keys)}}}, got {params!r}")
-    unknown, missing = sorted(set(params) - set(keys)), [k for k in keys if k not in params]
-    if unknown or missing:
-        raise SceneError(f"[pantograph] params of the {kind} pantograph: unknown {unknown}, missing {missing}; "
-                         f"valid keys: {list(keys)}")
+    section = LUMPED_SECTION if cls is LumpedParams else TRANSFER_SECTION
+    d = section.check(params, "[pantograph] params")
     try:
-        return cls(**{k: params[k] for k in keys})
+        return cls(**d)
     except ParameterError as exc:
         raise SceneError(f"[pantograph] params: {exc}") from None
 

@@ -39,6 +39,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from ...errors import SceneError
+from ...limits import limit_of
 from ...registry import ModelSpec, get_model
 from . import linear_pantographs as linear
 
@@ -279,9 +280,10 @@ def _check_section(value: Any, name: str, spec: ModelSpec) -> dict[str, dict[str
         raise SceneError(f"unknown parameter(s) {bad} of the {name!r} pantograph (model '{spec.name}') in "
                          f"[pantograph]; valid parameters: {valid}")
     for k, v in params.items():
-        if isinstance(v, bool) or not isinstance(v, int | float):
-            raise SceneError(f"[pantograph] parameter {k!r} must be a number (SI units), got {v!r}")
-    spec.params_cls(**params)  # the model's parameter dataclass validates the values
+        lim = limit_of(spec.params_cls, k)
+        if lim is not None:
+            lim.check(k, v, SceneError, f" in [pantograph] params (the {name!r} pantograph)")
+    spec.params_cls(**params)  # the model's parameter dataclass validates the values and across them
     return {"effects": dict(effects), "params": dict(params)}
 
 
@@ -303,6 +305,10 @@ def validate_section(value: Any) -> dict[str, dict[str, Any]]:
         except SceneError as exc:
             first = first or exc
     raise first if first is not None else SceneError("no registry pantograph takes a [pantograph] section")
+
+
+validate_section.schemas = {"pantograph_lumped": linear.LUMPED_SECTION,
+                            "pantograph_transfer": linear.TRANSFER_SECTION}
 
 
 def build(name: str, p, engine: str = "reference", dt: float = 1e-4, section: Mapping[str, Any] | None = None,

@@ -37,6 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ...errors import ParameterError
+from ...limits import Limit
 from ..catenary.linear_pantographs import LumpedParams, TransferParams, chain_receptance
 from .equations import PantographConfig, PantographODE
 from .params import PantographParams
@@ -71,6 +72,10 @@ class DrivingPoint:
         head falls."""
         return -1.0 / float(self.C @ np.linalg.solve(self.A, self.B))
 
+
+#: the stages of a lumped fit and the order of a transfer-function fit
+STAGES = Limit(lo=1, hi=6, kind=int, doc="stages of a lumped fit")
+ORDER = Limit(lo=2, hi=16, kind=int, doc="order of a transfer-function fit")
 
 def band_freqs(band: tuple[float, float] = BAND, df: float = DF) -> np.ndarray:
     """The frequencies f_lo, f_lo + df, ..., f_hi (Hz), checked."""
@@ -179,8 +184,7 @@ def fit_lumped(freqs: np.ndarray, G: np.ndarray, stages: int, static_force: floa
     its static contact force at the working height is `static_force` (N). `static_stiffness` (N/m): the chain's
     static stiffness at the head is held at this value through its base spring k_n (which may then be negative: an
     uplift that rises as the head falls) and k_n is not fitted; None: k_n is fitted as the others, positive."""
-    if isinstance(stages, bool) or not isinstance(stages, int | np.integer) or not 1 <= stages <= 6:
-        raise ParameterError(f"stages = {stages!r}: a lumped fit takes 1 to 6 stages")
+    stages = STAGES.check("stages", stages, ParameterError, " of a lumped fit")
     freqs, G = np.asarray(freqs, float), np.asarray(G, complex)
     if freqs.shape != G.shape or freqs.size < 3 * stages:
         raise ParameterError(f"a {stages}-stage fit needs at least {3 * stages} frequencies, as many as responses")
@@ -235,7 +239,8 @@ def fit_lumped(freqs: np.ndarray, G: np.ndarray, stages: int, static_force: floa
             best = pol
     m, k, c = unpack(best.x)
     # LumpedParams.static_force is F0 / (1 + k_n sum_{i<n} 1/k_i): the F0 that gives `static_force`
-    p = LumpedParams(tuple(m), tuple(k), tuple(c), float(static_force) * (1.0 + k[-1] * float(np.sum(1.0 / k[:-1]))))
+    p = LumpedParams(tuple(m), tuple(k), tuple(c), float(static_force) * (1.0 + k[-1] * float(np.sum(1.0 / k[:-1]))),
+                     negative_base_spring=bool(k[-1] < 0))  # stated: the fitted uplift rises as the head falls
     return LumpedFit(p, fit_error(freqs, p.receptance(freqs), G), float(best.cost), int(starts), int(nfev))
 
 
@@ -261,8 +266,7 @@ def fit_transfer(freqs: np.ndarray, G: np.ndarray, order: int, static_force: flo
                  ) -> TransferFit:
     """The rational G(s) of order `order` (denominator degree; numerator degree order - 2) nearest `G` at `freqs`
     (module docstring), as a transfer-function pantograph with static force `static_force` (N)."""
-    if isinstance(order, bool) or not isinstance(order, int | np.integer) or not 2 <= order <= 16:
-        raise ParameterError(f"order = {order!r}: a transfer-function fit takes orders 2 to 16")
+    order = ORDER.check("order", order, ParameterError, " of a transfer-function fit")
     freqs, G = np.asarray(freqs, float), np.asarray(G, complex)
     n, m = int(order), int(order) - 2
     if freqs.size < 2 * n:
@@ -293,7 +297,8 @@ def fit_transfer(freqs: np.ndarray, G: np.ndarray, order: int, static_force: flo
     num_s = coef[:m + 1] * g0 / w0 ** np.arange(m, -1, -1)
     den_s = np.concatenate([[1.0], coef[m + 1:]]) / w0 ** np.arange(n, -1, -1)
     num_s, den_s = num_s / den_s[0], den_s / den_s[0]
-    tp = TransferParams.from_tf(num_s, den_s, float(static_force))
+    g0 = float(np.polyval(num_s, 0.0) / np.polyval(den_s, 0.0)) if np.polyval(den_s, 0.0) != 0 else 0.0
+    tp = TransferParams.from_tf(num_s, den_s, float(static_force), negative_static_stiffness=g0 < 0)
     poles = np.roots(den_s)
     G_fit = tp.receptance(freqs)
     return TransferFit(tuple(map(float, num_s)), tuple(map(float, den_s)), tp, tuple(complex(z) for z in poles),

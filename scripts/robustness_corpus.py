@@ -1300,13 +1300,13 @@ def declared_attempts() -> Iterator[Attempt]:
 
     per_key = {"text", "nan", "inf", "below", "above", "fraction", "unknown word", "number"}
     for model, spec in models().items():
-        keys = [("params", f.name, f.metadata["limit"]) for f in dataclasses.fields(spec.params_cls)
+        keys = [("params", None, f.name, f.metadata["limit"]) for f in dataclasses.fields(spec.params_cls)
                 if "limit" in f.metadata]
-        keys += [("input", k, d) for keys_ in spec.inputs.values() for k, d in keys_.items() if isinstance(d, Limit)]
+        keys += [("input", t, k, d) for t, keys_ in spec.inputs.items() for k, d in keys_.items()
+                 if isinstance(d, Limit)]
         if model == "pantograph":  # one model's scene for the settings every model shares
-            keys += [("solver", k, d) for k, d in {**SOLVER_LIMITS, **SOLVER_WORDS}.items()]
-        for section, key, decl in keys:
-            itype = next((t for t, ks in spec.inputs.items() if key in ks), None) if section == "input" else None
+            keys += [("solver", None, k, d) for k, d in {**SOLVER_LIMITS, **SOLVER_WORDS}.items()]
+        for section, itype, key, decl in keys:
             good = decl.default if decl.has_default else None
             cases = [(lab, v) for lab, v in bad_values(decl) if lab in per_key]
             if good is not None and not isinstance(good, list | tuple):
@@ -1314,7 +1314,8 @@ def declared_attempts() -> Iterator[Attempt]:
             for label, value in cases:
                 table = {key: value, **({"type": itype} if itype else {})}
                 text = f"model = {json.dumps(model)}\n" + toml_text({section: table})
-                yield Attempt(f"declared-{model}.{section}-{key}-{label.replace(' ', '-')}", a,
+                yield Attempt(f"declared-{model}.{section}{'.' + itype if itype else ''}-{key}-"
+                              f"{label.replace(' ', '-')}", a,
                               f"{model} {section}.{key}: {label}", "error", ("run", f"{DIR}/input.toml", "--json"),
                               culprit=key, files=(("input.toml", text.encode()),))
 

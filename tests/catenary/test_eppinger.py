@@ -133,7 +133,7 @@ def test_pantograph_section_is_validated_against_the_pantograph_model(tmp_path):
         sc.replace(pantograph={"params": {"F0": 120.0}})
     with pytest.raises(SceneError, match="cylinder"):
         sc.replace(pantograph={"effects": {"cylinder": "pneumatic"}})
-    with pytest.raises(ParameterError, match="Pg"):
+    with pytest.raises(SceneError, match=r"Pg = -1.0 in \[pantograph\] params .*valid: \(0, inf\) Pa"):
         sc.replace(pantograph={"params": {"Pg": -1.0}})
     bad = tmp_path / "bad.toml"
     bad.write_text('model = "catenary"\n[pantograph]\nmass = 3.0\n')

@@ -37,9 +37,11 @@ def test_a_growing_oscillation_is_refused_even_when_stated():
 def test_a_non_passive_transfer_function_is_refused_naming_the_frequency():
     """G(s) = (1 - s) / (s + 1)^2 is stable (a double pole at -1) but Im G(j w) = (w^3 - 3 w) / (1 + w^2)^2 > 0 for
     w > sqrt 3 (f > 0.2757 Hz): the head would give energy to the wire there. The check's grid (601 points from 1 mHz
-    to 1 kHz) finds it; the worst point relative to |G| is at the grid's top."""
-    with pytest.raises(ParameterError, match=r"not passive: Im G = .* > 0 at .* Hz"):
+    to 1 kHz, 2.3 % apart) finds it: the lowest frequency named is the first grid point above sqrt(3) / (2 pi) Hz."""
+    with pytest.raises(ParameterError, match=r"not passive: Im G = .* > 0 at .* Hz, the lowest") as err:
         TransferParams.from_tf([-1.0, 1.0], [1.0, 2.0, 1.0], 90.0)
+    f_named = float(str(err.value).split(" Hz, the lowest")[0].rsplit(" at ", 1)[1])
+    assert np.sqrt(3) / (2 * np.pi) < f_named <= np.sqrt(3) / (2 * np.pi) * 10 ** 0.01 * 1.0001
     w = 2 * np.pi * 0.5
     g = (1 - 1j * w) / (1j * w + 1) ** 2
     assert g.imag == pytest.approx((w ** 3 - 3 * w) / (1 + w * w) ** 2) and g.imag > 0
@@ -57,7 +59,8 @@ def test_a_non_positive_static_force_is_refused(F0):
 def test_lumped_masses_springs_and_the_base_spring():
     """m = -1 refused; a negative base spring refused unless stated, stated without one refused; k = [100, -200]:
     1 + k_n / k_1 = -1 <= 0, the static force F0 / -1 not positive: refused."""
-    with pytest.raises(ParameterError, match=r"m\[0\] = -1.0 in lumped pantograph is invalid; valid: \(0, 10000\] kg"):
+    with pytest.raises(ParameterError,
+                       match=r"m\[0\] = -1.0 in lumped pantograph is invalid; valid: \[1e-06, 10000\] kg"):
         LumpedParams((-1.0,), (1e3,), (5.0,), 90.0)
     with pytest.raises(ParameterError, match=r"base spring k\[1\] = -30.0 N/m is negative.*negative_base_spring"):
         LumpedParams((10.0, 10.0), (1e4, -30.0), (10.0, 100.0), 90.0)
@@ -90,3 +93,56 @@ def test_numpy_users_numbers():
     for bad in (True, float("nan"), float("inf"), "90"):
         with pytest.raises(ParameterError, match="F0"):
             LumpedParams((10.0,), (1e3,), (5.0,), bad)
+
+
+def test_a_rigid_body_pole_is_refused_in_a_transfer_function():
+    """G(s) = 1 / (s (s + 1)): a pole at 0, G(0) infinite (no static stiffness). A transfer-function pantograph's
+    receptance is finite at 0 Hz; a constant uplift is the lumped chain with k_n = 0 (accepted: its rigid-body mode is
+    held by the wire, the static force F0 / (1 + 0) = F0)."""
+    with pytest.raises(ParameterError, match=r"A has 1 pole\(s\) at 0 \(a rigid-body mode"):
+        TransferParams.from_tf([1.0], [1.0, 1.0, 0.0], 90.0)
+    assert LumpedParams((10.0, 10.0), (1e4, 0.0), (10.0, 100.0), 90.0).static_force() == 90.0
+
+
+def test_a_negative_damper_above_the_grid_is_refused_by_the_high_frequency_rule():
+    """G(s) = 1 / (s + 1)^2 - e / (s + 1), e = 1e-8: stable (a double pole at -1); Im G(j w) = -2 w / (1 + w^2)^2 +
+    e w / (1 + w^2) > 0 only for w > sqrt(2 / e - 1) = 14142 rad/s (2251 Hz), above the 1 kHz grid. Exactly: C B = -e,
+    the head a negative damper at high frequency. With e = 0 (C B = 0, C A B = 1: a 1 kg head) it is accepted."""
+    e = 1e-8
+    w = np.sqrt(2 / e - 1)
+    for x, sign in ((0.99 * w, -1), (1.01 * w, 1)):  # the hand computation: the sign of Im G changes at w
+        assert np.sign(-2 * x / (1 + x * x) ** 2 + e * x / (1 + x * x)) == sign
+    with pytest.raises(ParameterError, match=r"not passive at high frequencies: C B = -1e-08 m/\(N s\) < 0"):
+        TransferParams.from_tf([-e, 1.0 - e], [1.0, 2.0, 1.0], 90.0)
+    ok = TransferParams.from_tf([1.0], [1.0, 2.0, 1.0], 90.0)
+    A, B, C = ok.arrays()
+    assert C @ B == 0.0 and C @ A @ B == pytest.approx(1.0)
+
+
+def test_large_state_matrix_entries_are_numbers_not_errors():
+    """A companion form's entries are the poles' products (an order-10 fit's exceed 1e12): any finite number. G(s) =
+    1 / (s + 1e13): G(0) = 1e-13 m/N."""
+    p = TransferParams([[-1e13]], [1.0], [1.0], 90.0)
+    assert p.receptance(np.array([0.0]))[0] == pytest.approx(1e-13)
+    with pytest.raises(ParameterError, match=r"A\[0\]\[0\] = inf in transfer-function pantograph is invalid"):
+        TransferParams([[float("inf")]], [1.0], [1.0], 90.0)
+
+
+def test_an_undamped_chain_stands_on_the_wire():
+    """c = 0: lossless modes (neither growing nor decaying) are not refused under the wire; the static force is the
+    chain's F0 / (1 + k_3 (1/k_1 + 1/k_2)) against a stiff wire (1e9 N/m: its compliance shifts it by < 1e-6)."""
+    p = LumpedParams((5.0, 8.0, 12.0), (6000.0, 3000.0, 80.0), (0.0, 0.0, 0.0), 90.0)
+    assert lumped(p).static(0.0, 1e9) == pytest.approx(90.0 / (1 + 80.0 * (1 / 6000.0 + 1 / 3000.0)), rel=1e-6)
+
+
+def test_registry_pantograph_params_are_checked_by_their_declared_limits():
+    """The Eppinger pantograph's `[pantograph] params`: a numpy scalar is the number it holds; a bool, NaN or text is
+    refused naming the key."""
+    from mbsuite.errors import SceneError
+    from mbsuite.models.catenary.pantographs import validate_section
+
+    out = validate_section({"params": {"Pg": np.float32(750000.0)}})["params"]["Pg"]
+    assert out == 750000.0 and type(out) is float
+    for bad in (True, float("nan"), "7.5e5"):
+        with pytest.raises(SceneError, match=r"Pg = .* in \[pantograph\] params \(the 'eppinger' pantograph\)"):
+            validate_section({"params": {"Pg": bad}})

@@ -68,6 +68,11 @@ def _lumped_rules(d: Mapping[str, Any]) -> str | None:
     return None
 
 
+def _poles(poles: Sequence[complex]) -> list[complex]:
+    """Poles (1/s) to 7 significant digits, for a message."""
+    return [complex(float(f"{p.real:.7g}"), float(f"{p.imag:.7g}")) for p in poles]
+
+
 def _transfer_rules(d: Mapping[str, Any]) -> str | None:
     A, B, C = d["A"], d["B"], d["C"]
     n = len(A)
@@ -76,29 +81,46 @@ def _transfer_rules(d: Mapping[str, Any]) -> str | None:
                 f"entries")
     A, B, C = np.array(A, float), np.array(B, float), np.array(C, float)
     poles = np.linalg.eigvals(A)
+    if not np.all(np.isfinite(poles)):
+        return "the eigenvalues of A are not finite (its entries overflow)"
     scale = max(1.0, float(np.max(np.abs(poles))))
-    oscillating = [p for p in poles if abs(p.imag) > 1e-9 * scale and p.real >= 0]
+    zero = [p for p in poles if abs(p) <= 1e-12 * scale]
+    if zero:
+        return (f"A has {len(zero)} pole(s) at 0 (a rigid-body mode: G(0) infinite, no static stiffness); a "
+                "transfer-function pantograph's receptance is finite at 0 Hz (a constant uplift is a lumped "
+                "pantograph with its base spring k_n = 0)")
+    oscillating = [p for p in poles if abs(p.imag) > 1e-9 * scale and p.real >= -1e-12 * scale]
     if oscillating:
-        return (f"unstable: pole(s) {[complex(round(p.real, 6), round(p.imag, 6)) for p in oscillating]} 1/s of A "
-                "have a real part >= 0 (an oscillation that grows; a pantograph's modes decay)")
-    rising = [float(p.real) for p in poles if abs(p.imag) <= 1e-9 * scale and p.real >= 0]
-    try:
-        g0 = float(-C @ np.linalg.solve(A, B))
-    except np.linalg.LinAlgError:
-        return "A is singular: G(0) does not exist (a pantograph free to drift: give it a static stiffness)"
+        return (f"unstable: pole(s) {_poles(oscillating)} 1/s of A have a real part >= 0 (an oscillation that does "
+                "not decay; a pantograph's modes decay)")
+    rising = [float(p.real) for p in poles if abs(p.imag) <= 1e-9 * scale and p.real > 0]
+    g0 = float(-C @ np.linalg.solve(A, B))
     if rising and not (d["negative_static_stiffness"] and g0 < 0 and len(rising) == 1):
-        return (f"unstable: real pole(s) {[round(p, 6) for p in rising]} 1/s >= 0; a pantograph alone is unstable "
-                "only through a negative static stiffness (one real pole, G(0) < 0), stated with "
+        return (f"unstable: real pole(s) {[float(f'{p:.7g}') for p in rising]} 1/s >= 0; a pantograph alone is "
+                "unstable only through a negative static stiffness (one real pole, G(0) < 0), stated with "
                 f"negative_static_stiffness = true (here G(0) = {g0:.4g} m/N)")
     if d["negative_static_stiffness"] and not g0 < 0:
         return f"negative_static_stiffness = true, but G(0) = {g0:.4g} m/N is not negative"
     f = np.concatenate([PASSIVITY_GRID, np.abs(poles.imag) / (2 * np.pi)])
     f = np.unique(f[f > 0])
     G = np.array([C @ np.linalg.solve(2j * np.pi * x * np.eye(n) - A, B) for x in f])
-    worst = int(np.argmax(G.imag / np.maximum(np.abs(G), 1e-300)))
-    if G.imag[worst] > 1e-9 * abs(G[worst]):
-        return (f"not passive: Im G = {G.imag[worst]:.3g} m/N > 0 at {f[worst]:.4g} Hz (the head would give energy "
-                "to the wire there: negative damping)")
+    bad = np.flatnonzero(G.imag > 1e-9 * np.abs(G))
+    if bad.size:
+        i = int(bad[0])
+        return (f"not passive: Im G = {G.imag[i]:.3g} m/N > 0 at {f[i]:.4g} Hz, the lowest of the {bad.size} checked "
+                f"frequencies where it fails ({f[i]:.4g} to {f[bad[-1]]:.4g} Hz; the head would give energy to the "
+                "wire there: negative damping)")
+    # high frequencies, exactly: a positive-real mobility s G(s) falls at most as 1/s, so G(s) = C B / s + C A B / s^2
+    # + ...: a massless head on a damper 1 / (C B) > 0, or C B = 0 and a head mass 1 / (C A B) > 0
+    h1, h2 = float(C @ B), float(C @ A @ B)
+    if h1 * scale > 1e-9 * abs(h2):
+        return None
+    if h1 * scale < -1e-9 * abs(h2):
+        return (f"not passive at high frequencies: C B = {h1:.4g} m/(N s) < 0 (G(s) = C B / s there: a massless head "
+                "on a negative damper)")
+    if not h2 > 0:
+        return (f"no positive head mass: C B = 0 and C A B = {h2:.4g} 1/kg (the head mass is 1 / (C A B); G(s) of a "
+                "pantograph falls as 1 / (m s^2) with m > 0, or as 1 / (c s))")
     return None
 
 
@@ -108,7 +130,7 @@ def _lim(lo: float | None = None, hi: float | None = None, unit: str = "", doc: 
 
 #: the declaration of a lumped pantograph's `[pantograph] params`
 LUMPED_SECTION = Section("[pantograph] params (lumped)", {
-    "m": Items(_lim(0.0, 1e4, "kg", "stage mass", lo_open=True), min=1, max=MAX_STAGES, unit="kg",
+    "m": Items(_lim(1e-6, 1e4, "kg", "stage mass"), min=1, max=MAX_STAGES, unit="kg",
                doc="stage masses, stage 1 the head"),
     "k": Items(_lim(-1e9, 1e9, "N/m", "stage spring"), min=1, max=MAX_STAGES, unit="N/m",
                doc="springs: k_i joins stage i to stage i + 1, the last to the base (only it may be <= 0)"),
@@ -125,16 +147,18 @@ LUMPED_SECTION = Section("[pantograph] params (lumped)", {
                                                  "c": [30.0, 60.0, 120.0], "F0": 100.0})
 #: the declaration of a transfer-function pantograph's `[pantograph] params`
 TRANSFER_SECTION = Section("[pantograph] params (transfer function)", {
-    "A": Items(Items(_lim(-1e12, 1e12, "1/s"), min=1, max=MAX_STATES), min=1, max=MAX_STATES,
-               doc="state matrix (square, rows of A)"),
-    "B": Items(_lim(-1e12, 1e12), min=1, max=MAX_STATES, doc="input vector (per N of upward force)"),
-    "C": Items(_lim(-1e12, 1e12), min=1, max=MAX_STATES, doc="output vector (m of head per unit state)"),
+    "A": Items(Items(_lim(doc="state matrix entry"), min=1, max=MAX_STATES), min=1, max=MAX_STATES,
+               doc="state matrix, its rows (square; 1/s where the states share a unit; a companion form's entries "
+                   "grow as the poles' product: unbounded)"),
+    "B": Items(_lim(), min=1, max=MAX_STATES, doc="input vector (state rate per N of upward force on the head)"),
+    "C": Items(_lim(), min=1, max=MAX_STATES, doc="output vector (m of head per unit state)"),
     "F0": _lim(0.0, 1e4, "N", "contact force at the working height against a rigid wire", lo_open=True),
     "negative_static_stiffness": Limit(kind=bool, default=False,
                                        doc="states G(0) < 0 and its one real unstable pole (a fitted pantograph's)"),
 }, required=("A", "B", "C", "F0"), rules=(
-    Rule("A square, B and C of its size; stable (every oscillating pole decays; one real pole >= 0 only with "
-         "negative_static_stiffness); passive (Im G(j w) <= 0)", _transfer_rules),),
+    Rule("A square, B and C of its size; stable (every pole of A has a real part < 0, but one real pole > 0 with "
+         "negative_static_stiffness = true and G(0) < 0; no pole at 0); passive (Im G(j w) <= 0 on 1 mHz - 1 kHz and "
+         "at the poles' frequencies; a head mass 1 / (C A B) > 0 or a head damper 1 / (C B) > 0)", _transfer_rules),),
     doc="a transfer-function pantograph G(s) = C (sI - A)^-1 B",
     example={"A": [[0.0, 1.0], [-500.0, -2.0]], "B": [0.0, 0.1], "C": [1.0, 0.0], "F0": 90.0})
 
@@ -235,7 +259,7 @@ class TransferParams:
             raise ParameterError("a transfer-function pantograph needs a strictly proper G(s) (numerator degree below "
                                  "the denominator's)")
         A, B, C, D = tf2ss(num, den)
-        return cls(tuple(map(tuple, A)), tuple(B[:, 0]), tuple(C[0]), F0, negative_static_stiffness)
+        return cls(A.tolist(), B[:, 0].tolist(), C[0].tolist(), F0, negative_static_stiffness)
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C) as arrays."""
@@ -302,8 +326,8 @@ class LinearPantograph:
                               f"{k_wire:g} N/m (its model is singular there)") from None
         if k_wire > 0:  # pressed on the wire: the pantograph and the wire's static stiffness together must be stable
             poles = np.linalg.eigvals(self.A - k_wire * np.outer(self.B, self.c))
-            worst = poles[np.argmax(poles.real)]
-            if worst.real >= -1e-12 * max(1.0, float(np.max(np.abs(poles)))):
+            worst = poles[np.argmax(poles.real)]  # a lossless chain (c = 0) neither grows nor decays: it stands
+            if worst.real > 1e-9 * max(1.0, float(np.max(np.abs(poles)))):
                 raise ParameterError(f"the {self.name} pantograph pressed on the wire (static stiffness {k_wire:.4g} "
                                      f"N/m) is unstable: pole {complex(worst):.4g} 1/s; its parameters describe no "
                                      "pantograph that can run under this line")

@@ -39,7 +39,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from ...errors import SceneError
-from ...limits import limit_of
+from ...limits import Limit, limit_of
 from ...registry import ModelSpec, get_model
 from . import linear_pantographs as linear
 
@@ -222,8 +222,8 @@ def _two_mass(p, params: Mapping[str, Any], effects: Mapping[str, Any], engine: 
 
 def _linear_section(name: str, value: Any) -> dict[str, dict[str, Any]]:
     """The `[pantograph]` section of the linear pantograph `name`, validated (its parameters built once)."""
-    linear.params_of(name, value if value else None)
-    return {"effects": {}, "params": dict(value["params"])}
+    p = linear.params_of(name, value if value else None)
+    return {"effects": {}, "params": p.section()}  # as checked: numpy users' numbers as the numbers they hold
 
 
 def _linear(name: str, params: Mapping[str, Any], effects: Mapping[str, Any], engine: str,
@@ -279,12 +279,11 @@ def _check_section(value: Any, name: str, spec: ModelSpec) -> dict[str, dict[str
     if bad:
         raise SceneError(f"unknown parameter(s) {bad} of the {name!r} pantograph (model '{spec.name}') in "
                          f"[pantograph]; valid parameters: {valid}")
-    for k, v in params.items():
-        lim = limit_of(spec.params_cls, k)
-        if lim is not None:
-            lim.check(k, v, SceneError, f" in [pantograph] params (the {name!r} pantograph)")
-    spec.params_cls(**params)  # the model's parameter dataclass validates the values and across them
-    return {"effects": dict(effects), "params": dict(params)}
+    # each value against its field's declared Limit (numpy scalars taken as the numbers they hold), as checked
+    params = {k: (limit_of(spec.params_cls, k) or Limit()).check(k, v, SceneError, f" in [pantograph] params (the "
+                                                                    f"{name!r} pantograph)") for k, v in params.items()}
+    spec.params_cls(**params)  # the model's parameter dataclass validates across them
+    return {"effects": dict(effects), "params": params}
 
 
 def validate_section(value: Any) -> dict[str, dict[str, Any]]:

@@ -24,6 +24,8 @@ ABOVE_HZ = 1.0
 
 
 def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):  # before the numbers: a bool is an int to Python, but true to TOML
+        return "true" if v else "false"
     if isinstance(v, list | tuple):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return repr(float(v))

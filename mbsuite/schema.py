@@ -195,6 +195,8 @@ def _describe(d: Limit | Items | Section) -> str:
 
 
 def check_value(decl: Limit | Items | Section, key: str, value: Any, where: str, error: type[Exception]) -> Any:
+    """`value` of `key` checked against its declaration (a `Limit`, an `Items` list or a nested `Section`); `where`
+    names the place in errors of type `error`."""
     if isinstance(decl, Section):
         return decl.check(value, f"{where} [{key}]", error)
     if isinstance(decl, Limit):
@@ -228,6 +230,7 @@ def check_value(decl: Limit | Items | Section, key: str, value: Any, where: str,
 
 
 def json_of(d: Limit | Items | Section) -> dict[str, Any]:
+    """The JSON Schema of one declaration."""
     if isinstance(d, Section):
         return d.json_schema()
     if isinstance(d, Items):

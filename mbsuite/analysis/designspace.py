@@ -64,12 +64,14 @@ FACTOR_INPUTS = Section("study range (Factor)", {
 
 
 def parse_factor(text: str, sections: Sequence[str], flag: str = "--vary") -> Factor:
-    """A `Factor` from `SECTION.KEY=LO:HI` (the key and the two numbers read by `cli.study.split_key` and
-    `sweep.parse_values`, the readers of `--set/--vary`); an error naming the flag and the text."""
-    from ..cli.study import split_key
+    """A `Factor` from `SECTION.KEY=LO:HI` (the key read by the one override reader, `overrides.parse_override`,
+    the two numbers by `sweep.parse_values`, as `--set/--vary`); an error naming the flag and the text."""
+    from ..overrides import parse_override, section_of
     from .sweep import parse_values
 
-    section, key, value = split_key(text, flag, tuple(sections))
+    o = parse_override(flag, text)
+    section, key = section_of(o, tuple(sections))
+    value = o.value
     parts = value.split(":")
     if len(parts) != 2:
         raise MbsuiteError(f"{flag} {text!r}: a study range reads SECTION.KEY=LO:HI (two numbers, e.g. "

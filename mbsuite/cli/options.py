@@ -14,12 +14,12 @@ the scene has."""
 from __future__ import annotations
 
 import argparse
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ..analysis.sweep.options import EXECUTORS, MAX_POINTS
 from ..errors import MbsuiteError
+from ..overrides import Override, compose, parse_override, section_of  # noqa: F401 (the rule's names)
 
 if TYPE_CHECKING:
     from ..analysis.sweep import SweepOptions
@@ -37,48 +37,6 @@ SCENE_FLAGS = {"engine": ("--engine", "solver.engine"), "max_steps": ("--max-ste
                "speed": ("--speed", "input.speed"), "spacings": ("--spacings", "train.spacings")}
 #: `--start SECTION.KEY=VALUE` (optimise): a start value per key, composed on its own (each key once)
 START_FLAG = ("start", "--start")
-
-
-@dataclass(frozen=True)
-class Override:
-    """One scene key a flag sets: the flag, the dotted key, its value (the text after `=` of an entry, else the
-    flag's value) and how the command line gave it (`text`, for messages)."""
-
-    flag: str
-    key: str
-    value: Any
-    text: str
-
-    def __str__(self) -> str:
-        return self.text
-
-
-def parse_override(flag: str, text: str) -> Override:
-    """`SECTION.KEY=VALUE` (KEY may be dotted: `pantograph.params.F0`) as an `Override` of `flag`; an error naming the
-    flag and the text unless every part of the key is a non-empty name."""
-    key, sep, value = str(text).partition("=")
-    parts = [p.strip() for p in key.split(".")]
-    if not sep or len(parts) < 2 or not all(parts):
-        what = "VALUE" if flag in ("--set", "--start") else "VALUES"
-        raise MbsuiteError(f"{flag} {text!r}: expected SECTION.KEY={what} (e.g. params.mh=14; a KEY may reach into a "
-                           "model's section: pantograph.params.F0=100)")
-    return Override(flag, ".".join(parts), value, f"{flag} {text}")
-
-
-def compose(items: Iterable[Override]) -> dict[str, Override]:
-    """The rule: dotted key -> its `Override`; a key given twice (even with the same value), or a key and a key
-    inside it, is an error naming both flags."""
-    out: dict[str, Override] = {}
-    for new in items:
-        for old in out.values():
-            if old.key == new.key:
-                same = " (to the same value)" if str(old.value).strip() == str(new.value).strip() else ""
-                raise MbsuiteError(f"{old} and {new} both set {new.key}{same}; give one")
-            outer, inner = (old, new) if new.key.startswith(old.key + ".") else (new, old)
-            if inner.key.startswith(outer.key + "."):
-                raise MbsuiteError(f"{old} and {new} both set {inner.key} ({outer.key} holds it); give one")
-        out[new.key] = new
-    return out
 
 
 def overrides(args: argparse.Namespace) -> dict[str, Override]:
@@ -110,16 +68,6 @@ def resolve(scene: Scene, values: Mapping[Override, Any]) -> dict[str, Any]:
         section_of(o, scene_sections(scene))
     return sections_for(scene.to_dict(), {o.key: v for o, v in values.items()})
 
-
-def section_of(o: Override, sections: tuple[str, ...]) -> tuple[str, str]:
-    """(section, the rest of the key) of an override; an error naming the flag unless the section is in
-    `sections`."""
-    section, _, name = o.key.partition(".")
-    if section not in sections:
-        example = "params.mh=14" if "params" in sections else "option.gamma=0.3"
-        raise MbsuiteError(f"{o}: expected SECTION.KEY={'VALUE' if o.flag in ('--set', '--start') else 'VALUES'} "
-                           f"with SECTION in {', '.join(sections)} (e.g. {example})")
-    return section, name
 
 MAX_REPEATS = 100
 SCENE_HELP = "scene TOML path, model name (default scene), model/scene or a summary.json (the scene it ran)"

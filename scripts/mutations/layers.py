@@ -84,7 +84,7 @@ MUTATIONS: tuple[Mutation, ...] = (
              "        unknown: list[Any] = []",
              "a declared section silently drops a key it does not declare (a typo in a line file or a scene section "
              "runs on the default)", "tests/suite/test_declarations.py"),
-    Mutation("cli_override_repeated_key_kept", "mbsuite/cli/options.py",
+    Mutation("cli_override_repeated_key_kept", "mbsuite/overrides.py",
              "            if old.key == new.key:", "            if old.key == new.key and False:",
              "the command line keeps the last of two overrides of one key (--set and --vary, or --vary twice): one "
              "is dropped silently", "tests/suite/test_overrides.py"),

@@ -143,5 +143,6 @@ def test_a_scene_run_away_from_its_design_record_is_refused_naming_both_keys():
             with pytest.raises(SceneError, match=r"params\.K = .* is not the design's \[design\.derived\] K"):
                 scene_from_dict(edited)
     edited = {**scene, "input": {**scene["input"], "value": 301.0}}
-    with pytest.raises(SceneError, match=r"input\.value = 30[01][.\d]* is not the design's \[design\.derived\] w_op = 300"):
+    with pytest.raises(SceneError, match=r"input\.value = 30[01][.\d]* is not the design's \[design\.derived\] "
+                                         r"w_op = 300"):
         scene_from_dict(edited)

@@ -25,6 +25,8 @@ from .params import CatenaryParams
 HEAD_WIDTH = 0.5
 #: most pantographs on one train (the compiled core's fixed per-step buffer)
 MAX_PANTOGRAPHS = 64
+#: the catenary's time step (its upper bounds depend on the parameters: `check_timestep`)
+TIMESTEP = Limit(lo=0.0, lo_open=True, unit="s", doc="time step of the passage")
 #: a steady arm's uplift is charged to a pantograph while it is within this distance of it (m)
 UPLIFT_REACH = 30.0
 
@@ -111,7 +113,7 @@ def check_timestep(p: CatenaryParams, dt: float) -> None:
     1 / (2 filter_cutoff) (the 20 Hz EN 50318 contact-force filter needs the record's Nyquist frequency above its
     cut-off; past it the statistics do not exist). A `ParameterError` names `solver.timestep` (CLI `--timestep`), the
     valid range and why; the accuracy bound (`wave_courant`) is `check_wave_resolution`'s."""
-    dt = Limit(lo=0.0, lo_open=True, unit="s").check("solver.timestep (--timestep)", dt, ParameterError)
+    dt = TIMESTEP.check("solver.timestep (--timestep)", dt, ParameterError)
     c = p.max_wave_speed
     nyquist, courant = 1.0 / (2.0 * p.filter_cutoff), p.element_length / c
     if not dt < nyquist:
@@ -206,7 +208,7 @@ class PassageConfig:
         if n != ns + 1:
             raise ParameterError(f"{n} pantographs need {n - 1} spacings, got {ns}")
         speed = Limit(lo=0.0, lo_open=True, unit="km/h").check("speed", speed, ParameterError)
-        dt = Limit(lo=0.0, lo_open=True, unit="s").check("solver.timestep (--timestep)", dt, ParameterError)
+        dt = TIMESTEP.check("solver.timestep (--timestep)", dt, ParameterError)
         check_timestep(p, dt)
         offsets = check_train(p, self.spacings, self.head_width)
         V = speed / 3.6

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from . import perturbation
 from .errors import ParameterError
+from .trust import perturbation
 
 _NO_DEFAULT = object()
 

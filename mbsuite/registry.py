@@ -19,7 +19,7 @@ from typing import Any
 
 from .errors import SceneError
 from .limits import Limit
-from .solver import SolverSettings
+from .settings import SolverSettings
 
 
 @dataclass(frozen=True)
@@ -111,7 +111,7 @@ class ModelSpec:
       why (an input key only when it differs from its declared default): against the effects when the scene is
       built, against the path (and the path's `lacks`) when a path runs it, so a scene may carry one path's
       settings while another path's run is asked for on the way.
-    - `accuracy`: the model's accuracy declaration (`mbsuite.accuracy.AccuracySpec`: headline outputs with the
+    - `accuracy`: the model's accuracy declaration (`mbsuite.trust.estimate.AccuracySpec`: headline outputs with the
       tolerances the defaults meet, their values from a result, how a run is refined for `--error-estimate`).
     - `file_checks`: model-file stem -> `check(path, engine, model)`, handed to the engines' loaders for a file of
       that name by `mbsuite.load_model_file` (engine "mujoco" with an MjModel, "pinocchio" or "urdf" with a

@@ -31,9 +31,9 @@ class SimResult:
     events: list[dict[str, Any]] = field(default_factory=list)
     stats: dict[str, Any] = field(default_factory=dict)
     scene: dict[str, Any] = field(default_factory=dict)
-    health: list[Any] = field(default_factory=list)  # mbsuite.health.Figure: the run's own accuracy figures
+    health: list[Any] = field(default_factory=list)  # mbsuite.trust.health.Figure: the run's own accuracy figures
     warnings: list[str] = field(default_factory=list)  # accepted health violations (allow_inaccurate), loud
-    error_estimate: Any = None  # mbsuite.accuracy.ErrorEstimate of the headline outputs (run(..., error_estimate=True))
+    error_estimate: Any = None  # trust.estimate.ErrorEstimate of the headline outputs (run(..., error_estimate=True))
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]

@@ -17,7 +17,7 @@ from .deferred import Deferred
 from .limits import Limit
 from .registry import ModelSpec, get_model, models
 from .schema import Items, Section, json_of
-from .solver import INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS
+from .settings import INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 

@@ -46,13 +46,13 @@ from typing import Any
 
 import numpy as np
 
-from . import perturbation
-from .accuracy import check_tolerances, declared
 from .errors import MbsuiteError, ParameterError, SceneError
 from .limits import Limit, real
 from .registry import ModelSpec, get_model, models
 from .schema import Items, check_value, toml_error
-from .solver import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
+from .settings import DEFAULT_MAX_STEPS, INTEGRATORS, SCIPY_METHODS, SOLVER_LIMITS, SolverSettings  # noqa: F401 (the [solver] section's names)
+from .trust import perturbation
+from .trust.estimate import check_tolerances, declared
 
 TOP_KEYS = ("model", "name", "description", "effects", "params", "input", "outputs", "solver", "accuracy")
 MAX_SCENE_BYTES = 1_000_000
@@ -77,7 +77,7 @@ class Scene:
     solver: SolverSettings = field(default_factory=SolverSettings)
     source: str | None = None
     sections: Mapping[str, Any] = field(default_factory=dict)  # the model's own extra sections (ModelSpec.sections)
-    accuracy: Mapping[str, float] = field(default_factory=dict)  # [accuracy]: headline -> tolerance (mbsuite.accuracy)
+    accuracy: Mapping[str, float] = field(default_factory=dict)  # [accuracy]: headline -> tolerance (trust.estimate)
 
     @property
     def spec(self) -> ModelSpec:

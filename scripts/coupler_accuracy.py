@@ -15,9 +15,9 @@ import argparse
 import json
 
 import mbsuite
-from mbsuite.accuracy import declared
 from mbsuite.models.coupler.accuracy import much_refined
 from mbsuite.results import format_table
+from mbsuite.trust.estimate import declared
 
 SCENES = ("double_lateral", "double_massless", "double_inclined", "double_phibc90", "double_friction")
 

@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 
 import mbsuite
-from mbsuite.accuracy import declared
 from mbsuite.engines.core import map_threads
 from mbsuite.models.coupler import SPEC
 from mbsuite.models.coupler.plots import dynamics_figure
 from mbsuite.plotting import save
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
+from mbsuite.trust.estimate import declared
 
 KEYS = ("phi_c_err_max", "phi_c_kin_fluctuation_pp", "closure_residual_max", "torque_in_mean", "torque_in_ripple_pp",
         "link_force_max_abs")

@@ -2,7 +2,7 @@
 
 For every shipped scene of every model that declares headline outputs (`ModelSpec.accuracy`), on the scene's own path
 (and with `--all-paths` on every path of its model), the scene runs with `error_estimate=True` (the scene refined once
-and twice, `mbsuite.accuracy`) and the script prints one Markdown row per headline: value, declared tolerance,
+and twice, `mbsuite.trust.estimate`) and the script prints one Markdown row per headline: value, declared tolerance,
 estimated error, observed order, whether the tolerance holds, and the wall seconds of the run and of the estimate
 (the refined copies, on `--workers` processes).
 

@@ -1,7 +1,7 @@
 """Study (not a test): the drives' declared accuracy measured on every shipped scene and both paths.
 
 For each scene and path: the headline values at the scene's settings (level 0) and refined once and twice (the
-error estimate of `mbsuite.accuracy`: hand path rtol / 10 per level, MuJoCo step / 2 per level), and a much finer
+error estimate of `mbsuite.trust.estimate`: hand path rtol / 10 per level, MuJoCo step / 2 per level), and a much finer
 run for the true error (hand path rtol 1e-12, atol 1e-14; MuJoCo the step / FINE). One Markdown row per headline:
 value, declared tolerance, estimated error, observed order, true error, estimate / true error. The tolerances of
 `mbsuite/models/drives/accuracy.py` are set a stated factor above the largest numbers of this table.
@@ -23,8 +23,8 @@ import sys
 import time
 
 from mbsuite import load_scene
-from mbsuite.accuracy import declared
 from mbsuite.analysis.errorestimate import error_estimate, run_values
+from mbsuite.trust.estimate import declared
 
 #: how much finer than the scene's step the MuJoCo "true" run is
 FINE = 16

@@ -17,10 +17,10 @@ import sys
 import time
 
 import mbsuite
-from mbsuite.accuracy import declared
 from mbsuite.analysis.errorestimate import error_estimate
 from mbsuite.results import format_table
 from mbsuite.scenes import scene_from_dict
+from mbsuite.trust.estimate import declared
 
 SCENES = ("lab", "unilateral", "nonlinear_cylinder", "step", "static")
 #: the finest runs: MuJoCo at 1/16 of the scene's step (its own method refined) and the reference at rtol 1e-11

@@ -459,13 +459,13 @@ def input_attempts() -> Iterator[Attempt]:
     for name, (expr, cul) in api.items():
         code = f"""
             import numpy as np
-            from mbsuite.engines.signals import *
+            from mbsuite.engines.inputs import *
             s = {expr}
             y = s(np.linspace(0.0, 1.0, 11))
             assert np.all(np.isfinite(y)), f"non-finite signal values {{y}}"
             print(s.spec())
             """
-        yield snip(f"api-{name}", a, f"mbsuite.engines.signals.{expr}", code, culprit=cul)
+        yield snip(f"api-{name}", a, f"mbsuite.engines.inputs.{expr}", code, culprit=cul)
 
 
 # ------------------------------------------------------------------------------------------------- model files
@@ -1296,7 +1296,7 @@ def declared_attempts() -> Iterator[Attempt]:
     # every model's [params] and [input] keys and the [solver] settings, each in a scene file (the scene files of
     # the original corpus above try -inf, huge values, bools and the rest on a sample of them)
     from mbsuite.registry import models
-    from mbsuite.solver import SOLVER_LIMITS, SOLVER_WORDS
+    from mbsuite.settings import SOLVER_LIMITS, SOLVER_WORDS
 
     per_key = {"text", "nan", "inf", "below", "above", "fraction", "unknown word", "number"}
     for model, spec in models().items():

@@ -1,6 +1,6 @@
 """The perturbed run: `pytest --perturb EPS[:EPS_MAX] [--perturb-seed N]` runs only the tests that read
 digit-sensitive quantities (marker `rounding`) and runs each of them, fixtures included, inside
-`mbsuite.perturbation.perturbed`: every parameter, scene input and initial state the test builds is changed by a
+`mbsuite.trust.perturbation.perturbed`: every parameter, scene input and initial state the test builds is changed by a
 seeded relative draw of EPS (or of a size drawn per quantity in [EPS, EPS_MAX]). A stranger's machine changes the
 last bits through its BLAS kernel, its libm or its SIMD level; the draws change them here, on any machine, without
 touching the machine's settings (OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE stay as they are). A test that passes only
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from mbsuite.perturbation import perturbed
+from mbsuite.trust.perturbation import perturbed
 
 ROOT = Path(__file__).resolve().parent
 #: folders and files whose every test reads digit-sensitive quantities (event times, lock instants, window means of

@@ -141,7 +141,7 @@ def point_scene(scene: Scene, point: Mapping[str, Any], origin: str = "at a desi
 def scene_outputs(scene_dict: dict, point: dict[str, Any]) -> dict[str, float]:
     """Run the scene at `point` and return its headline outputs (module-level: it pickles to any executor)."""
     from ..scenes import scene_from_dict
-    from ..timerun import run_judged
+    from ..simulate import run_judged
 
     scene = scene_from_dict(scene_dict)
     try:
@@ -164,7 +164,7 @@ def headline_units(scene: Scene | None) -> dict[str, str]:
     """Headline name -> SI unit of the scene's declared outputs (empty without a scene)."""
     if scene is None or scene.spec.accuracy is None:
         return {}
-    from ..accuracy import declared
+    from ..trust.estimate import declared
 
     return {h.name: h.unit for h in declared(scene)}
 

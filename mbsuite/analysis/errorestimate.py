@@ -1,4 +1,4 @@
-"""Run a scene's refined copies and estimate the error of its headline outputs (`mbsuite.accuracy`).
+"""Run a scene's refined copies and estimate the error of its headline outputs (`mbsuite.trust.estimate`).
 
     est = error_estimate(scene)                        # levels 0, 1, 2 in parallel on all local cores
     est = error_estimate(scene, base=values_of_run)    # the run's own values as level 0: only the refined copies run
@@ -15,14 +15,14 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from ..accuracy import ErrorEstimate, declared, estimate
 from ..scenes import Scene, scene_from_dict
+from ..trust.estimate import ErrorEstimate, declared, estimate
 from .sweep import run_sweep
 
 
 def run_values(scene_d: dict) -> dict[str, float]:
     """The headline values of one time run of the scene `scene_d` (a `Scene.to_dict()`)."""
-    from ..timerun import run_judged as run
+    from ..simulate import run_judged as run
 
     scene = scene_from_dict(scene_d)
     return dict(scene.spec.accuracy.values(scene, run(scene)))
@@ -47,7 +47,8 @@ def level_settings(scene: Scene, levels: list[Scene]) -> list[str]:
 
 def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
                    evaluate: Callable[[dict], Mapping[str, float]] = run_values, workers: int = 0) -> ErrorEstimate:
-    """The estimated error of every headline of `scene` from the scene refined once and twice (`mbsuite.accuracy`).
+    """The estimated error of every headline of `scene` from the scene refined once and twice
+    (`mbsuite.trust.estimate`).
 
     `base`: the headline values of the scene's own run when the caller has it (only the refined copies run then);
     `workers`: local processes for the levels (0 = all cores)."""

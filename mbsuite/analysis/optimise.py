@@ -428,7 +428,7 @@ def rerun(result: OptimiseResult, scene: Scene, workers: int = 0) -> dict[str, A
     `mbsuite.analysis.errorestimate`); stores and returns per point the headline values, the estimate and a table.
     Judging the estimates against their tolerances is left to `judge_rerun`, so that the result is reported
     first."""
-    from ..timerun import run_judged
+    from ..simulate import run_judged
     from .errorestimate import error_estimate
 
     points = []
@@ -449,7 +449,7 @@ def rerun(result: OptimiseResult, scene: Scene, workers: int = 0) -> dict[str, A
 def judge_rerun(result: OptimiseResult, scene: Scene) -> None:
     """The re-run's error estimates against their tolerances: an `AccuracyError` naming the first past its tolerance
     (warnings with solver.allow_inaccurate / --allow-inaccurate)."""
-    from ..health import judge
+    from ..trust.health import judge
 
     for p in (result.rerun or {}).get("points", []):
         where = ", ".join(f"{k} = {v:g}" for k, v in p["context"].items())

@@ -188,7 +188,8 @@ def cmd_hardcases(args: argparse.Namespace) -> None:
 
 def cmd_perturb(args: argparse.Namespace) -> None:
     """`mbsuite perturb`: stability under relative perturbations of every scene or hard case given."""
-    from .. import hardcases, stability
+    from .. import hardcases
+    from ..trust import robustness as stability
 
     try:
         epsilons = [float(e) for e in args.eps.split(",")]

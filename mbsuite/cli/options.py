@@ -83,7 +83,8 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_error_estimate(p: argparse.ArgumentParser) -> None:
-    """`--error-estimate`: run refined copies and report each headline output's estimated error (mbsuite.accuracy)."""
+    """`--error-estimate`: run refined copies and report each headline output's estimated error
+    (mbsuite.trust.estimate)."""
     p.add_argument("--error-estimate", action="store_true",
                    help="also run the scene refined once and twice (the path's step, tolerance or mesh; in parallel "
                         "on the local cores) and report per headline output the estimated error, the observed order "

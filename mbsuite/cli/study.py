@@ -272,7 +272,7 @@ def plot_study(head: list[str], axis_units: dict[str, str], combos: list[tuple],
 def axis_unit(scene, section: str, name: str) -> str:
     """The SI unit of a swept key, from its declaration (parameter field, input key or solver setting)."""
     from ..limits import limit_of
-    from ..solver import SOLVER_LIMITS
+    from ..settings import SOLVER_LIMITS
 
     lim = None
     if section == "params":

@@ -67,8 +67,9 @@ LEVELS = (0, 1, 2)
 
 
 def point_estimates(scene: Scene, points: list[tuple], results: list[dict]) -> list[dict]:
-    """Fold the three levels of every point into the level-0 result with its `error_estimate` (mbsuite.accuracy)."""
-    from ..accuracy import declared, estimate
+    """Fold the three levels of every point into the level-0 result with its `error_estimate`
+    (mbsuite.trust.estimate)."""
+    from ..trust.estimate import declared, estimate
 
     out = []
     n = len(LEVELS)
@@ -84,7 +85,7 @@ def point_estimates(scene: Scene, points: list[tuple], results: list[dict]) -> l
 def judge_points(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict]) -> None:
     """Every point's estimates against their tolerances: an AccuracyError naming the first point and headline past
     its tolerance (warnings with solver.allow_inaccurate / --allow-inaccurate)."""
-    from ..health import judge
+    from ..trust.health import judge
 
     for combo, r in zip(combos, results, strict=True):
         where = ", ".join(f"{s}.{n} = {v}" for (s, n, _), v in zip(axes, combo, strict=True))

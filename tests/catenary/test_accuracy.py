@@ -13,12 +13,12 @@ import pytest
 from scipy.signal import butter, filtfilt
 
 import mbsuite
-from mbsuite.accuracy import declared
 from mbsuite.analysis.errorestimate import error_estimate
 from mbsuite.errors import SceneError
-from mbsuite.health import InaccurateResultWarning
 from mbsuite.models.catenary import accuracy
 from mbsuite.models.catenary.cases import CatenaryStudy
+from mbsuite.trust.estimate import declared
+from mbsuite.trust.health import InaccurateResultWarning
 
 STATS = ("Fm", "sigma", "stat_max", "stat_min", "max", "min", "uplift_mm", "loss_pct")
 SCENES = ("en50318", "en50318_linear", "en50318_two_pantographs", "en50318_eppinger", "eppinger_lab")

@@ -11,13 +11,13 @@ import pytest
 import mbsuite
 from mbsuite import load_scene
 from mbsuite.errors import ParameterError, SceneError
-from mbsuite.health import AccuracyError, InaccurateResultWarning
 from mbsuite.limits import limit_of, undeclared
 from mbsuite.models.catenary import train
 from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.config import CriticalSpeedWarning, passage_size
 from mbsuite.models.catenary.fe import build_nodes
 from mbsuite.models.catenary.params import CatenaryParams
+from mbsuite.trust.health import AccuracyError, InaccurateResultWarning
 
 SHORT = {"n_spans": 2, "element_length": 0.5, "x_end": 100.0, "window_start": 40.0, "window_end": 80.0}
 

@@ -11,13 +11,13 @@ import pytest
 import mbsuite
 from mbsuite.cli import main
 from mbsuite.errors import ParameterError
-from mbsuite.health import AccuracyError, InaccurateResultWarning
 from mbsuite.models.catenary import train
 from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.config import check_timestep, check_wave_resolution
 from mbsuite.models.catenary.params import CatenaryParams
 from mbsuite.models.catenary.train import simulate_train
 from mbsuite.scenes import load_scene
+from mbsuite.trust.health import AccuracyError, InaccurateResultWarning
 
 SHORT = ('model = "catenary"\n[params]\nn_spans = 2\nelement_length = 0.5\nx_end = 110.0\nwindow_start = 50.0\n'
          'window_end = 100.0\n[input]\nspeed = 200.0\n[solver]\ntimestep = {dt}\n')

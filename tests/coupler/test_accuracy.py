@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 import mbsuite
-from mbsuite.accuracy import declared
 from mbsuite.cli import main
-from mbsuite.health import InaccurateResultWarning
 from mbsuite.models.coupler import accuracy as acc
 from mbsuite.models.coupler.criteria import double_c5
+from mbsuite.trust.estimate import declared
+from mbsuite.trust.health import InaccurateResultWarning
 
 SCENES = ("double_lateral", "double_massless", "double_inclined", "double_phibc90", "double_friction")
 

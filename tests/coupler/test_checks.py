@@ -263,8 +263,8 @@ def test_health_figures_on_both_engines():
     assert t[gaps.argmax()] < sc.input["t_ramp"] and gaps.max() > 10 * settled
     rf = mbsuite.run(sc, engine="reference")
     assert rf.health[0].value < 2e-13  # rigid FPP, |r| <= 1e-13 R^2: measured 3.4e-14 m; bound 6x
-    from mbsuite.health import judge
     from mbsuite.models.coupler.scenario import closure_figure
+    from mbsuite.trust.health import judge
 
     with pytest.raises(mbsuite.AccuracyError, match="closure_residual = 0.005666 m exceeds its bound 0.004721 m"):
         judge([closure_figure(6e-3 * l, sc.build_params())])

@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 
 import mbsuite
-from mbsuite.accuracy import declared, estimate
 from mbsuite.analysis.errorestimate import error_estimate, run_values
-from mbsuite.health import AccuracyError, judge
 from mbsuite.models.drives import accuracy as acc
 from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import msl
 from mbsuite.scenes import load_scene
+from mbsuite.trust.estimate import declared, estimate
+from mbsuite.trust.health import AccuracyError, judge
 
 SCENES = sorted(load_scene("drives").spec.scene_files())
 

@@ -12,7 +12,6 @@ import itertools
 import numpy as np
 import pytest
 
-from mbsuite import perturbation
 from mbsuite.errors import SceneError
 from mbsuite.models.drives.config import (
     CONTROLLERS,
@@ -25,6 +24,7 @@ from mbsuite.models.drives.config import (
 from mbsuite.models.drives.params import PARAM_SETS, DriveParams
 from mbsuite.models.drives.scene_run import setup as run_setup  # a module-level `setup` is pytest's xunit hook
 from mbsuite.scenes import load_scene, scene_from_dict
+from mbsuite.trust import perturbation
 
 ALL = [f.name for f in dataclasses.fields(DriveParams)]
 BASE = {"step_up": "table_4_2", "step_up_down": "design_100w"}

@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mbsuite import stability
 from mbsuite.cli import main
 from mbsuite.errors import SceneError
 from mbsuite.models.drives import controllers as C
@@ -18,6 +17,7 @@ from mbsuite.models.drives import drive
 from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.models.drives.commands import CommandQueue
 from mbsuite.scenes import load_scene
+from mbsuite.trust import robustness as stability
 
 FS = 500.0  # Table 4.2 controller rate
 D_ON, D_OFF = 0.004, 0.010  # unequal delays: 2 and 5 samples at 500 Hz

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mbsuite.engines.signals import Pulse, Step
+from mbsuite.engines.inputs import Pulse, Step
 from mbsuite.errors import ParameterError, SceneError, SolverError
 from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import drive

@@ -85,7 +85,7 @@ def test_every_drives_run_carries_its_energy_balance_as_health(monkeypatch):
     """A thesis drive that loses energy from its books is an AccuracyError, not an exit 0: 1 % of every sliding
     element's loss left out of the books (relative residual ~1e-3 against the bound 1e-4) trips the figure."""
     import mbsuite
-    from mbsuite.health import AccuracyError
+    from mbsuite.trust.health import AccuracyError
 
     sc = load_scene("drives/step_up_motor_resonant").replace(
         solver={"duration": 2.0, "t_settle": 1.0, "engine": "reference"})

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from mbsuite.engines import native
-from mbsuite.engines.signals import Constant, Pulse, Ramp, Sine, Step, Table
+from mbsuite.engines.inputs import Constant, Pulse, Ramp, Sine, Step, Table
 from mbsuite.errors import ParameterError
 
 SIGNALS = [

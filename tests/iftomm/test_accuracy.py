@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import mbsuite
-from mbsuite.accuracy import declared
+from mbsuite.trust.estimate import declared
 
 
 def _closed_form_final(g: float, rate: float, duration: float) -> float:

@@ -22,10 +22,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 import mbsuite
 from mbsuite import load_scene, run, scene_from_dict
-from mbsuite.accuracy import declared
 from mbsuite.analysis.harmonic import whole_period_window
 from mbsuite.errors import SceneError
-from mbsuite.health import AccuracyError, InaccurateResultWarning
 from mbsuite.models.pantograph import accuracy as acc
 from mbsuite.models.pantograph.freqresp import (
     DEFAULTS,
@@ -37,6 +35,8 @@ from mbsuite.models.pantograph.freqresp import (
 )
 from mbsuite.models.pantograph.inputs import config_of, operating_height
 from mbsuite.models.pantograph.linearise import linear_model, linear_response
+from mbsuite.trust.estimate import declared
+from mbsuite.trust.health import AccuracyError, InaccurateResultWarning
 
 SHIPPED = ("lab", "unilateral", "nonlinear_cylinder")
 

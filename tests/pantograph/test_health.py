@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from mbsuite import AccuracyError, ParameterError, SceneError, SolverError, load_scene, run, scene_from_dict
-from mbsuite.health import InaccurateResultWarning
 from mbsuite.limits import undeclared
 from mbsuite.models.pantograph.cases import PantographStudy
 from mbsuite.models.pantograph.equations import PantographConfig
@@ -17,6 +16,7 @@ from mbsuite.models.pantograph.health import STABILITY_FRACTION
 from mbsuite.models.pantograph.inputs import operating_height
 from mbsuite.models.pantograph.linearise import linear_model, omega_max
 from mbsuite.models.pantograph.params import PantographParams
+from mbsuite.trust.health import InaccurateResultWarning
 
 
 def test_every_parameter_declares_its_range():

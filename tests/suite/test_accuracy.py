@@ -1,4 +1,4 @@
-"""Declared accuracy and the error estimate (`mbsuite.accuracy`, `mbsuite.analysis.errorestimate`).
+"""Declared accuracy and the error estimate (`mbsuite.trust.estimate`, `mbsuite.analysis.errorestimate`).
 
 The estimator against sequences with a known limit (the grid-convergence index must bracket the true error without
 inflating it more than its safety factor allows), against a closed form through a real run (the IFToMM four-bar on its
@@ -15,10 +15,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import mbsuite
-from mbsuite.accuracy import declared, estimate_one
 from mbsuite.analysis.errorestimate import error_estimate
 from mbsuite.errors import SceneError
-from mbsuite.health import AccuracyError
+from mbsuite.trust.estimate import declared, estimate_one
+from mbsuite.trust.health import AccuracyError
 
 
 @pytest.mark.parametrize("factor,order", [(2.0, 1.0), (2.0, 2.0), (2.0, 4.0), (10.0, 1.0), (10.0, 2.0)])
@@ -145,7 +145,7 @@ def test_a_relative_tolerance_scales_with_the_value():
     """`Headline(tol, rtol)`: the bound is tol + rtol |value| of the run (level 0). A second-order sequence with a
     known limit (hand values: q_k = 2 + 0.4 / 4^k, true error of q0 0.4, estimate 1.25 * 0.3 * 4/3 = 0.5) is within
     0.05 + 0.3 * 2.4 = 0.77 and outside 0.05 + 0.1 * 2.4 = 0.29; an [accuracy] override is absolute."""
-    from mbsuite.accuracy import Headline, estimate, timestep_refinement
+    from mbsuite.trust.estimate import Headline, estimate, timestep_refinement
 
     ref = timestep_refinement(2.0)
     levels = [{"q": 2.0 + 0.4 / 4**k} for k in range(3)]

@@ -266,7 +266,7 @@ def test_a_numpy_users_line_reads_the_same():
 
 # --- the scene sections every model has: [params], [input], [solver], [effects] -------------------------------------
 def _scene_keys() -> Iterator[Any]:
-    from mbsuite.solver import SOLVER_LIMITS, SOLVER_WORDS
+    from mbsuite.settings import SOLVER_LIMITS, SOLVER_WORDS
 
     for name, spec in models().items():
         for f in dataclasses.fields(spec.params_cls):

@@ -15,11 +15,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from mbsuite.accuracy import TOLERANCE, check_tolerances
 from mbsuite.analysis.designspace import FACTOR_INPUTS, Factor
 from mbsuite.analysis.sweep import parse_values
 from mbsuite.cli.design import PARETO_LEVELS, START_VALUE
-from mbsuite.engines import signals as S
+from mbsuite.engines import inputs as S
 from mbsuite.errors import MbsuiteError, SceneError
 from mbsuite.limits import Limit
 from mbsuite.models.catenary.design import GRID_INPUTS, design_grid
@@ -37,6 +36,7 @@ from mbsuite.models.drives.design_scene import (
 from mbsuite.models.drives.scene_run import PROFILE, check_profile
 from mbsuite.scenes import scene_from_dict
 from mbsuite.schema import Items, Section, check_value
+from mbsuite.trust.estimate import TOLERANCE, check_tolerances
 
 PLANT = dict(J_l=0.0023, t_s=1 / 14.5, B_total=2.5e-4, tau_l=0.15, w0=400.0)
 DESIGN = dict(P=200.0, Sr_min=15.0, w_max=400.0, V_m=100.0, tau_c=8.0, w_op=300.0)

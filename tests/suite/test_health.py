@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
-from mbsuite.health import AccuracyError, Figure, InaccurateResultWarning, judge, nyquist_ratio, stability_margin
+from mbsuite.trust.health import AccuracyError, Figure, InaccurateResultWarning, judge, nyquist_ratio, stability_margin
 
 
 @pytest.mark.parametrize("integrator, limit", [("rk4", 2.8), ("euler", 2.0), ("implicit", 1.0)])

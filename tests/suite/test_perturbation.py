@@ -1,4 +1,5 @@
-"""Stability under perturbation (`mbsuite.perturbation`, `mbsuite perturb`): copies of every scene and hard case with
+"""Stability under perturbation (`mbsuite.trust.perturbation`, `mbsuite.trust.robustness`, `mbsuite perturb`):
+copies of every scene and hard case with
 every parameter, scene input and initial state changed by a relative 1e-12 or 1e-9 keep their invariants, move their
 headline outputs by at most KAPPA_MAX x eps (relative), and jump only where a model declares a discontinuity.
 
@@ -13,8 +14,10 @@ import zlib
 import numpy as np
 import pytest
 
-from mbsuite import hardcases, load_scene, perturbation, run, stability
+from mbsuite import hardcases, load_scene, run
 from mbsuite.registry import models
+from mbsuite.trust import perturbation
+from mbsuite.trust import robustness as stability
 
 FAST_SCENES = [("pantograph/lab", 1.0), ("coupler/double_friction", 1.0), ("drives/step_up_motor_resonant", 4.0),
                ("drives/susd_100w_design", 1.0), ("iftomm/fourbar", 1.0), ("catenary/en50318", None)]

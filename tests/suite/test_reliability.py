@@ -514,7 +514,7 @@ def test_loaders_refuse_what_their_parsers_let_through(tmp_path):
 
 
 def test_signal_parameters_are_checked():
-    from mbsuite.engines.signals import Pulse, Table
+    from mbsuite.engines.inputs import Pulse, Table
     from mbsuite.errors import ParameterError
 
     with pytest.raises(ParameterError, match=r"n = 1.5 in pulse signal is invalid; valid: integer in \[0, inf\)"):

@@ -13,7 +13,7 @@ import pytest
 import mbsuite
 from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.pantograph.params import PantographParams
-from mbsuite.solver import SolverSettings
+from mbsuite.settings import SolverSettings
 
 # 14 as every real number type a user may hold; the independent source is the plain Python float 14.0
 FOURTEEN = [np.float16(14.0), np.float32(14.0), np.float64(14.0), np.longdouble(14.0), np.int8(14), np.int16(14),

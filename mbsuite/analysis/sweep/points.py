@@ -12,10 +12,11 @@ from ...results import to_jsonable
 def scene_point(job: tuple[dict, dict] | tuple[dict, dict, int]) -> dict[str, Any]:
     """A generic parameter-study point: `job = (scene_dict, sections[, level])`; runs `scene.replace(**sections)` and
     returns per-signal statistics (min, max, mean, final) and the solver stats. With a `level`, the scene is first
-    refined that many times (`mbsuite.accuracy`: its path's refinement) and the result also holds its headline values
+    refined that many times (`mbsuite.trust.estimate`: its path's refinement) and the result also holds its headline
+    values
     (`headlines`), for the point's error estimate. Module-level, so it pickles to any executor."""
     from ...scenes import scene_from_dict
-    from ...timerun import run_judged as run
+    from ...simulate import run_judged as run
 
     scene_d, sections, *rest = job
     scene = scene_from_dict(scene_d)

@@ -59,7 +59,7 @@ enum {
 const char* mbs_fault_text(int code);
 
 /* ------------------------------------------------------------------------------------------------ signals */
-/* A time signal as a flat array: [kind, p0, p1, ...]. Kinds and parameters (mbsuite.engines.signals mirrors them):
+/* A time signal as a flat array: [kind, p0, p1, ...]. Kinds and parameters (mbsuite.engines.inputs mirrors them):
  *  0 constant   [0, c]
  *  1 step       [1, offset, height, t0]                          offset + height (t >= t0)
  *  2 sine       [2, offset, amplitude, freq_hz, phase, t0]       offset + A sin(2 pi f (t - t0) + phase) (t >= t0)

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...accuracy import AccuracySpec
 from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath, Uses
-from ...solver import SolverSettings
+from ...settings import SolverSettings
+from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .config import validate_train_section
 from .linefile import scene_params, validate_line_section

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ...accuracy import Headline, Refinement
 from ...scenes import Scene, scene_from_dict
+from ...trust.estimate import Headline, Refinement
 from .stats import STAT_NAMES
 
 #: the statistics of one pantograph, in the order of the EN 50318 tables

@@ -157,7 +157,7 @@ def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0)
     against its tolerance (`AccuracyError` naming the statistic and the setting to refine, unless the scene allows
     inaccurate results: then a warning) and add the table, `error_estimate` and the warnings to the report."""
     from ...analysis.errorestimate import error_estimate
-    from ...health import judge
+    from ...trust.health import judge
     from .accuracy import passage_values, stats_values
 
     est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers)

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from ...errors import ParameterError, SceneError
-from ...health import Figure, judge
 from ...limits import Limit
 from ...schema import Items, Rule, Section
+from ...trust.health import Figure, judge
 from .pantographs import PANTOGRAPHS, TWO_MASS, Pantograph
 from .params import CatenaryParams
 

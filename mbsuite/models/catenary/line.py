@@ -30,11 +30,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import perturbation
 from ...errors import ParameterError
 from ...limits import Limit, check_fields, param
-from ...perturbation import POSITION
 from ...schema import Items, check_value
+from ...trust import perturbation
+from ...trust.perturbation import POSITION
 
 WIRE_ROLES = ("contact", "messenger", "stitch", "auxiliary", "other")
 END_KINDS = ("pinned", "free")

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 from ...errors import ParameterError
 from ...limits import check_fields, param, real
-from ...perturbation import POSITION
+from ...trust.perturbation import POSITION
 from .line import Line
 
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...accuracy import AccuracySpec
 from ...deferred import Deferred
 from ...registry import Effect, ModelSpec, RunPath, Uses
-from ...solver import SolverSettings
+from ...settings import SolverSettings
+from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .params import CouplerParams
 from .scenario import INPUTS, OUTPUTS

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ...accuracy import Headline, Refinement, refine_timestep
+from ...trust.estimate import Headline, Refinement, refine_timestep
 
 #: nominal order of each MuJoCo integrator in the step
 ORDER = {"euler": 1.0, "implicit": 1.0, "implicitfast": 1.0, "rk4": 4.0}

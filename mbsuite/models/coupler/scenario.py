@@ -9,8 +9,8 @@ import math
 import numpy as np
 
 from ...errors import SceneError
-from ...health import Figure
 from ...limits import Limit
+from ...trust.health import Figure
 from .params import CouplerParams
 
 #: the scene input of type "constant_speed": valid range, unit, meaning and the default used when a scene omits the

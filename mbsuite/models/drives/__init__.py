@@ -1,7 +1,7 @@
 """Switched-mode mechanical drives (Oldaker 1997): step-up and step-up/step-down three-mass models with event-exact
 clutches, switching controllers, losses and Chapter 5 design tools; plus Modelica's CoupledClutches as an outside check.
 
-Two independent paths (`SPEC.paths`): the hand-derived event-exact stick/slip simulation (`equations.run` on
+Two independent paths (`SPEC.paths`): the hand-derived event-exact stick/slip simulation (`reference.run` on
 `event_exact.simulate_reference`) and MuJoCo (`mujoco.run` on `mujoco.MujocoRotorSim`, hinge rotors with real equality
 locks, its state machine a native stepper of mbsuite's C core). Suite declarations (hard cases, work-precision study,
 random inputs) in `cases.py`. See README.md (its Files table says where everything is).
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...accuracy import AccuracySpec
 from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath
-from ...solver import SolverSettings
+from ...settings import SolverSettings
+from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .params import PARAM_SETS, DriveParams
 from .scene_run import PROFILE, SIGNALS
@@ -55,7 +55,7 @@ SPEC = ModelSpec(
     scenes_dir=Path(__file__).parent / "scenes",
     default_scene="step_up_pwm",
     paths={
-        "reference": RunPath(run=Deferred("mbsuite.models.drives.equations:run"), label="equations",
+        "reference": RunPath(run=Deferred("mbsuite.models.drives.reference:run"), label="equations",
                              what="hand-derived equations (Oldaker Ch. 3), event-exact stick/slip (scipy DOP853 "
                                   "between events)"),
         "mujoco": RunPath(run=Deferred("mbsuite.models.drives.mujoco:run"), label="mujoco",

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ...accuracy import Headline, Refinement, rtol_refinement, timestep_refinement
+from ...trust.estimate import Headline, Refinement, rtol_refinement, timestep_refinement
 from .drive import T0_TOL
 
 #: the switched elements of each drive whose first lock-up in the window is a headline: headline suffix -> element

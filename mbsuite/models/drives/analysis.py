@@ -12,17 +12,17 @@ import numpy as np
 
 from ...analysis.errorestimate import run_values
 from ...errors import SceneError
-from ...health import judge
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
+from ...trust.health import judge
 from . import coupled_clutches as cc
 from . import design as D
-from . import drive, equations, mujoco
+from . import drive, mujoco, reference
 from .rotor_system import RefResult, RotorSystem
 
 #: each path's simulation of a scene, returning (result, controller, rotor system) for the analyses: the runs behind
-#: `SPEC.paths` ("reference" = `equations.run`, "mujoco" = `mujoco.run`) before their `SimResult` is assembled
-SIMULATE = {"reference": equations.simulate, "mujoco": mujoco.simulate}
+#: `SPEC.paths` ("reference" = `reference.run`, "mujoco" = `mujoco.run`) before their `SimResult` is assembled
+SIMULATE = {"reference": reference.simulate, "mujoco": mujoco.simulate}
 
 
 def simulate_scene(scene: Scene) -> tuple[RefResult, Any, RotorSystem]:
@@ -99,12 +99,12 @@ def _headlines_of(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem,
 
 def estimate_points(scenes: list[Scene], bases: list[dict[str, float]], evaluate, names: tuple[str, ...] | None,
                     workers: int = 0) -> list[Any]:
-    """The error estimate (`mbsuite.accuracy`) of several runs at once: every run's two refined copies in one
+    """The error estimate (`mbsuite.trust.estimate`) of several runs at once: every run's two refined copies in one
     parallel batch (`workers` local processes, 0 = all cores); `bases` are the runs' own headline values and
     `evaluate(scene_dict)` computes one refined copy's (module-level). Headlines restricted to `names` (None: all)."""
-    from ...accuracy import declared, estimate
     from ...analysis.errorestimate import level_settings
     from ...analysis.sweep import run_sweep
+    from ...trust.estimate import declared, estimate
 
     refs = [sc.spec.accuracy.refinement(sc) for sc in scenes]
     levels = [[r.refine(sc, k) for k in (0, 1, 2)] for sc, r in zip(scenes, refs, strict=True)]
@@ -124,7 +124,7 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
     points and one of the mean loss powers; `--out` writes efficiency.csv (SI units in the header) and efficiency.png
     (`plots.efficiency_figure`: the curve ordered by load speed, non-switching points apart, losses as sorted bars).
 
-    `error_estimate`: every point also runs refined once and twice (`mbsuite.accuracy`; all points' copies in one
+    `error_estimate`: every point also runs refined once and twice (`mbsuite.trust.estimate`; all points' copies in one
     parallel batch) and its efficiency-curve headlines (`EFFICIENCY_HEADLINES`) get an estimated error: a table per
     point and `data["points"][i]["error_estimate"]`; an estimate past its tolerance is an `AccuracyError` naming the
     point (a warning in `data["warnings"]` when the scene allows inaccurate results)."""

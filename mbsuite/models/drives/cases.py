@@ -10,7 +10,7 @@ import numpy as np
 
 from ... import load_scene, run
 from ...analysis.workprecision import Setting, Study, _rel
-from ...engines.signals import Step
+from ...engines.inputs import Step
 from ...errors import SceneError
 from ...hardcases import Checker, HardCase
 from ...paths import mjcf_path

@@ -14,11 +14,11 @@ from ...analysis.errorestimate import error_estimate
 from ...cli.options import SCENE_HELP, add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError, SceneError
-from ...health import judge
 from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene, scene_from_dict
+from ...trust.health import judge
 from . import accuracy
 from . import coupled_clutches as cc
 from . import design as D

@@ -4,7 +4,7 @@ torque 10 sin(2 pi 5 t) -> J1 -> clutch1 -> J2 -> clutch2 -> J3 -> clutch3 -> J4
 Clutch k: fn = fn_max * f_norm_k(t) with fn_max = 20 N, sliding torque mu * cgeo * fn (mu = 0.5, cgeo = 1), breakaway
 peak = 1.1 x sliding. f_norm_1 = sin(2 pi 0.2 t + pi/2) (released at t = 1.25 s), f_norm_2 and f_norm_3 step 0 -> 1 at
 0.4 s and 0.9 s. Reference: the Modelica Association's Dymola result (MSL 4.1.0), see `reference_path()`. The schedules
-and the drive torque are `mbsuite.engines.signals` (Sine, Step), evaluated alike by the hand path and in C.
+and the drive torque are `mbsuite.engines.inputs` (Sine, Step), evaluated alike by the hand path and in C.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...engines.signals import Signal, Sine, Step
+from ...engines.inputs import Signal, Sine, Step
 from . import msl
 from .rotor_system import Friction, Part, RotorSystem, Source
 

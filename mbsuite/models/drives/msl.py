@@ -10,7 +10,7 @@ Components (reusable parts of the drives package, equations of `Modelica/Mechani
 * `planetary_rows` (`Components.IdealPlanetary`): (1 + ratio) w_carrier = w_sun + ratio w_ring with a massless
   ring: the ring speed as a row over the rotors, so elements on the ring act through it (virtual work);
 * `ideal_gear_row` (`Components.IdealGear`): w_a = ratio w_b, flange b as a row over the rotors;
-* torque sources from `mbsuite.engines.signals` (Step, Sine, Pulse, Ramp) and `quadratic_speed_torque`
+* torque sources from `mbsuite.engines.inputs` (Step, Sine, Pulse, Ramp) and `quadratic_speed_torque`
   (`Sources.QuadraticSpeedDependentTorque`, TorqueDirection = true: tau = tau_nominal (w/w_nominal)^2);
 * spring-damper: `rotor_system.Spring` with `D` (`Components.SpringDamper`: tau = c phi_rel + d w_rel).
 
@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ...engines.signals import Pulse, Ramp, Signal, Sine, Step
+from ...engines.inputs import Pulse, Ramp, Signal, Sine, Step
 from ...errors import ModelFileError, ParameterError
 from .rotor_system import Friction, Part, RefResult, RotorSystem, Source, Spring
 

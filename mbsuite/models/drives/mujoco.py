@@ -24,7 +24,7 @@ are accumulated and the row recorded - all in C. Python runs only the discrete c
 core's `between`), and writes the command states into an array the C side reads. `stepper.RotorStepper` is the same
 state machine in Python (the readable twin, statement for statement; `MujocoRotorSim.run(..., stepper="python")`).
 
-Schedules and source shapes are evaluated in C: a `mbsuite.engines.signals` signal directly, any other Python callable
+Schedules and source shapes are evaluated in C: a `mbsuite.engines.inputs` signal directly, any other Python callable
 tabulated on the run's half-step grid (`signal_for`: exact at every instant the state machine evaluates it).
 """
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ...engines import core, mujoco_engine, native
-from ...engines.signals import Signal
+from ...engines.inputs import Signal
 from .rotor_run import CHATTER_N, CHATTER_WINDOW, CHUNK, HINT, RotorRun
 from .rotor_system import FREE
 

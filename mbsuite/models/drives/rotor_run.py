@@ -11,7 +11,7 @@ from typing import Any, Protocol
 import mujoco
 import numpy as np
 
-from ...engines.signals import Signal, Table
+from ...engines.inputs import Signal, Table
 from ...errors import ParameterError, SceneError
 from .commands import CommandQueue, Controller
 from .rotor_system import MODE_NAME, RefResult, RotorSystem
@@ -41,13 +41,13 @@ class CompiledRotors(Protocol):
 
 
 def signal_for(fn: Callable[[float], float] | Signal, grid: np.ndarray, what: str) -> Signal:
-    """A signal the native state machine can evaluate: `fn` itself if it is a `mbsuite.engines.signals` signal, else
+    """A signal the native state machine can evaluate: `fn` itself if it is a `mbsuite.engines.inputs` signal, else
     `fn` tabulated on `grid` (the run's instants t_k and t_k + dt/2, at which the state machine evaluates schedules
     and shapes: exact there, linear between). A non-finite value is refused, naming `what` and the time."""
     if isinstance(fn, Signal):
         return fn
     if not callable(fn):
-        raise ParameterError(f"{what} must be a signal (mbsuite.engines.signals) or a callable of time, got {fn!r}")
+        raise ParameterError(f"{what} must be a signal (mbsuite.engines.inputs) or a callable of time, got {fn!r}")
     vals = np.array([float(fn(float(x))) for x in grid])
     bad = np.nonzero(~np.isfinite(vals))[0]
     if bad.size:

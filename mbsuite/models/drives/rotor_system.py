@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ... import perturbation
 from ...errors import ParameterError
+from ...trust import perturbation
 
 FWD, STUCK, BWD, FREE = 1, 0, -1, 2
 MODE_NAME = {FWD: "forward", STUCK: "stuck", BWD: "backward", FREE: "free"}
@@ -29,7 +29,7 @@ class Part:
     """One contribution to a friction element's sliding torque: `level` N m, times the command `command` (0/1, None =
     always on) times `schedule(t)` (clipped at 0; None = 1). `output=True` marks a useful load (its work is output).
 
-    A schedule is best an `mbsuite.engines.signals` signal (Step, Sine, Ramp, Pulse, Table, ...): the hand path calls
+    A schedule is best an `mbsuite.engines.inputs` signal (Step, Sine, Ramp, Pulse, Table, ...): the hand path calls
     it, the MuJoCo path evaluates the same signal in C. Any other callable works too; the MuJoCo path then tabulates it
     on its half-step grid (`rotor_run.signal_for`)."""
 
@@ -78,7 +78,7 @@ class Spring:
 class Source:
     """Torque source on rotor `body`: tau = c0 * shape(t) + c1 * w + c2 * w^2 (a DC motor: c0 = Kt Vs / R,
     c1 = -Kt Ke / R; Modelica `QuadraticSpeedDependentTorque`: c2 = tau_nominal / w_nominal^2).
-    `shape` (None = 1) is best a signal of `mbsuite.engines.signals`, as `Part.schedule`."""
+    `shape` (None = 1) is best a signal of `mbsuite.engines.inputs`, as `Part.schedule`."""
 
     label: str
     body: int

@@ -1,6 +1,6 @@
 """A drives scene as a run of a rotor system: what both paths share - the system, initial state, controller and output
 grid a scene asks for (`setup`), and the `SimResult` of a run (`sim_result`: signals, energy balance, cycle statistics,
-mode changes, the energy-residual health figure). The paths themselves: `equations.py` (hand) and `mujoco.py`."""
+mode changes, the energy-residual health figure). The paths themselves: `reference.py` (hand) and `mujoco.py`."""
 
 from __future__ import annotations
 
@@ -9,13 +9,13 @@ from typing import Any
 
 import numpy as np
 
-from ... import perturbation
 from ...errors import SceneError
-from ...health import Figure
 from ...limits import Limit
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from ...schema import Items, Rule, check_value
+from ...trust import perturbation
+from ...trust.health import Figure
 from . import coupled_clutches as cc
 from . import drive, msl
 from .accuracy import window_efficiency
@@ -74,7 +74,7 @@ def reference_signal(inp: dict[str, Any], default: float):
 
 
 def _initial(q0, w0) -> tuple[np.ndarray, np.ndarray]:
-    """The initial angles and speeds (perturbed inside the stability check, `mbsuite.perturbation`)."""
+    """The initial angles and speeds (perturbed inside the stability check, `mbsuite.trust.perturbation`)."""
     return perturbation.state(q0, "q0"), perturbation.state(w0, "w0")
 
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...accuracy import AccuracySpec
 from ...deferred import Deferred
 from ...limits import Limit
 from ...registry import Effect, ModelSpec, RunPath, Uses
-from ...solver import SolverSettings
+from ...settings import SolverSettings
+from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .outputs import OUTPUTS
 from .params import IftommParams

@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...health import Figure
 from ...results import SimResult, assemble
 from ...scenes import Scene
+from ...trust.health import Figure
 from .geometry import BAR, Trajectory
 
 if TYPE_CHECKING:

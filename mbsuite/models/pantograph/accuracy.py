@@ -29,9 +29,9 @@ from typing import Any
 
 import numpy as np
 
-from ...accuracy import Headline, Refinement, rtol_refinement, timestep_refinement
 from ...analysis.harmonic import fundamental, whole_period_window
 from ...errors import SceneError
+from ...trust.estimate import Headline, Refinement, rtol_refinement, timestep_refinement
 
 #: nominal order in the step of each MuJoCo integrator on this model (RK4: 2, limited by the ram input held over the
 #: step; measured 4.0x per halving in the work-precision study, docs/accuracy.md)

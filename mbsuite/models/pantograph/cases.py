@@ -14,8 +14,8 @@ from ...analysis.harmonic import fundamental
 from ...analysis.workprecision import Setting, Study
 from ...errors import SceneError, SolverError
 from ...hardcases import Checker, HardCase
-from ...health import AccuracyError, InaccurateResultWarning
 from ...scenes import Scene
+from ...trust.health import AccuracyError, InaccurateResultWarning
 
 
 def _pantograph_stick_slip(ck: Checker) -> None:

@@ -24,14 +24,14 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ...accuracy import ErrorEstimate, Headline
 from ...analysis.harmonic import fundamental
 from ...analysis.sweep import SweepOptions, run_sweep
 from ...errors import SceneError
-from ...health import judge
 from ...limits import Limit
 from ...results import Report, SimResult, format_table, write_csv
 from ...scenes import Scene, scene_from_dict
+from ...trust.estimate import ErrorEstimate, Headline
+from ...trust.health import judge
 from .equations import PantographODE
 from .health import step_figures
 from .inputs import InputSignal, config_of, input_of, operating_height, start_of
@@ -517,7 +517,7 @@ def time_history_runs(scene: Scene, freqs: tuple[float, ...] = THESIS_FREQS) -> 
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# the error estimate of a frequency response (mbsuite.accuracy)
+# the error estimate of a frequency response (mbsuite.trust.estimate)
 # ---------------------------------------------------------------------------------------------------------------
 
 #: declared tolerances of the frequency response at the shipped settings (MuJoCo RK4 1 ms, the default grid and peak

@@ -1,4 +1,4 @@
-"""The pantograph's health figures (`mbsuite.health`): `step_figures` of a MuJoCo run, known before it steps
+"""The pantograph's health figures (`mbsuite.trust.health`): `step_figures` of a MuJoCo run, known before it steps
 (`stability_margin`, `nyquist_ratio`), and the `excursion` of a run of either path, judged by `mbsuite.run`."""
 
 from __future__ import annotations
@@ -7,14 +7,14 @@ import math
 
 import numpy as np
 
-from ...health import Figure, nyquist_ratio, stability_margin
 from ...scenes import Scene
+from ...trust.health import Figure, nyquist_ratio, stability_margin
 from .equations import PantographConfig
 from .inputs import InputSignal, operating_height
 from .linearise import omega_max
 from .params import PantographParams
 
-#: bound on h * omega_max per MuJoCo integrator as a fraction of its stability limit (`mbsuite.health`): rk4 1.4,
+#: bound on h * omega_max per MuJoCo integrator as a fraction of its stability limit (`mbsuite.trust.health`): rk4 1.4,
 #: the Euler family 0.1, discrete 0.01. Chosen from the error measured against the reference (lab scene, Coulomb off,
 #: 2 / 4.25 / 8.5 Hz; README "Health figures"): near each bound the physics error is about 1 % (rk4 0.61-0.78 % at
 #: h omega = 1.22, 2.4-27 % at 1.46-2.44; Euler family ~0.1 h omega: 0.61-0.89 % at 0.061, 4.4 % at 0.49; discrete

@@ -36,9 +36,9 @@ from scipy.optimize import fsolve
 from ...engines import core, native
 from ...engines import mujoco_engine as mje
 from ...errors import GeometryError, SceneError
-from ...health import judge
 from ...results import SimResult, assemble
 from ...scenes import Scene
+from ...trust.health import judge
 from .equations import PantographConfig, PantographODE
 from .health import excursion, step_figures
 from .inputs import Start, config_of, input_of, start_of

@@ -23,7 +23,7 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from .errors import SolverError
+from ..errors import SolverError
 
 
 class AccuracyError(SolverError):

@@ -31,10 +31,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from .errors import SceneError
+from ..errors import SceneError
+from ..limits import Limit
+from ..settings import SOLVER_LIMITS
 from .health import Figure
-from .limits import Limit
-from .solver import SOLVER_LIMITS
 
 #: safety factors of the grid-convergence index (Roache 1998): three levels in the asymptotic range, else two levels
 SAFETY_ASYMPTOTIC, SAFETY_OTHER = 1.25, 3.0
@@ -144,7 +144,7 @@ class ErrorEstimate:
 
     def table(self) -> str:
         """The estimates as a text table."""
-        from .results import format_table
+        from ..results import format_table
 
         rows = [[r.name, r.unit, r.value, r.error, "-" if r.tol is None else r.tol,
                  "-" if r.order is None else f"{r.order:.2f}", "yes" if r.asymptotic else "no",

@@ -1,5 +1,5 @@
 """Stability under perturbation: copies of a run with every parameter and the initial state changed by a relative
-1e-12 or 1e-9 (`mbsuite.perturbation`), and what must (and may not) change.
+1e-12 or 1e-9 (`mbsuite.trust.perturbation`), and what must (and may not) change.
 
 `check_scene(scene)` runs the unperturbed scene and the copies and holds them to two rules:
 (a) **invariants**: every health figure of every copy (energy balance, closure residual, stability margins, ...)
@@ -23,11 +23,12 @@ from typing import Any
 
 import numpy as np
 
-from . import perturbation, run
-from .hardcases import run_case
+from ..hardcases import run_case
+from ..registry import get_model
+from ..results import Report, format_table
+from ..simulate import run
+from . import perturbation
 from .perturbation import perturbed
-from .registry import get_model
-from .results import Report, format_table
 
 #: relative perturbations of the check (the default suite runs the first, the slow suite both)
 EPSILONS = (1e-12, 1e-9)

@@ -6,7 +6,7 @@ rounding of a stranger's machine, emulated) - so a quantity rebuilt within one c
 inside its declared range: a draw that would cross a range end is mirrored); integers, words and exact zeros of
 parameters stay as they are, an initial state at rest stays at rest. The context is a `ContextVar`: it reaches what the
 calling thread builds. Outside it every function here returns its input unchanged. The check that uses these copies is
-`mbsuite.stability`.
+`mbsuite.trust.robustness`.
 """
 
 

@@ -1,0 +1,51 @@
+"""Running a scene: `run` (public as `mbsuite.run`) picks the scene's path and judges its health figures once,
+with an optional error estimate; `run_judged` is that run without the estimate, what each refined copy of an error
+estimate and each sweep point runs (`mbsuite.analysis`)."""
+
+from __future__ import annotations
+
+from .errors import SceneError
+from .scenes import Scene, load_scene
+from .trust.health import judge
+
+
+def run_judged(scene: Scene):
+    """Run `scene`'s time simulation on its path (`solver.engine`) and judge its health figures once
+    (`mbsuite.trust.health.judge`: an `AccuracyError` for a figure above its bound unless `solver.allow_inaccurate`)."""
+    spec = scene.spec
+    if not spec.paths:
+        raise SceneError(f"model '{spec.name}' has no time simulation")
+    res = spec.paths[scene.solver.engine].run(scene)
+    res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene)))
+    return res
+
+
+def run_name(scene: Scene) -> str:
+    """The run's name in a health message: model and scene."""
+    return f"{scene.spec.name} scene {scene.name or scene.source or ''}".strip()
+
+
+def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool = False, workers: int = 0):
+    """Run a scene's time simulation on its path (`solver.engine`, or `engine`: a key or label of the model's path
+    table, `mbsuite list`), returning a `SimResult` whose health figures are judged here, once.
+
+    `error_estimate=True` also runs the scene refined once and twice (`mbsuite.trust.estimate`; `workers` local
+    processes,
+    0 = all cores) and attaches `res.error_estimate`: per headline output the estimated error and the observed order;
+    an estimate above its declared tolerance is a health figure like any other."""
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    spec = scene.spec
+    if engine is not None and spec.paths:
+        scene = scene.replace(solver={"engine": engine})
+    if error_estimate and spec.paths and spec.accuracy is None:
+        raise SceneError(f"model '{spec.name}' declares no headline outputs: no error estimate")
+    res = run_judged(scene)
+    if error_estimate:
+        from .analysis.errorestimate import error_estimate as estimate_error
+
+        res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers)
+        figures = res.error_estimate.figures()
+        res.health.extend(figures)
+        res.warnings.extend(judge(figures, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene)))
+    return res

@@ -145,6 +145,9 @@ class ModelSpec:
     #: the input files a model reads besides scenes (the catenary's line file): name -> `schema.Section` (or a
     #: `Deferred` naming one); docs, JSON Schemas and the generated input tests walk them
     input_files: Mapping[str, Any] = field(default_factory=dict)
+    #: shipped scenes that moved to another model: old scene name -> "model/scene". `load_scene("<this>/<old>")`
+    #: loads the new one with a `DeprecationWarning` naming it (`mbsuite list` shows only the new name)
+    moved_scenes: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._check_uses()

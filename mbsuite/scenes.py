@@ -39,6 +39,7 @@ import copy
 import dataclasses
 import math
 import tomllib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -396,6 +397,11 @@ def load_scene(ref: str | Path) -> Scene:
     spec = get_model(model)
     files = spec.scene_files()
     scene_name = scene_name or spec.default_scene
+    if scene_name not in files and scene_name in spec.moved_scenes:
+        new = spec.moved_scenes[scene_name]
+        warnings.warn(f"scene '{model}/{scene_name}' is now '{new}'; load it by that name (the old name will go)",
+                      DeprecationWarning, stacklevel=2)
+        return load_scene(new)
     if scene_name not in files:
         raise SceneError(f"model '{model}' has no scene '{scene_name}'; shipped scenes: {sorted(files)}")
     return load_scene(files[scene_name])

@@ -47,8 +47,8 @@ _LAZY = {
     "load_scene": ("mbsuite.scenes", "load_scene"),
     "scene_from_dict": ("mbsuite.scenes", "scene_from_dict"),
     "run": ("mbsuite.simulate", "run"),
-    "run_judged": ("mbsuite.simulate", "run_judged"),
-    "run_name": ("mbsuite.simulate", "run_name"),
+    "run_judged": ("mbsuite.pathrun", "run_judged"),
+    "run_name": ("mbsuite.pathrun", "run_name"),
 }
 
 

@@ -86,6 +86,47 @@ class RunPath:
 
 
 @dataclass(frozen=True)
+class Band:
+    """A bound a model offers the design studies (`mbsuite optimise --band SYSTEM`, `OUTPUT=band:SYSTEM`): its headline
+    output `output` inside a target band that depends on the scene's operating point, one band per named system (the
+    catenary's: the EN 50367 band of the mean contact force per supply system). `target(system, scene) -> (lo, hi)`
+    in the output's unit, at the scene's operating point; `name` says what it is in tables."""
+
+    output: str
+    systems: tuple[str, ...]
+    target: Callable[[str, Any], tuple[float, float]]
+    name: str
+    doc: str = ""
+
+    def check(self, system: str, output: str, model: str) -> str:
+        """The system (the first when `system` is empty), or an MbsuiteError naming the valid ones."""
+        from .errors import MbsuiteError
+
+        if output != self.output:
+            raise MbsuiteError(f"the {self.name} of model '{model}' bounds {self.output} only, not {output}")
+        if not system:
+            return self.systems[0]
+        if system not in self.systems:
+            raise MbsuiteError(f"the {self.name} of model '{model}' has no system {system!r}; valid: "
+                               f"{', '.join(self.systems)}")
+        return system
+
+
+@dataclass(frozen=True)
+class Studies:
+    """What the design studies (`mbsuite.analysis`: optimise, sensitivity, sweeps) take from a model, so that they name
+    none: the default `objective` of `optimise` and the output a Pareto front trades against (`against`), both
+    headline outputs (`accuracy`); the `band` the model offers as a constraint; and the paths whose runs may share a
+    process in threads (`threads`: their loop is compiled and holds no global state, so a study runs them in a thread
+    pool instead of processes)."""
+
+    objective: str | None = None
+    against: str | None = None
+    band: Band | None = None
+    threads: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class ModelSpec:
     """What a model offers. Hooks take a validated `Scene` and return plain results (dicts / result objects).
 
@@ -111,6 +152,10 @@ class ModelSpec:
       why (an input key only when it differs from its declared default): against the effects when the scene is
       built, against the path (and the path's `lacks`) when a path runs it, so a scene may carry one path's
       settings while another path's run is asked for on the way.
+    - `studies`: what the design studies take from the model (`Studies`: default objective, a band constraint, the
+      paths that may run in threads).
+    - `commands`: the dotted name of the module whose `register(subparsers, add_common, emit)` adds the model's
+      command group to `mbsuite` (None: no group).
     - `accuracy`: the model's accuracy declaration (`mbsuite.trust.estimate.AccuracySpec`: headline outputs with the
       tolerances the defaults meet, their values from a result, how a run is refined for `--error-estimate`).
     - `file_checks`: model-file stem -> `check(path, engine, model)`, handed to the engines' loaders for a file of
@@ -148,6 +193,8 @@ class ModelSpec:
     #: shipped scenes that moved to another model: old scene name -> "model/scene". `load_scene("<this>/<old>")`
     #: loads the new one with a `DeprecationWarning` naming it (`mbsuite list` shows only the new name)
     moved_scenes: Mapping[str, str] = field(default_factory=dict)
+    studies: Studies = field(default_factory=Studies)
+    commands: str | None = None
 
     def __post_init__(self) -> None:
         self._check_uses()
@@ -158,6 +205,8 @@ class ModelSpec:
         clash = [p.label for k, p in self.paths.items() if p.label in self.paths and p.label != k]
         if len(set(labels)) != len(labels) or clash:
             raise ValueError(f"model '{self.name}': path labels must be unique and name no other path: {labels}")
+        if set(self.studies.threads) - set(self.paths):
+            raise ValueError(f"model '{self.name}': studies.threads names unknown paths {self.studies.threads}")
         if self.paths and self.solver.engine not in self.paths:
             raise ValueError(f"model '{self.name}': default engine {self.solver.engine!r} is not one of its paths "
                              f"{list(self.paths)}")

@@ -1,28 +1,12 @@
-"""Running a scene: `run` (public as `mbsuite.run`) picks the scene's path and judges its health figures once,
-with an optional error estimate; `run_judged` is that run without the estimate, what each refined copy of an error
-estimate and each sweep point runs (`mbsuite.analysis`)."""
+"""`run` (public as `mbsuite.run`): a scene's time simulation on its path, its health figures judged once, with an
+optional error estimate of its headline outputs (`mbsuite.analysis.errorestimate`)."""
 
 from __future__ import annotations
 
 from .errors import SceneError
+from .pathrun import run_judged, run_name
 from .scenes import Scene, load_scene
 from .trust.health import judge
-
-
-def run_judged(scene: Scene):
-    """Run `scene`'s time simulation on its path (`solver.engine`) and judge its health figures once
-    (`mbsuite.trust.health.judge`: an `AccuracyError` for a figure above its bound unless `solver.allow_inaccurate`)."""
-    spec = scene.spec
-    if not spec.paths:
-        raise SceneError(f"model '{spec.name}' has no time simulation")
-    res = spec.paths[scene.solver.engine].run(scene)
-    res.warnings.extend(judge(res.health, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene)))
-    return res
-
-
-def run_name(scene: Scene) -> str:
-    """The run's name in a health message: model and scene."""
-    return f"{scene.spec.name} scene {scene.name or scene.source or ''}".strip()
 
 
 def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool = False, workers: int = 0):

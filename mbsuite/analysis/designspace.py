@@ -140,8 +140,8 @@ def point_scene(scene: Scene, point: Mapping[str, Any], origin: str = "at a desi
 
 def scene_outputs(scene_dict: dict, point: dict[str, Any]) -> dict[str, float]:
     """Run the scene at `point` and return its headline outputs (module-level: it pickles to any executor)."""
+    from ..pathrun import run_judged
     from ..scenes import scene_from_dict
-    from ..simulate import run_judged
 
     scene = scene_from_dict(scene_dict)
     try:
@@ -172,12 +172,12 @@ def headline_units(scene: Scene | None) -> dict[str, str]:
 def evaluate(fn: Callable[[dict[str, Any]], Mapping[str, Any]], points: Sequence[dict[str, Any]], *,
              scene: Scene | None = None, workers: int = 0, options: SweepOptions | None = None,
              progress: bool | None = None, desc: str = "study") -> list[dict[str, float]]:
-    """`fn` at every point on the sweep machinery, in the order of the points. A scene whose path is MuJoCo runs its
-    points in threads (the native core releases the GIL), any other in processes, unless `options` names an
-    executor. Each result must be a mapping of output name -> number."""
+    """`fn` at every point on the sweep machinery, in the order of the points. A scene runs its points in threads when
+    its model declares the scene's path thread-safe (`SPEC.studies.threads`: a compiled loop that releases the GIL),
+    else in processes, unless `options` names an executor. Each result must be a mapping of output name -> number."""
     from .sweep import run_sweep
 
-    auto = "threads" if scene is not None and scene.solver.engine == "mujoco" else None
+    auto = "threads" if scene is not None and scene.solver.engine in scene.spec.studies.threads else None
     results = run_sweep(fn, list(points), workers=workers, progress=progress, desc=desc, executor=auto,
                         options=options)
     out = []

@@ -22,7 +22,7 @@ from .sweep import run_sweep
 
 def run_values(scene_d: dict) -> dict[str, float]:
     """The headline values of one time run of the scene `scene_d` (a `Scene.to_dict()`)."""
-    from ..simulate import run_judged as run
+    from ..pathrun import run_judged as run
 
     scene = scene_from_dict(scene_d)
     return dict(scene.spec.accuracy.values(scene, run(scene)))

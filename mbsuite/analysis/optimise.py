@@ -44,7 +44,6 @@ if TYPE_CHECKING:
     from .sweep import SweepOptions
 
 AGGREGATES = ("worst", "mean")
-BAND_SYSTEMS = ("AC", "DC3kV", "DC1.5kV")
 #: the numbers `run` and `pareto` take, declared once (`Limit.check`: numpy scalars too; bools, NaN, inf refused)
 BOUND = Limit(doc="a bound on a headline output (its unit)")
 LIMITS = {"penalty": Limit(lo=0.0, lo_open=True, doc="objective units per unit of constraint violation"),
@@ -57,18 +56,17 @@ LIMITS = {"penalty": Limit(lo=0.0, lo_open=True, doc="objective units per unit o
 
 @dataclass(frozen=True)
 class Bound:
-    """`lo <= output <= hi` (either side may be None). `band`: the catenary's EN 50367 target band of the mean
-    contact force for a supply system (`AC`, `DC3kV`, `DC1.5kV`), at each evaluation's train speed; then `output`
-    is `Fm` and lo/hi are read from `catenary.quality.QualityCriteria.target`."""
+    """`lo <= output <= hi` (either side may be None). `band`: a system of the band the scene's model declares
+    (`SPEC.studies.band`, e.g. the catenary's EN 50367 band of Fm per supply system; "" = its first system), read at
+    each evaluation's operating point."""
 
     output: str
     lo: float | None = None
     hi: float | None = None
     band: str | None = None
+    band_name: str = "band"  # what the band is, for tables (the model's `Band.name`, set by `for_scene`)
 
     def __post_init__(self) -> None:
-        if self.band is not None and self.band not in BAND_SYSTEMS:
-            raise MbsuiteError(f"constraint band {self.band!r} is unknown; valid: {', '.join(BAND_SYSTEMS)}")
         for name in ("lo", "hi"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, BOUND.check(f"constraint on {self.output}: {name}",
@@ -78,43 +76,50 @@ class Bound:
         if self.lo is not None and self.hi is not None and self.lo > self.hi:
             raise MbsuiteError(f"constraint on {self.output}: lower bound {self.lo:g} above upper bound {self.hi:g}")
 
+    def for_scene(self, scene: Scene | None) -> Bound:
+        """This bound with its band's system named, checked against the band the scene's model declares."""
+        if self.band is None:
+            return self
+        if scene is None or scene.spec.studies.band is None:
+            owner = "a function" if scene is None else f"model '{scene.model}'"
+            raise MbsuiteError(f"constraint {self.output or 'OUTPUT'}=band: {owner} declares no band "
+                               "(SPEC.studies.band)")
+        declared = scene.spec.studies.band
+        system = declared.check(self.band, self.output or declared.output, scene.model)
+        return Bound(declared.output, band=system, band_name=declared.name)
+
     def at(self, scene: Scene | None) -> tuple[float, float]:
         """(lo, hi) at the scene's operating point (-inf/inf for an open side)."""
         if self.band is not None:
-            if scene is None or scene.model != "catenary":
-                raise MbsuiteError(f"constraint band {self.band}: the EN 50367 band is the catenary's (a scene of "
-                                   "model 'catenary')")
-            from ..models.catenary.quality import QualityCriteria
-
-            return QualityCriteria.for_system(self.band).target(float(scene.input["speed"]))
+            b = self.for_scene(scene)
+            return scene.spec.studies.band.target(b.band, scene)
         return (-math.inf if self.lo is None else float(self.lo), math.inf if self.hi is None else float(self.hi))
 
     def text(self) -> str:
         """How the constraint reads in tables."""
         if self.band is not None:
-            return f"{self.output} in the EN 50367 band ({self.band})"
+            return f"{self.output} in the {self.band_name} ({self.band})"
         lo = "" if self.lo is None else f"{self.lo:g} <= "
         hi = "" if self.hi is None else f" <= {self.hi:g}"
         return f"{lo}{self.output}{hi}"
 
 
-def band(system: str = "AC") -> Bound:
-    """Fm inside the EN 50367 target band of `system` at each evaluation's speed (the catenary's `quality`)."""
-    return Bound("Fm", band=system)
+def band(system: str = "") -> Bound:
+    """The band the scene's model declares on its output, of `system` ("" = its first), at each evaluation's
+    operating point (the catenary: Fm in the EN 50367 band of a supply system)."""
+    return Bound("", band=system)
 
 
 def parse_bound(text: str) -> Bound:
-    """`OUTPUT=LO:HI` (either side may be empty: `Fm=100:`), or `OUTPUT=band` / `OUTPUT=band:DC3kV` for the
-    catenary's EN 50367 band."""
+    """`OUTPUT=LO:HI` (either side may be empty: `Fm=100:`), or `OUTPUT=band` / `OUTPUT=band:SYSTEM` for the band the
+    scene's model declares (the catenary: `Fm=band:DC3kV`, the EN 50367 band)."""
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or not name:
         raise MbsuiteError(f"--constraint {text!r}: expected OUTPUT=LO:HI (e.g. Fm=100:130) or Fm=band[:SYSTEM]")
     head, _, tail = value.partition(":")
     if head.strip() == "band":
-        if name != "Fm":
-            raise MbsuiteError(f"--constraint {text!r}: the EN 50367 band bounds Fm only")
-        return Bound(name, band=tail.strip() or "AC")
+        return Bound(name, band=tail.strip())
     if value.count(":") != 1:
         raise MbsuiteError(f"--constraint {text!r}: expected OUTPUT=LO:HI with one colon (an empty side is open)")
     sides = []
@@ -318,25 +323,27 @@ def _check(objective: Any, aggregate: str, **numbers: Any) -> dict[str, Any]:
 
 
 def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: Sequence[Factor | str], *,
-        objective: str = "sigma", constraints: Sequence[Bound | str] = (), over: Mapping[str, Sequence] | None = None,
-        aggregate: str = "worst", penalty: float = 10.0, maxiter: int = 20, popsize: int = 5, seed: int = 0,
-        tol: float = 1e-3, start: Mapping[str, float] | None = None, workers: int = 0,
-        options: SweepOptions | None = None, progress: bool | None = None) -> OptimiseResult:
+        objective: str | None = None, constraints: Sequence[Bound | str] = (),
+        over: Mapping[str, Sequence] | None = None, aggregate: str = "worst", penalty: float = 10.0,
+        maxiter: int = 20, popsize: int = 5, seed: int = 0, tol: float = 1e-3,
+        start: Mapping[str, float] | None = None, workers: int = 0, options: SweepOptions | None = None,
+        progress: bool | None = None) -> OptimiseResult:
     """Minimise `objective` over the factors' ranges (scipy `differential_evolution`, generations evaluated on the
     sweep machinery), subject to `constraints` (`Bound`s or `OUTPUT=LO:HI` texts) at every operating point of
     `over`, aggregated by `aggregate`. `popsize`: members per factor (scipy's meaning, at least 5 in all);
-    `maxiter`: generations.
+    `maxiter`: generations. `objective` None: the model's declared one (`SPEC.studies.objective`).
     `start`: a design evaluated first and reported beside the optimum (default: the scene's own values of the
     factors, when they lie in the ranges)."""
     from scipy.optimize import differential_evolution
 
     from ..scenes import Scene
 
+    scene = target if isinstance(target, Scene) else None
+    objective = _default(scene, "objective", objective)
     checked = _check(objective, aggregate, penalty=penalty, tol=tol, maxiter=maxiter, popsize=popsize, seed=seed)
     penalty, tol, maxiter, popsize, seed = (checked[k] for k in ("penalty", "tol", "maxiter", "popsize", "seed"))
-    scene = target if isinstance(target, Scene) else None
     facs = factors_for(scene, factors)
-    cons = [parse_bound(c) if isinstance(c, str) else c for c in constraints]
+    cons = [(parse_bound(c) if isinstance(c, str) else c).for_scene(scene) for c in constraints]
     units = headline_units(scene)
     if scene is not None:
         for name in (objective, *(c.output for c in cons)):
@@ -371,6 +378,18 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
                            "popsize": popsize, "tol": tol, "penalty": penalty, "generations": int(res.nit),
                            "polish": False, "updating": "deferred"},
                           str(res.message), units, scene.name if scene is not None else _name(fn), start_rec)
+
+
+def _default(scene: Scene | None, what: str, value: str | None) -> str:
+    """`value`, or the model's declared default study output `what` (`SPEC.studies.objective` / `.against`)."""
+    if value is not None:
+        return value
+    declared = getattr(scene.spec.studies, what) if scene is not None else None
+    if declared is None:
+        owner = "a function" if scene is None else f"model '{scene.model}'"
+        raise MbsuiteError(f"optimise: give the {what} (an output name): {owner} declares no default "
+                           f"(SPEC.studies.{what})")
+    return declared
 
 
 def _name(fn: Any) -> str:
@@ -428,7 +447,7 @@ def rerun(result: OptimiseResult, scene: Scene, workers: int = 0) -> dict[str, A
     `mbsuite.analysis.errorestimate`); stores and returns per point the headline values, the estimate and a table.
     Judging the estimates against their tolerances is left to `judge_rerun`, so that the result is reported
     first."""
-    from ..simulate import run_judged
+    from ..pathrun import run_judged
     from .errorestimate import error_estimate
 
     points = []
@@ -555,12 +574,16 @@ def non_dominated(evals: Sequence[Mapping[str, Any]], objective: str, against: s
 
 
 def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: Sequence[Factor | str], *,
-           objective: str = "sigma", against: str = "Fm", levels: Sequence[float], **kwargs: Any) -> ParetoResult:
+           objective: str | None = None, against: str | None = None, levels: Sequence[float],
+           **kwargs: Any) -> ParetoResult:
     """The trade-off of `objective` (minimised) against `against` (maximised): one `run` per level with the extra
     constraint `against >= level` (epsilon-constraint), the front the non-dominated set of all their evaluations.
-    `kwargs` go to `run` (constraints, over, maxiter, popsize, seed, workers, options)."""
+    `objective` / `against` None: the model's declared ones (`SPEC.studies`). `kwargs` go to `run` (constraints,
+    over, maxiter, popsize, seed, workers, options)."""
     from ..scenes import Scene
 
+    scene = target if isinstance(target, Scene) else None
+    objective, against = _default(scene, "objective", objective), _default(scene, "against", against)
     lv = [LIMITS["level"].check("pareto level", x, MbsuiteError) for x in levels]
     if not lv:
         raise MbsuiteError(f"pareto levels {levels!r}: give one or more finite numbers")
@@ -570,7 +593,6 @@ def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factor
     # a design is on the front if it meets the run's own constraints; the level it was searched under does not count
     evals = [{**e, "violation": float(sum(e["violations"][:len(base)]))} for r in runs for e in r.evaluations]
     units = runs[0].units
-    scene = target if isinstance(target, Scene) else None
     return ParetoResult(objective, against, lv, runs, non_dominated(evals, objective, against), units,
                         scene.name if scene is not None else runs[0].target)
 

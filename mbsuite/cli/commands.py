@@ -58,6 +58,14 @@ def cmd_list(args: argparse.Namespace) -> None:
                       "effects": {k: list(e.choices) for k, e in spec.effects.items()}, "paths": paths}
         path_lines = [wrap(f"path {k}" + (f" ({p['label']})" if p["label"] != k else "") + f": {p['what']}")
                       for k, p in paths.items()]
+        st = spec.studies
+        studies = {"objective": st.objective, "against": st.against, "threads": list(st.threads),
+                   "band": None if st.band is None else {"name": st.band.name, "output": st.band.output,
+                                                         "systems": list(st.band.systems), "doc": st.band.doc}}
+        data[name]["studies"] = studies
+        if st.objective or st.band:
+            band = f"; --band: {st.band.output} in the {st.band.name} ({', '.join(st.band.systems)})" if st.band else ""
+            path_lines.append(wrap(f"studies: objective {st.objective}, against {st.against}{band}"))
         blocks.append("\n".join([wrap(f"{name}: {spec.summary}", indent=""), *path_lines,
                                  wrap("analyses: " + ", ".join(offered)), wrap("scenes: " + ", ".join(scenes))]))
     table = format_table(["model", "default scene", "scenes", "engines"], rows) + "\n\n" + "\n\n".join(blocks)

@@ -228,16 +228,19 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=deferred(".design", "cmd_sensitivity"))
 
     p = sub.add_parser("optimise", help="the design minimising a headline output over declared ranges, subject to "
-                                        "bounds (e.g. Fm in the EN 50367 band), at one or several speeds; or a "
-                                        "Pareto front")
+                                        "bounds (e.g. an output inside a band the model declares), at one or "
+                                        "several speeds; or a Pareto front")
     p.add_argument("scene", help=SCENE_HELP)
     _design_ranges(p)
-    p.add_argument("--objective", default="sigma", help="the headline output to minimise (default sigma)")
+    p.add_argument("--objective", help="the headline output to minimise (default: the one the scene's model declares, "
+                                       "`mbsuite list`)")
     p.add_argument("--constraint", action="append", metavar="OUTPUT=LO:HI",
                    help="bounds on a headline output, e.g. Fm=100:130 (an empty side is open: Fm=100:); "
-                        "Fm=band[:SYSTEM] is the EN 50367 band at each speed (repeatable)")
-    p.add_argument("--band", metavar="SYSTEM", choices=("AC", "DC3kV", "DC1.5kV"),
-                   help="shortcut for --constraint Fm=band:SYSTEM (the catenary's EN 50367 band)")
+                        "OUTPUT=band[:SYSTEM] is the band the scene's model declares, at each operating point "
+                        "(repeatable)")
+    p.add_argument("--band", metavar="SYSTEM",
+                   help="shortcut for --constraint OUTPUT=band:SYSTEM: the band the scene's model declares on its "
+                        "output, for SYSTEM (`mbsuite list` names the bands and their systems)")
     p.add_argument("--speed", metavar="KMH",
                    help="train speed(s), km/h: one value sets input.speed; a comma list makes the robust variant "
                         "(every design at each speed, --aggregate)")
@@ -257,7 +260,8 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--pareto", metavar="LEVELS",
                    help="a Pareto front instead: minimise the objective with --against >= each level (a,b,c or "
                         "start:stop:step; epsilon-constraint)")
-    p.add_argument("--against", default="Fm", help="the output the front trades against, maximised (default Fm)")
+    p.add_argument("--against", help="the output the front trades against, maximised (default: the one the scene's "
+                                     "model declares)")
     p.add_argument("--error-estimate", action="store_true",
                    help="re-run the optimum at each operating point with its error estimate (refined once and "
                         "twice)")
@@ -277,19 +281,16 @@ def _design_ranges(p: argparse.ArgumentParser) -> None:
 
 
 def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:
-    """Let each model with a `cli` module add its command group; returns model -> the group's command name."""
+    """Let each model that declares a command module (`SPEC.commands`) add its command group; returns model -> the
+    group's command name."""
     from .. import registry
 
     groups: dict[str, str] = {}
-    for name in sorted(registry.models()):
-        try:
-            mod = importlib.import_module(f"mbsuite.models.{name}.cli")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"mbsuite.models.{name}.cli":
-                raise
+    for name, spec in sorted(registry.models().items()):
+        if spec.commands is None:
             continue
-        group = mod.register(sub, add_common, emit)
+        group = importlib.import_module(spec.commands).register(sub, add_common, emit)
         if group not in sub.choices:
-            raise TypeError(f"mbsuite.models.{name}.cli.register returned {group!r}, not the command it added")
+            raise TypeError(f"{spec.commands}.register returned {group!r}, not the command it added")
         groups[name] = group
     return groups

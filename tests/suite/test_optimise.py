@@ -110,10 +110,10 @@ def test_bad_settings_are_refused():
         optimise.run(quadratic, ["x.a=0:1", "x.b=0:1"], objective="f", aggregate="median")
     with pytest.raises(MbsuiteError, match="maxiter"):
         optimise.run(quadratic, ["x.a=0:1", "x.b=0:1"], objective="f", maxiter=0)
-    with pytest.raises(MbsuiteError, match="band 'XX' is unknown"):
-        optimise.Bound("Fm", band="XX")
+    with pytest.raises(MbsuiteError, match="EN 50367 band of model 'catenary' has no system 'XX'; valid: AC"):
+        optimise.Bound("Fm", band="XX").for_scene(mbsuite.load_scene("catenary"))
     with pytest.raises(MbsuiteError, match="lower bound 3 above upper bound 1"):
         optimise.parse_bound("Fm=3:1")
-    with pytest.raises(MbsuiteError, match="catenary"):
+    with pytest.raises(MbsuiteError, match="model 'pantograph' declares no band"):
         optimise.band("AC").at(mbsuite.load_scene("pantograph"))
     assert not math.isinf(optimise.parse_bound("Fm=100:").at(None)[0])

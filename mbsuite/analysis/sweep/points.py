@@ -15,8 +15,8 @@ def scene_point(job: tuple[dict, dict] | tuple[dict, dict, int]) -> dict[str, An
     refined that many times (`mbsuite.trust.estimate`: its path's refinement) and the result also holds its headline
     values
     (`headlines`), for the point's error estimate. Module-level, so it pickles to any executor."""
+    from ...pathrun import run_judged as run
     from ...scenes import scene_from_dict
-    from ...simulate import run_judged as run
 
     scene_d, sections, *rest = job
     scene = scene_from_dict(scene_d)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ...deferred import Deferred
 from ...limits import Limit
-from ...registry import Effect, ModelSpec, RunPath, Uses
+from ...registry import Band, Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
@@ -17,6 +17,7 @@ from .config import validate_train_section
 from .linefile import scene_params, validate_line_section
 from .pantographs import PANTOGRAPHS, SECTION_PANTOGRAPHS, TWO_MASS, validate_section
 from .params import CatenaryParams
+from .quality import SYSTEMS
 from .quality import validate_section as validate_quality
 
 #: the 2-mass reference pantograph's parameters are read only when it runs; a registry pantograph takes its own from the
@@ -68,4 +69,10 @@ SPEC = ModelSpec(
     uses=USES,
     params_builder=scene_params,
     input_files={"line_file": Deferred("mbsuite.models.catenary.linefile:LINE_FILE")},
+    studies=Studies(objective="sigma", against="Fm",
+                    band=Band("Fm", tuple(SYSTEMS), Deferred("mbsuite.models.catenary.quality:band_target"),
+                              "EN 50367 band", "the target band of the mean contact force Fm at the scene's speed "
+                              "(EN 50367 / TSI Energy), per supply system"),
+                    threads=("mujoco",)),
+    commands="mbsuite.models.catenary.cli",
 )

@@ -108,6 +108,12 @@ def validate_section(value: Any) -> dict[str, Any]:
 validate_section.schema = SECTION
 
 
+def band_target(system: str, scene: Any) -> tuple[float, float]:
+    """The EN 50367 target band of the mean contact force (N) of supply system `system` at the scene's train speed:
+    the catenary's `Band` for the design studies (`SPEC.studies`)."""
+    return QualityCriteria.for_system(system).target(float(scene.input["speed"]))
+
+
 def criteria_from(section: dict[str, Any] | None) -> QualityCriteria:
     """QualityCriteria of a `[quality]` section (or the AC defaults)."""
     sec = dict(section or {})

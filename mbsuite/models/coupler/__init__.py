@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...deferred import Deferred
-from ...registry import Effect, ModelSpec, RunPath, Uses
+from ...registry import Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
@@ -63,4 +63,6 @@ SPEC = ModelSpec(
     file_checks={"coupler_single": _check_file, "coupler_double": _check_file},
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
+    studies=Studies(threads=("mujoco",)),
+    commands="mbsuite.models.coupler.cli",
 )

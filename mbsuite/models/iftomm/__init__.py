@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ...deferred import Deferred
 from ...limits import Limit
-from ...registry import Effect, ModelSpec, RunPath, Uses
+from ...registry import Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
@@ -48,4 +48,5 @@ SPEC = ModelSpec(
                  "iftomm_bricard": Deferred("mbsuite.models.iftomm.modelfiles:check_model_file")},
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
+    studies=Studies(threads=("mujoco",)),
 )

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...deferred import Deferred
-from ...registry import Effect, ModelSpec, RunPath, Uses
+from ...registry import Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
@@ -73,4 +73,6 @@ SPEC = ModelSpec(
     # (implicitfast needs 5e-5 s for 6e-4) at the lowest cost of all MuJoCo settings; see the README.
     solver=SolverSettings(engine="mujoco", integrator="rk4", timestep=1e-3, method="LSODA", rtol=1e-8, atol=1e-10,
                           duration=10.0, t_settle=5.0),
+    studies=Studies(threads=("mujoco",)),
+    commands="mbsuite.models.pantograph.cli",
 )

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mbsuite.components.linear_pantograph import LumpedParams, TransferParams, lumped
 from mbsuite.errors import ParameterError
-from mbsuite.models.catenary.linear_pantographs import LumpedParams, TransferParams, lumped
 
 
 def test_an_unstable_transfer_function_is_refused_naming_its_pole():

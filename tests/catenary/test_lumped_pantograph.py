@@ -1,4 +1,4 @@
-"""The linear pantographs under the wire (`linear_pantographs.py`): the 2-stage lumped pantograph with the reference's
+"""The linear pantographs under the wire (`linear_pantograph.py`): the 2-stage lumped pantograph with the reference's
 parameters and the transfer-function pantograph built from the 2-mass model's exact transfer function both reproduce
 the EN 50318 2-mass pantograph's passage (the catenary's own, in the compiled loop); their statics in closed form; the
 `[pantograph]` section checked key by key; the shipped scenes."""
@@ -11,9 +11,7 @@ import numpy as np
 import pytest
 
 from mbsuite import load_scene
-from mbsuite.errors import ParameterError, SceneError
-from mbsuite.models.catenary.analysis import simulate
-from mbsuite.models.catenary.linear_pantographs import (
+from mbsuite.components.linear_pantograph import (
     LinearPantograph,
     LumpedParams,
     TransferParams,
@@ -21,6 +19,8 @@ from mbsuite.models.catenary.linear_pantographs import (
     params_of,
     transfer,
 )
+from mbsuite.errors import ParameterError, SceneError
+from mbsuite.models.catenary.analysis import simulate
 from mbsuite.models.catenary.pantographs import TwoMassPantograph, build, validate_section
 from mbsuite.models.catenary.params import CatenaryParams
 

@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
+from mbsuite.components.linear_pantograph import LumpedParams, TransferParams
 from mbsuite.errors import ParameterError
-from mbsuite.models.catenary.linear_pantographs import LumpedParams, TransferParams
 from mbsuite.models.pantograph.equations import PantographConfig
 from mbsuite.models.pantograph.linearise import linear_model, linear_response
 from mbsuite.models.pantograph.lumped_fit import band_freqs, driving_point, fit_lumped, fit_transfer

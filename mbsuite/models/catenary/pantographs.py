@@ -23,10 +23,10 @@ section it takes and its `UnderWire` factory. `reference2mass` is the catenary's
 parameters m1 ... F0 the catenary's); every other name is a pantograph model of the registry (`PANTOGRAPH_MODELS`),
 found by `mbsuite.registry.get_model(name).under_wire` with the `[pantograph]` section of the scene (its own `effects`
 and `params`, validated against that model's spec). `lumped` and `transfer` are the catenary's linear pantographs
-(`linear_pantographs.py`: an n-stage lumped one and a state-space model of a receptance), their parameters in the
-`[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step, but they run on the Python
-coupling (`trial / commit`), not in the compiled loop, except the 2-stage lumped one, which is a `TwoMassPantograph`
-with its own numbers. The catenary imports no pantograph model.
+(`components/linear_pantograph.py`: an n-stage lumped one and a state-space model of a receptance), their parameters
+in the `[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step, but they run on the
+Python coupling (`trial / commit`), not in the compiled loop, except the 2-stage lumped one, which is a
+`TwoMassPantograph` with its own numbers. The catenary imports no pantograph model.
 """
 
 from __future__ import annotations
@@ -38,16 +38,16 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from ...components import linear_pantograph as linear
 from ...errors import SceneError
 from ...limits import Limit, limit_of
 from ...registry import ModelSpec, get_model
-from . import linear_pantographs as linear
 
 #: the catenary's own pantograph, the EN 50318 2-mass reference (parameters m1 ... F0 among the catenary's)
 TWO_MASS = "reference2mass"
 #: the `pantograph` effect's values that name a registry model (value -> model name)
 PANTOGRAPH_MODELS = {"eppinger": "pantograph"}
-#: the catenary's linear pantographs, their parameters in the `[pantograph]` section (`linear_pantographs.py`)
+#: the catenary's linear pantographs, their parameters in the `[pantograph]` section (`components/linear_pantograph.py`)
 LINEAR = (linear.LUMPED, linear.TRANSFER)
 #: every value of the `pantograph` effect
 PANTOGRAPHS = (TWO_MASS, *PANTOGRAPH_MODELS, *LINEAR)

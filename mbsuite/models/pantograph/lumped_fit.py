@@ -36,9 +36,9 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from ...components.linear_pantograph import LumpedParams, TransferParams, chain_receptance
 from ...errors import ParameterError
 from ...limits import Limit
-from ..catenary.linear_pantographs import LumpedParams, TransferParams, chain_receptance
 from .equations import PantographConfig, PantographODE
 from .params import PantographParams
 

@@ -1,4 +1,5 @@
-"""Linear pantographs under the wire: the n-stage lumped pantograph and the transfer-function pantograph.
+"""Linear pantographs: the n-stage lumped pantograph and the transfer-function pantograph, run under the wire by the
+catenary (its `[pantograph]` section) and fitted by the pantograph model (`mbsuite pantograph fit-lumped`).
 
 Both are one linear state-space model of the head (`LinearPantograph`), x' = A x + b0 F0 - B f, head = c x, with f
 the contact force (N, >= 0 pushes the head down) entering where it acts (B: the response to an upward force on the
@@ -31,9 +32,9 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import ParameterError, SceneError, SolverError
-from ...limits import Limit
-from ...schema import Items, Rule, Section
+from ..errors import ParameterError, SceneError, SolverError
+from ..limits import Limit
+from ..schema import Items, Rule, Section
 
 #: the `pantograph` effect's values of the linear pantographs
 LUMPED, TRANSFER = "lumped", "transfer"

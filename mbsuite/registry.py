@@ -152,6 +152,7 @@ class ModelSpec:
       why (an input key only when it differs from its declared default): against the effects when the scene is
       built, against the path (and the path's `lacks`) when a path runs it, so a scene may carry one path's
       settings while another path's run is asked for on the way.
+    - `statistics`: the statistics its runs state (name -> `mbsuite.statistics.Statistic`), declared like `outputs`.
     - `studies`: what the design studies take from the model (`Studies`: default objective, a band constraint, the
       paths that may run in threads).
     - `commands`: the dotted name of the module whose `register(subparsers, add_common, emit)` adds the model's
@@ -194,6 +195,9 @@ class ModelSpec:
     #: loads the new one with a `DeprecationWarning` naming it (`mbsuite list` shows only the new name)
     moved_scenes: Mapping[str, str] = field(default_factory=dict)
     studies: Studies = field(default_factory=Studies)
+    #: the statistics a run of the model states (`mbsuite.statistics.Statistic`: unit, definition, window), name ->
+    #: declaration; `SimResult.statistics` holds their values
+    statistics: Mapping[str, Any] = field(default_factory=dict)
     commands: str | None = None
 
     def __post_init__(self) -> None:

@@ -22,7 +22,10 @@ import numpy as np
 @dataclass
 class SimResult:
     """A time simulation. `signals[name]` is sampled at `t`; `units[name]` is its SI unit.
-    `events` lists discrete events (e.g. contact losses: {"kind", "t_start", "duration"}); `stats` solver counters."""
+    `events` lists discrete events (e.g. contact losses: {"kind", "t_start", "duration"}); `statistics` the values of
+    the model's declared statistics (`mbsuite.statistics`: name -> number or verdict, the unit, definition and window
+    in `SPEC.statistics`); `stats` the solver's counters, timings and settings (steps, function evaluations, wall
+    time: not physics)."""
 
     t: np.ndarray
     signals: dict[str, np.ndarray]
@@ -34,6 +37,8 @@ class SimResult:
     health: list[Any] = field(default_factory=list)  # mbsuite.trust.health.Figure: the run's own accuracy figures
     warnings: list[str] = field(default_factory=list)  # accepted health violations (allow_inaccurate), loud
     error_estimate: Any = None  # trust.estimate.ErrorEstimate of the headline outputs (run(..., error_estimate=True))
+    statistics: dict[str, Any] = field(default_factory=dict)
+    statistic_units: dict[str, str] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]
@@ -49,6 +54,8 @@ class SimResult:
             out["input"] = dict(self.scene.get("input") or {})
             out["solver"] = dict(self.scene.get("solver") or {})
         out["events"] = self.events
+        out["statistics"] = {k: {"value": v, "unit": self.statistic_units.get(k, "")}
+                             for k, v in self.statistics.items()}
         out["stats"] = self.stats
         out["health"] = [f.to_dict() for f in self.health]
         if self.error_estimate is not None:
@@ -143,6 +150,10 @@ class SimResult:
             for e in self.events:
                 kinds[e.get("kind", "event")] = kinds.get(e.get("kind", "event"), 0) + 1
             table += "\nevents: " + ", ".join(f"{k} x{n}" for k, n in sorted(kinds.items()))
+        if self.statistics:
+            table += "\n" + textwrap.fill("statistics: " + ", ".join(
+                f"{k} = {_plain(v)}" + (f" {self.statistic_units[k]}" if self.statistic_units.get(k, "-") != "-"
+                                        else "") for k, v in self.statistics.items()), 100, subsequent_indent="  ")
         stats = ", ".join(f"{k} = {_plain(v)}" for k, v in self.stats.items())
         table += "\n" + textwrap.fill(f"engine {self.engine}; {stats}", 100, subsequent_indent="  ")
         if self.health:
@@ -164,19 +175,26 @@ class SimResult:
 
 def assemble(scene: Any, t: np.ndarray, signals: Mapping[str, np.ndarray], *, engine: str,
              events: Sequence[dict[str, Any]] = (), stats: Mapping[str, Any] | None = None,
-             always: Sequence[str] = (), health: Sequence[Any] = ()) -> SimResult:
+             statistics: Mapping[str, Any] | None = None, always: Sequence[str] = (),
+             health: Sequence[Any] = ()) -> SimResult:
     """The one place that turns a model's signals into a `SimResult`: keeps the signals the scene asks for (its
     `outputs`; all when it names none) plus `always`, takes their units from the model's declared output table
-    (`scene.spec.outputs`, SI) and attaches the scene. A signal missing from the table is an error, not a unitless
-    column."""
+    (`scene.spec.outputs`, SI), checks the `statistics` against the model's declared ones (`scene.spec.statistics`,
+    `mbsuite.statistics.checked`) and attaches the scene. A signal or statistic missing from its table is an error,
+    not a unitless number. `stats`: counters, timings and settings of the solver."""
+    from .statistics import checked, unit_of
+
     table = scene.spec.outputs
     wanted = set(scene.outputs) | set(always) if scene.outputs else set(signals)
     keep = {k: np.asarray(v) for k, v in signals.items() if k in wanted}
     missing = sorted(k for k in keep if k not in table)
     if missing:
         raise KeyError(f"model '{scene.model}' declares no unit for signal(s) {missing}; add them to its outputs")
+    stat_table = scene.spec.statistics
+    values = checked(statistics or {}, stat_table, scene.model)
     return SimResult(np.asarray(t), keep, {k: table[k] for k in keep}, engine, events=list(events),
-                     stats=dict(stats or {}), scene=scene.to_dict(), health=list(health))
+                     stats=dict(stats or {}), scene=scene.to_dict(), health=list(health), statistics=values,
+                     statistic_units={k: unit_of(stat_table, k) for k in values})
 
 
 def _plain(v: Any) -> str:

@@ -36,7 +36,7 @@ def main() -> None:
 
     def pm(sc, res, key: str) -> str:  # value +- the declared tolerance of the path's headline (if it is one)
         tol = {h.name: h.tol for h in declared(sc.replace(solver={"engine": res.engine}))}.get(key)
-        return f"{res.stats[key]:.6g}" + ("" if tol is None else f" ± {tol:.2g}")
+        return f"{res.statistics[key]:.6g}" + ("" if tol is None else f" ± {tol:.2g}")
 
     rows = [[name, *(pm(scenes[name], r, k) for k in KEYS), pm(scenes[name], rr, "torque_in_ripple_pp"),
              len(r.stats["warnings"])] for name, (r, rr) in zip(names, runs, strict=True)]
@@ -48,7 +48,7 @@ def main() -> None:
     base = load_scene("coupler/double_lateral").replace(effects={"gravity": False}, solver={"allow_inaccurate": True})
     taus = (1e-3, 2e-3, 4e-3, 8e-3)
     runs = map_threads(lambda tau: mbsuite.run(base.replace(params={"solref_timeconst": tau})), taus)
-    rows = [[tau, r.stats["closure_residual_max"], r.stats["phi_c_err_max"], r.stats["torque_in_ripple_pp"]]
+    rows = [[tau, *(r.statistics[k] for k in ("closure_residual_max", "phi_c_err_max", "torque_in_ripple_pp"))]
             for tau, r in zip(taus, runs, strict=True)]
     print("\nsolref time constant (timestep 5e-4 s, dampratio 1): residual scales ~ tau^2")
     print(format_table(["timeconst", "closure_res_max", "phi_c_err_max", "ripple_pp"], rows, ".4g"))
@@ -58,9 +58,9 @@ def main() -> None:
         "massless_factor": fac, "solref_timeconst": 1e-3})), facs)
     rows = []
     for fac, r in zip(facs, runs, strict=True):
-        f = np.array(r.stats["link_force_mean"])
-        rows.append([fac, r.stats["torque_in_ripple_pp"], float(np.mean(np.abs(f))), float(np.ptp(np.abs(f))),
-                     r.stats["closure_residual_max"]])
+        f = np.array(r.statistics["link_force_mean"])
+        rows.append([fac, r.statistics["torque_in_ripple_pp"], float(np.mean(np.abs(f))), float(np.ptp(np.abs(f))),
+                     r.statistics["closure_residual_max"]])
     print("\nmassless-link limit (link mass x factor, no gravity): |mean link force| spread -> 0")
     print(format_table(["factor", "ripple_pp", "mean|F|", "spread|F|", "closure_res"], rows, ".4g"))
 

@@ -4,7 +4,8 @@
 `check_scene(scene)` runs the unperturbed scene and the copies and holds them to two rules:
 (a) **invariants**: every health figure of every copy (energy balance, closure residual, stability margins, ...)
     stays within its bound - `mbsuite.run` raises `AccuracyError` otherwise;
-(b) **sensitivity**: each headline output y (the numbers of `SimResult.stats` and each signal's final, min and max)
+(b) **sensitivity**: each headline output y (the numbers of `SimResult.statistics` and `.stats`, and each signal's
+    final, min and max)
     moves by at most `KAPPA_MAX` x eps x scale (scale: `headline`): the measured
     condition estimate kappa = |dy| / (eps scale) is reported per output. An output whose kappa exceeds the bound must
     be declared by the model (`PERTURBATION_JUMPS` in its suite module: output pattern -> why), as a true
@@ -113,7 +114,8 @@ WORK_COUNTERS = ("stats.nfev", "stats.njev", "stats.nlu", "stats.steps", "stats.
 
 
 def headline(res: Any) -> dict[str, tuple[float, float]]:
-    """The headline outputs of a `SimResult`: name -> (value, scale). Every finite number of `stats` (nested keys
+    """The headline outputs of a `SimResult`: name -> (value, scale). Every finite number of its declared
+    `statistics` and of its `stats` (nested keys
     joined by '.', lists by their length; solver work counters left out), scaled by the largest magnitude in its
     top-level group (an energy residual by the energies of its balance), and per signal its final, min and max,
     scaled by the largest magnitude among the signals of its unit."""
@@ -131,8 +133,9 @@ def headline(res: Any) -> dict[str, tuple[float, float]]:
         elif isinstance(v, list | tuple):
             out[f"{prefix}.count"] = (float(len(v)), float(len(v)))
 
+    walk("statistics", {k: v for k, v in res.statistics.items() if not isinstance(v, bool)})
     walk("stats", res.stats)
-    groups: dict[str, float] = {}  # "stats.<key>" -> the largest magnitude under it
+    groups: dict[str, float] = {}  # "statistics.<key>" / "stats.<key>" -> the largest magnitude under it
     for k, (x, _) in out.items():
         g = ".".join(k.split(".")[:2])
         groups[g] = max(groups.get(g, 0.0), abs(x))

@@ -116,7 +116,7 @@ def test_run_hook_returns_simresult_with_statistics(tmp_path, capsys):
     p, dt = CatenaryParams(n_spans=2, element_length=0.5, x_end=110.0, window_start=50.0, window_end=100.0), 2e-4
     run = simulate(p, 200.0, dt)
     r = run.result
-    assert np.array_equal(res.signals["contact_force"], r.force) and res.stats["Fm"] == run.stats["Fm"]
+    assert np.array_equal(res.signals["contact_force"], r.force) and res.statistics["Fm"] == run.stats["Fm"]
     i0, i1 = np.flatnonzero((r.x >= p.window_start) & (r.x <= p.window_end))[[0, -1]]
     T = r.t[i1] - r.t[i0]
     x1, x2 = r.panto["head_displacement"], r.panto["frame_displacement"]
@@ -129,10 +129,10 @@ def test_run_hook_returns_simresult_with_statistics(tmp_path, capsys):
 
     balance = p.F0 - p.k2 * mean(x2) - p.c2 * (x2[i1] - x2[i0]) / T - (p.m1 * dv(x1) + p.m2 * dv(x2)) / T
     assert mean(r.force) == pytest.approx(balance, abs=3e-4)
-    assert res.stats["Fm"] == pytest.approx(mean(r.force), abs=0.25)
+    assert res.statistics["Fm"] == pytest.approx(mean(r.force), abs=0.25)
     path = tmp_path / "short.toml"
     path.write_text('model = "catenary"\n[params]\nn_spans = 2\nelement_length = 0.5\nx_end = 110.0\n'
                     'window_start = 50.0\nwindow_end = 100.0\n[input]\nspeed = 200.0\n[solver]\ntimestep = 2e-4\n')
     assert main(["run", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["stats"]["Fm"] == pytest.approx(res.stats["Fm"], rel=1e-12)
+    assert data["statistics"]["Fm"]["value"] == pytest.approx(res.statistics["Fm"], rel=1e-12)

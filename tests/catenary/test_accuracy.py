@@ -147,7 +147,7 @@ def test_cli_error_estimate_judges_every_statistic(tmp_path, capsys):
     assert all(rows[s]["value"] == stats[s] for s in STATS)
     fine = mbsuite.run(mbsuite.load_scene(scene).replace(params={"element_length": 0.25},
                                                           solver={"timestep": 1e-4}))
-    assert all(rows[s]["refined"][1] == fine.stats[s] for s in STATS)
+    assert all(rows[s]["refined"][1] == fine.statistics[s] for s in STATS)
     assert not rows["sigma"]["ok"]
     over = sorted(r["name"] for r in rows.values() if not r["ok"])
     assert sorted(w.split("error_estimate[")[1].split("]")[0] for w in data["warnings"]

@@ -144,7 +144,7 @@ def test_two_pantograph_scene_runs_through_mbsuite_run():
         params={"n_spans": 5, "x_end": 150.0, "window_start": 60.0, "window_end": 120.0},
         train={"pantographs": ["reference2mass", "reference2mass"], "spacings": [100.0]})
     r = mbsuite.run(sc)
-    assert {"p1_Fm", "p2_Fm", "p1_quality_pass", "p2_sigma"} <= set(r.stats)
+    assert {"p1_Fm", "p2_Fm", "p1_quality_pass", "p2_sigma"} <= set(r.statistics)
     assert r.signals["contact_force_p2"].size == r.signals["contact_force_p1"].size == r.t.size
 
 

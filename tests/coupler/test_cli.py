@@ -120,7 +120,7 @@ def test_dynamics_command_json_and_csv(tmp_path, capsys):
                      '[solver]\nduration = 0.45\nt_settle = 0.3\n')
     assert main(["coupler", "dynamics", str(scene), "--json", "--out", str(tmp_path / "o")]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["stats"]["warnings"] == {} and d["stats"]["closure_residual_max"] < 2e-4
+    assert d["stats"]["warnings"] == {} and d["statistics"]["closure_residual_max"] < 2e-4
     header = (tmp_path / "o" / "run.csv").read_text().splitlines()[0]
     assert "torque_in [N m]" in header and "link_force_8 [N]" in header
     assert (tmp_path / "o" / "run.png").stat().st_size > 10_000

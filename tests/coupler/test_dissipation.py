@@ -18,7 +18,7 @@ def _excess(sc) -> tuple[float, float, CouplerParams]:
     """(mean T_in - T_load over the settled window, w_a, the scene's parameters) of a MuJoCo run."""
     res = mbsuite.run(sc)
     inp = scene_inputs(sc)
-    return res.stats["torque_in_mean"] - inp["load_torque"], inp["omega"], sc.build_params()
+    return res.statistics["torque_in_mean"] - inp["load_torque"], inp["omega"], sc.build_params()
 
 
 def test_joint_damping_dissipates_c_omega_squared(swing):

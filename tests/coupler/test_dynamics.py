@@ -31,7 +31,7 @@ def test_shipped_scenes_power_balance(name, request):
     bound 0.3 % (10x). Without the output bearing's friction the excess drops by F."""
     sc = load_scene(f"coupler/{name}").replace(solver={"duration": 1.0})
     res = mbsuite.run(sc)
-    load, excess = sc.input["load_torque"], res.stats["torque_in_mean"] - sc.input["load_torque"]
+    load, excess = sc.input["load_torque"], res.statistics["torque_in_mean"] - sc.input["load_torque"]
     if sc.effects["friction"]:
         p = sc.build_params()
         # `swing` is the default design's revolution at z_c = 0.05, input shaft turning about its own axis
@@ -51,7 +51,7 @@ def test_lateral_offset_agreement_and_torque_balance():
     coupler has a small ripple (0.70 %: the links' own inertia)."""
     sc = load_scene("coupler/double_lateral")
     r = mbsuite.run(sc)
-    s = r.stats
+    s = r.statistics
     assert s["revolutions"] > 2.9
     assert s["phi_c_kin_fluctuation_pp"] < 1e-12  # kinematically homokinetic
     assert s["phi_c_err_max"] < 1e-4
@@ -68,7 +68,7 @@ def test_massless_limit_forces_match_quasi_static():
     p = sc.build_params()
     inp = np.array([0.0, 0.0, 0.0, 0.0, sc.input["z_c"]])
     f, _ = double_quasi_static(p, inp, ramp_double(p, inp), sc.input["load_torque"])
-    np.testing.assert_allclose(r.stats["link_force_mean"], f, rtol=0.02)
+    np.testing.assert_allclose(r.statistics["link_force_mean"], f, rtol=0.02)
 
 
 @pytest.mark.parametrize("name, extra", [("double_phibc90", {}), ("double_lateral", {"gravity": False}),
@@ -88,7 +88,7 @@ def test_torque_ripple_matches_rigid_reference(name, extra):
     assert np.max(np.abs(rm["torque_in"][w] - t_ref)) < 0.05 * ripple + 0.2
     assert np.mean(rm["torque_in"][w]) == pytest.approx(np.mean(t_ref), abs=0.03)  # measured <= 7.7e-3 N m
     if name == "double_phibc90":  # inertial ripple of the output shaft dominates the quasi-static one
-        assert ripple > 5 * rr.stats["torque_in_ripple_quasi_static_pp"]
+        assert ripple > 5 * rr.statistics["torque_in_ripple_quasi_static_pp"]
 
 
 def test_effects_switch_model_content():

@@ -57,5 +57,5 @@ def test_closure_residual_scales_with_solref_squared():
     base = load_scene("coupler/double_lateral").replace(effects={"gravity": False}, solver={"duration": 1.5})
     r1 = mbsuite.run(base.replace(params={"solref_timeconst": 1e-3}))
     r2 = mbsuite.run(base.replace(params={"solref_timeconst": 2e-3}))
-    ratio = r2.stats["closure_residual_max"] / r1.stats["closure_residual_max"]
+    ratio = r2.statistics["closure_residual_max"] / r1.statistics["closure_residual_max"]
     assert ratio == pytest.approx(4.0, rel=0.2)

@@ -71,7 +71,7 @@ def test_declared_tolerances_hold_against_a_much_refined_run(name, engine):
     fine_sc = _much_refined(sc)
     fine_res = mbsuite.run(fine_sc)
     fine = sc.spec.accuracy.values(fine_sc, fine_res)
-    b0, b1 = res.stats["branch_angle_max"], fine_res.stats["branch_angle_max"]
+    b0, b1 = res.statistics["branch_angle_max"], fine_res.statistics["branch_angle_max"]
     print(f"{name} {engine} branch_angle_max: value {b0:.3g}, refined run {b1:.3g}, change {abs(b0 - b1):.2g}")
     for row in res.error_estimate.rows:
         true = abs(row.value - fine[row.name])

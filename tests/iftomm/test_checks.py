@@ -24,7 +24,7 @@ def test_health_figures_short_runs():
     names = [f.name for f in r.health]
     assert names == ["closure_residual", "energy_drift"] and all(f.ok for f in r.health)
     # energy scale: E_kin(0) = (5/3) 6^2 / 2 = 30 J plus m g L for the three bars (29.43 J)
-    assert r.stats["energy_scale"] == pytest.approx(30.0 + 3 * 9.81, rel=1e-12)
+    assert r.statistics["energy_scale"] == pytest.approx(30.0 + 3 * 9.81, rel=1e-12)
 
 
 @pytest.mark.parametrize("mechanism", ["fourbar", "bricard"])

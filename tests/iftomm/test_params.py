@@ -42,7 +42,7 @@ def test_gravity_and_rate_against_the_closed_form_on_both_paths(params, rate, g,
     assert np.max(np.abs(mj["input_angle"] - _closed_form(g, rate, mj.t))) < bound_mj
     assert np.max(np.abs(pin["input_angle"] - _closed_form(g, rate, pin.t))) < bound_pin
     for r in (mj, pin):
-        assert r.stats["energy_scale"] == pytest.approx(0.5 * (5.0 / 3.0) * rate**2 + 3 * g, rel=1e-12)
+        assert r.statistics["energy_scale"] == pytest.approx(0.5 * (5.0 / 3.0) * rate**2 + 3 * g, rel=1e-12)
         assert r["input_rate"][0] == pytest.approx(rate, rel=1e-12)
 
 
@@ -75,7 +75,7 @@ def test_mujoco_closure_time_constant_against_the_closed_form():
     sc4 = mbsuite.load_scene("iftomm/fourbar").replace(solver={"duration": 1.0})
     mj4 = mbsuite.run(sc4)
     assert np.max(np.abs(mj2["input_angle"] - _closed_form(9.81, 6.0, mj2.t))) < 8e-4
-    ratio = mj4.stats["closure_residual_max"] / mj2.stats["closure_residual_max"]
+    ratio = mj4.statistics["closure_residual_max"] / mj2.statistics["closure_residual_max"]
     assert 3.0 < ratio < 5.0
 
 
@@ -90,7 +90,7 @@ def test_penalty_factor_and_frequency_against_the_closure_error_scaling(bricard_
     """The penalty formulation holds r'' + 2 w r' + w^2 r = O(1/p): the Bricard's closure gap scales as 1/(p w^2).
     p 100x smaller: 100x the gap (measured 85.7 over 0.3 s); w 3x larger: 1/9 of it (measured 8.37). Bounds [70, 130]
     and [7, 11]. The motion itself is the MuJoCo path's (joint 1 within 1e-5 rad: measured 2.0e-6 over 0.3 s, 5x)."""
-    r = {k: v.stats["closure_residual_max"] for k, v in bricard_penalties.items() if k != "mujoco"}
+    r = {k: v.statistics["closure_residual_max"] for k, v in bricard_penalties.items() if k != "mujoco"}
     assert 70.0 < r[(1e5, 10.0)] / r[(1e7, 10.0)] < 130.0
     assert 7.0 < r[(1e7, 10.0)] / r[(1e7, 30.0)] < 11.0
     mj = bricard_penalties["mujoco"]

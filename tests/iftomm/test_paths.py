@@ -28,5 +28,5 @@ def test_bricard_symmetric_motion_on_both_paths(bricard):
     """The orthogonal Bricard released from the cube pose moves symmetrically, q1 + q3 = 0 (the branch figure)."""
     mj, pin = bricard
     # measured 4.30e-4 rad (MuJoCo), 3.02e-7 rad (Pinocchio: the penalty closure error, 3e-7 m); 3.5x / 6.6x
-    assert mj.stats["branch_angle_max"] < 1.5e-3
-    assert pin.stats["branch_angle_max"] < 2e-6
+    assert mj.statistics["branch_angle_max"] < 1.5e-3
+    assert pin.statistics["branch_angle_max"] < 2e-6

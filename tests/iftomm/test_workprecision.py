@@ -44,7 +44,7 @@ class _Run:
     """A stand-in run: times, a crank angle and the statistics the study reads."""
 
     def __init__(self, t, angle, stats):
-        self.t, self._angle, self.stats = t, angle, stats
+        self.t, self._angle, self.statistics = t, angle, stats
 
     def __getitem__(self, name):
         assert name == "input_angle"

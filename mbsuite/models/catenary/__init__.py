@@ -19,6 +19,7 @@ from .pantographs import PANTOGRAPHS, SECTION_PANTOGRAPHS, TWO_MASS, validate_se
 from .params import CatenaryParams
 from .quality import SYSTEMS
 from .quality import validate_section as validate_quality
+from .stats import STATISTICS
 
 #: the 2-mass reference pantograph's parameters are read only when it runs; a registry pantograph takes its own from the
 #: [pantograph] section (measured: m1 and F0 10 % up leave every signal of a 3-span Eppinger passage identical,
@@ -75,4 +76,5 @@ SPEC = ModelSpec(
                               "(EN 50367 / TSI Energy), per supply system"),
                     threads=("mujoco",)),
     commands="mbsuite.models.catenary.cli",
+    statistics=STATISTICS,
 )

@@ -2,7 +2,7 @@
 
 Headlines: the eight EN 50318 statistics of every pantograph (`stats.STAT_NAMES`: Fm, sigma, Fm + 3 sigma,
 Fm - 3 sigma, the actual max and min of the 20 Hz filtered force in N, the largest steady-arm uplift in mm, the
-percentage of contact loss). A single pantograph's are named as its SimResult's stats (`Fm`, ..., `uplift_mm`,
+percentage of contact loss). A single pantograph's are named as its SimResult's statistics (`Fm`, ..., `uplift_mm`,
 `loss_pct`); those of a train's pantograph k = 1, 2, ... (leading first) as the train's (`p1_Fm`, `p2_max`, ...).
 
 Tolerances (absolute, at the scene's default settings): 1 N on every force statistic and 0.5 mm on the uplift (the
@@ -77,8 +77,8 @@ def headlines(scene: Scene) -> tuple[Headline, ...]:
 
 
 def values(scene: Scene, res: Any) -> dict[str, float]:
-    """The headline values of a passage's SimResult (its `stats`)."""
-    return {name: float(res.stats[name]) for name in names(pantograph_count(scene))}
+    """The headline values of a passage's SimResult (its `statistics`)."""
+    return {name: float(res.statistics[name]) for name in names(pantograph_count(scene))}
 
 
 def stats_values(stats: list[dict]) -> dict[str, float]:

@@ -33,20 +33,20 @@ def passage_result(scene, engine: str) -> SimResult:
 def to_simresult(run: CatenaryRun, scene) -> SimResult:
     """The run as a SimResult (`results.assemble`: the scene's output signals with the declared units). The declared
     signal `uplift` stands for one column per support, `uplift_<x>m` (x = the support's position), in its unit.
-    `stats`: timings, the eight EN 50318 statistics, the static contact force, the pantograph engine's warnings and
-    the quality verdicts (`quality_pass`, `quality_<criterion>_pass`, `quality_nq_pct`; limits from the scene's
-    `[quality]` section, else the AC defaults);
+    `statistics` (declared in `stats.STATISTICS`): the eight EN 50318 statistics, the static contact force and the
+    quality verdicts (`quality_pass`, `quality_<criterion>_pass`, `quality_nq_pct`; limits from the scene's
+    `[quality]` section, else the AC defaults); `stats`: timings and the pantograph engine's warnings;
     `events`: the contact losses in the window."""
     r = run.result
     signals = {"contact_force": r.force, "contact_force_filtered": run.filtered, "position": r.x,
                "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
     q = quality_of(run, criteria_from(scene.sections.get("quality")))
-    stats = {**{k: v for k, v in run.timing.items() if k != "method"}, **_scalar_stats(run),
-             "static_contact_force": run.static_force, "warnings": dict(run.engine_warnings),
-             "quality_pass": q["pass"], **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
-             "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
+    stats = {**{k: v for k, v in run.timing.items() if k != "method"}, "warnings": dict(run.engine_warnings)}
+    statistics = {**_scalar_stats(run), "static_contact_force": run.static_force, "quality_pass": q["pass"],
+                  **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
+                  "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
     res = assemble_result(scene, r.t, signals, engine=run.engine, events=run.stats["loss_events"], stats=stats,
-                          health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
+                          statistics=statistics, health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
     if "uplift" in scene.outputs:
         unit = scene.spec.outputs["uplift"]
         for j, xs in enumerate(r.support_x):
@@ -230,20 +230,20 @@ def train_to_simresult(run: TrainRun, scene) -> SimResult:
     """A train passage as a SimResult: the leading pantograph's channels under the usual names (on its own record),
     `contact_force_p<k>` / `position_p<k>` for every pantograph k = 1, 2, ... (each on its own record; all records
     have the same length, one passage from x_start to x_end, on the time since the pantograph's entry), and per
-    pantograph the eight statistics and quality verdicts in `stats` (`p<k>_Fm`, ..., `p<k>_quality_pass`)."""
+    pantograph the eight statistics and quality verdicts in `statistics` (`p<k>_Fm`, ..., `p<k>_quality_pass`)."""
     lead = run.results[0]
     signals = {"contact_force": lead.force, "contact_force_filtered": run.filtered[0], "position": lead.x,
                "head_height": lead.head, "wire_height": lead.wire, "slack_droppers": lead.n_slack.astype(float)}
     qs = train_assessments(run, criteria_from(scene.sections.get("quality")))
-    stats: dict[str, Any] = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"],
-                             "total_s": run.timing["total_s"]}
+    stats = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"], "total_s": run.timing["total_s"]}
+    statistics: dict[str, Any] = {}
     for k, s in enumerate(run.stats):
-        stats.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})
-        stats[f"p{k + 1}_static_contact_force"] = run.static_forces[k]
-        stats[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
+        statistics.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})
+        statistics[f"p{k + 1}_static_contact_force"] = run.static_forces[k]
+        statistics[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
     events = [{**e, "pantograph": k + 1} for k, s in enumerate(run.stats) for e in s["loss_events"]]
     res = assemble_result(scene, lead.t, signals, engine=run.engines[-1], events=events, stats=stats,
-                   health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
+                          statistics=statistics, health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
     for k, r in enumerate(run.results):
         res.signals[f"contact_force_p{k + 1}"] = r.force
         res.units[f"contact_force_p{k + 1}"] = "N"

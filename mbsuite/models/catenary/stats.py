@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import SolverError
+from ...statistics import Statistic
 from .params import CatenaryParams
 
 #: EN 50318:2002 accepted ranges (catenary.md), speed (km/h) -> statistic -> (low, high); units N, mm, %
@@ -27,6 +28,31 @@ STAT_NAMES = {"Fm": "mean contact force Fm (N)", "sigma": "standard deviation si
               "stat_max": "statistical max Fm+3sigma (N)", "stat_min": "statistical min Fm-3sigma (N)",
               "max": "actual max (N)", "min": "actual min (N)", "uplift_mm": "max uplift at support (mm)",
               "loss_pct": "percentage of contact loss (%)"}
+#: the window of the statistics (EN 50318:2002, 6.2: the middle spans of the reference line)
+WINDOW = "the statistics window [params.window_start, params.window_end] (EN 50318: the middle two spans)"
+_FILTERED = "the contact force low-pass filtered at 20 Hz (4th-order Butterworth, zero phase; EN 50318 6.2)"
+_PER = "p{k}_{name}"  # a train's pantograph k = 1, 2, ... (leading first)
+#: the statistics of a passage (`SPEC.statistics`; `SimResult.statistics`), per pantograph in a train
+STATISTICS: dict[str, Statistic] = {
+    "Fm": Statistic("N", f"mean of {_FILTERED}", WINDOW, per=_PER),
+    "sigma": Statistic("N", f"population standard deviation of {_FILTERED}", WINDOW, per=_PER),
+    "stat_max": Statistic("N", "statistical maximum Fm + 3 sigma", WINDOW, per=_PER),
+    "stat_min": Statistic("N", "statistical minimum Fm - 3 sigma", WINDOW, per=_PER),
+    "max": Statistic("N", f"largest sample of {_FILTERED}", WINDOW, per=_PER),
+    "min": Statistic("N", f"smallest sample of {_FILTERED}", WINDOW, per=_PER),
+    "uplift_mm": Statistic("mm", "largest contact-wire rise above its static position at the steady arms inside the "
+                                 "window", "the whole run, at the supports inside the window", per=_PER),
+    "loss_pct": Statistic("%", "share of the samples with zero (unfiltered) contact force", WINDOW, per=_PER),
+    "static_contact_force": Statistic("N", "contact force of the static equilibrium of pantograph and line before "
+                                           "the passage", "the start of the run", per=_PER),
+    "quality_pass": Statistic("-", "every EN 50367 / TSI Energy criterion of the scene's [quality] section met",
+                              WINDOW, kind="verdict", per=_PER),
+    **{f"quality_{c}_pass": Statistic("-", f"the EN 50367 criterion {c} met ([quality] limits)", WINDOW,
+                                      kind="verdict")
+       for c in ("mean_force", "sigma", "stat_min", "contact_loss", "arcing_nq", "uplift")},
+    "quality_nq_pct": Statistic("%", "arcing measure NQ: summed durations of the losses of at least "
+                                     "[quality] arc_min_duration over the window's time (EN 50367)", WINDOW),
+}
 LOSS_CLASSES = (("short_lt_5ms", 0.0, 0.005), ("damaging_5_20ms", 0.005, 0.020), ("power_loss_gt_20ms", 0.020, np.inf))
 
 

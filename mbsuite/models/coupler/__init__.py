@@ -15,7 +15,7 @@ from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .params import CouplerParams
-from .scenario import INPUTS, OUTPUTS
+from .scenario import INPUTS, OUTPUTS, STATISTICS
 
 
 def _check_file(path: Path, engine: str, model: object) -> None:
@@ -65,4 +65,5 @@ SPEC = ModelSpec(
     uses=USES,
     studies=Studies(threads=("mujoco",)),
     commands="mbsuite.models.coupler.cli",
+    statistics=STATISTICS,
 )

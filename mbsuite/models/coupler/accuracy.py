@@ -1,7 +1,7 @@
 """The coupler's headline outputs, the tolerances its shipped settings meet, and how a run is refined.
 
-Headlines of a double-coupler run (statistics over the settled window t >= max(t_settle, t_ramp), `mujoco.stats`,
-`reference.run_reference`):
+Headlines of a double-coupler run (statistics over the settled window t >= max(t_settle, t_ramp),
+`SimResult.statistics`, declared in `scenario.STATISTICS`):
 - MuJoCo path: the largest |phi_c - phi_c,kin| (the soft closures' torsional wind-up against the rigid FPP), the mean
   input torque, the largest closure residual, the input torque's peak-to-peak ripple and the largest |link force|;
 - kinematic reference: the mean input torque, its ripple, the largest closure residual of the solved FPP and the
@@ -73,7 +73,7 @@ def headlines(scene: Any) -> tuple[Headline, ...]:
 
 def values(scene: Any, res: Any) -> dict[str, float]:
     """The headline values of a run's result (its statistics)."""
-    return {n: float(res.stats[n]) for n in names(scene)}
+    return {n: float(res.statistics[n]) for n in names(scene)}
 
 
 def refine_mujoco(scene: Any, level: int) -> Any:

@@ -122,13 +122,13 @@ def _coupler_phibc90(ck: Checker) -> None:
     ck.finite("MuJoCo outputs", *res.signals.values())
     ck.true("MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
     # measured 2.77e-5 m (1 s and 2 s); the start-up ramp peak is excluded by t_settle
-    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1e-4)
+    ck.le("closure residual after the ramp (m)", res.statistics["closure_residual_max"], 1e-4)
     # measured 3.57e-5 rad: the closures' torsional wind-up under 1 kN m (README); bound 2.8x
-    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1e-4)
+    ck.le("phi_c - phi_c,kin (rad)", res.statistics["phi_c_err_max"], 1e-4)
     # the simulated output fluctuation is the paper's criterion: p-p of phi_a - phi_c over the settled revolution vs
     # 2 c5 from the continuation FPP with c5 located between samples (a different solver path); measured 3.9e-4 rel.
     c5 = double_c5(CouplerParams(phi_bc=math.pi / 2), 0.08, n=19)
-    w = res.t >= res.stats["window_start"]
+    w = res.t >= res.statistics["window_start"]
     ck.le("MuJoCo p-p(phi_a - phi_c) vs the FPP's 2 c5 (relative)",
           abs(np.ptp(res["phi_a"][w] - res["phi_c"][w]) / c5["c5_pp"] - 1), 2e-3)
 
@@ -148,8 +148,8 @@ def _coupler_big_step(ck: Checker) -> None:
     res = run(sc.replace(solver={"timestep": 1e-3}))
     ck.finite("h = 1 ms (= solref_timeconst / 2) outputs", *res.signals.values())
     ck.true("h = 1 ms: no MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
-    ck.le("h = 1 ms: closure residual after the ramp (m)", res.stats["closure_residual_max"], 5e-5)
-    ck.le("h = 1 ms: phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 5e-5)
+    ck.le("h = 1 ms: closure residual after the ramp (m)", res.statistics["closure_residual_max"], 5e-5)
+    ck.le("h = 1 ms: phi_c - phi_c,kin (rad)", res.statistics["phi_c_err_max"], 5e-5)
 
 
 def _coupler_rk4_limit(ck: Checker) -> None:
@@ -167,12 +167,12 @@ def _coupler_rk4_limit(ck: Checker) -> None:
     res = run(sc.replace(solver={"timestep": 5e-4}, params={"solref_timeconst": 1e-3}))
     ck.finite("RK4 at h = 0.5 ms = solref_timeconst / 2: outputs", *res.signals.values())
     ck.true("RK4 at h = 0.5 ms: no MuJoCo warnings", res.stats["warnings"] == {}, res.stats["warnings"])
-    ck.le("closure residual after the ramp (m)", res.stats["closure_residual_max"], 1.5e-5)
-    ck.le("phi_c - phi_c,kin (rad)", res.stats["phi_c_err_max"], 1.5e-5)
+    ck.le("closure residual after the ramp (m)", res.statistics["closure_residual_max"], 1.5e-5)
+    ck.le("phi_c - phi_c,kin (rad)", res.statistics["phi_c_err_max"], 1.5e-5)
     # power balance: the mean input torque equals the 1 kN m load
     # (measured 1.4e-6: the S-joint damping and the closures' damping dissipate; bound 7x)
-    ck.le("|mean input torque / load - 1|", abs(res.stats["torque_in_mean"] / 1000.0 - 1), 1e-5)
-    ck.le("input-torque ripple p-p (N m)", res.stats["torque_in_ripple_pp"], 8.0)
+    ck.le("|mean input torque / load - 1|", abs(res.statistics["torque_in_mean"] / 1000.0 - 1), 1e-5)
+    ck.le("input-torque ripple p-p (N m)", res.statistics["torque_in_ripple_pp"], 8.0)
 
 
 def _coupler_drift_100s(ck: Checker) -> None:
@@ -350,7 +350,7 @@ class CouplerStudy(Study):
             det = {"phi_c_err_rad": float(np.max(np.abs(r[:, 0] - uref[:, 0]))),
                    "c5_err_rad": abs(self._c5(r, n) - self._c5(uref, n)), "closure_residual": resid}
             return max(det.values()), det
-        sr, sf = r.stats, ref["mujoco"].stats
+        sr, sf = r.statistics, ref["mujoco"].statistics
         det = {"phi_c_err_rel": _rel(sr["phi_c_err_max"], sf["phi_c_err_max"]),
                "closure_rel": _rel(sr["closure_residual_max"], sf["closure_residual_max"]),
                "ripple_rel": _rel(sr["torque_in_ripple_pp"], sf["torque_in_ripple_pp"])}

@@ -125,12 +125,8 @@ def cmd_criteria(args: argparse.Namespace, emit) -> None:
     emit(rep, args, None)
 
 
-#: units of the statistics of a dynamics run (`mujoco.stats`, `reference.run_reference`)
-STAT_UNITS = {"window_start": "s", "revolutions": "-", "phi_c_err_max": "rad", "phi_c_err_rms": "rad",
-              "phi_c_kin_fluctuation_pp": "rad", "closure_residual_max": "m", "closure_residual_max_all": "m",
-              "torque_in_mean": "N m", "torque_in_ripple_pp": "N m", "torque_in_ripple_rel": "-",
-              "torque_in_ripple_quasi_static_pp": "N m", "speed_ratio_min": "-", "speed_ratio_max": "-",
-              "link_force_max_abs": "N", "steps": "-", "timestep": "s"}
+#: units of the solver counters a dynamics run reports beside its declared statistics (`SimResult.statistics`)
+COUNTER_UNITS = {"steps": "-", "timestep": "s"}
 
 
 def _plain(v: object) -> str:
@@ -139,9 +135,8 @@ def _plain(v: object) -> str:
 
 def dynamics_table(scene_input: dict, res) -> str:
     """The human table of `coupler dynamics`: resolved input, statistics with units, health, link forces."""
-    st = res.stats
-    units = dict(STAT_UNITS)
-    units.update({k: (u or "-") for k, u in res.units.items()})
+    st = {**res.statistics, **res.stats}
+    units = {**COUNTER_UNITS, **{k: (u or "-") for k, u in res.statistic_units.items()}}
     inp_units = {"omega": "rad/s", "load_torque": "N m", "alpha_cx": "rad", "alpha_cz": "rad", "x_c": "m",
                  "z_c": "m", "t_ramp": "s"}
     table = textwrap.fill("input (resolved, defaults included): " + ", ".join(
@@ -198,7 +193,8 @@ def dynamics_of(scene: Scene, args: argparse.Namespace) -> Report:
     table = dynamics_table(inputs, res)
     if res.error_estimate is not None:
         table += "\n" + res.error_estimate.table()
-    return Report({"input": inputs, "scene": scene.to_dict(), "stats": res.stats, "summary": res.summary()}, table,
+    return Report({"input": inputs, "scene": scene.to_dict(), "statistics": res.statistics, "stats": res.stats,
+                   "summary": res.summary()}, table,
                   partial(write_dynamics, res))
 
 

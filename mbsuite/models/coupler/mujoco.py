@@ -312,10 +312,10 @@ def run_mujoco(scene) -> SimResult:
     tr = stepper.run(n, ctrl=ramp_input(inp, n, sv.timestep), ctrl_idx=[0, 1])
     signals = signals_of(p, inp, tr, what)
     st = stats(tr.t, signals, sv.t_settle, inp)
-    st.update(warnings=tr.warnings, solref=[p.solref_timeconst, p.solref_dampratio], steps=tr.steps,
-              integrator=sv.integrator, timestep=sv.timestep)
-    return results.assemble(scene, tr.t, signals, engine="mujoco", stats=st, always=("phi_c_err",),
-                            health=[closure_figure(st["closure_residual_max_all"], p)])
+    counters = dict(warnings=tr.warnings, solref=[p.solref_timeconst, p.solref_dampratio], steps=tr.steps,
+                    integrator=sv.integrator, timestep=sv.timestep)
+    return results.assemble(scene, tr.t, signals, engine="mujoco", stats=counters, statistics=st,
+                            always=("phi_c_err",), health=[closure_figure(st["closure_residual_max_all"], p)])
 
 
 def simulated_pose(p: CouplerParams, tr: core.Trajectory) -> np.ndarray:

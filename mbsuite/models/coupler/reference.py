@@ -175,6 +175,6 @@ def run_reference(scene) -> SimResult:
           "speed_ratio_min": float(np.min(D1[w, 0])), "speed_ratio_max": float(np.max(D1[w, 0])),
           "phi_c_kin_fluctuation_pp": float(np.ptp(phi_a[w] - U[w, 0])), "closure_residual_max": float(gap[w].max()),
           "closure_residual_max_all": float(gap.max())}
-    return results.assemble(scene, t, signals, engine="reference", stats=st, always=("phi_c_err",),
+    return results.assemble(scene, t, signals, engine="reference", statistics=st, always=("phi_c_err",),
                             health=[closure_figure(st["closure_residual_max_all"], p, reference=True)])
 

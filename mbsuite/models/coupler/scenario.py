@@ -10,6 +10,7 @@ import numpy as np
 
 from ...errors import SceneError
 from ...limits import Limit
+from ...statistics import Statistic
 from ...trust.health import Figure
 from .params import CouplerParams
 
@@ -74,6 +75,30 @@ def closure_figure(value: float, p: CouplerParams, reference: bool = False) -> F
 
 
 #: the output signals of a run (both paths) and their SI units
+#: the window the statistics of a run are taken over (the settled, constant-speed part)
+WINDOW = "the settled window t >= max(solver.t_settle, input.t_ramp)"
+#: the statistics of a run (`SPEC.statistics`; `SimResult.statistics`; `mujoco.stats`, `reference.run_reference`)
+STATISTICS = {
+    "window_start": Statistic("s", "the first sample of the window", WINDOW),
+    "revolutions": Statistic("-", "input-shaft revolutions over the window", WINDOW),
+    "phi_c_err_max": Statistic("rad", "largest |phi_c - phi_c,kin| (output angle against the rigid kinematics)",
+                               WINDOW),
+    "phi_c_err_rms": Statistic("rad", "RMS of phi_c - phi_c,kin", WINDOW),
+    "phi_c_kin_fluctuation_pp": Statistic("rad", "peak-to-peak of phi_a - phi_c (the joint's angle fluctuation)",
+                                          WINDOW),
+    "closure_residual_max": Statistic("m", "largest SS-link closure gap", WINDOW),
+    "closure_residual_max_all": Statistic("m", "largest SS-link closure gap", "the whole run, ramp included"),
+    "torque_in_mean": Statistic("N m", "time mean of the input torque", WINDOW),
+    "torque_in_ripple_pp": Statistic("N m", "peak-to-peak of the input torque", WINDOW),
+    "torque_in_ripple_rel": Statistic("-", "peak-to-peak of the input torque over |its mean|", WINDOW),
+    "torque_in_ripple_quasi_static_pp": Statistic("N m", "peak-to-peak of the quasi-static input torque "
+                                                         "load torque x dphi_c/dphi_a", WINDOW),
+    "speed_ratio_min": Statistic("-", "smallest speed ratio dphi_c/dphi_a", WINDOW),
+    "speed_ratio_max": Statistic("-", "largest speed ratio dphi_c/dphi_a", WINDOW),
+    "link_force_max_abs": Statistic("N", "largest |axial force| of the eight SS links", WINDOW),
+    "link_force_mean": Statistic("N", "mean axial force of each SS link 1..8", WINDOW, kind="numbers"),
+}
+
 OUTPUTS = {"phi_a": "rad", "phi_c": "rad", "phi_c_kin": "rad", "phi_c_err": "rad", "omega_c": "rad/s",
            "torque_in": "N m", "torque_out": "N m", "closure_residual": "m",
            **{f"link_force_{k + 1}": "N" for k in range(8)}}

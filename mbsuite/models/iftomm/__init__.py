@@ -11,7 +11,7 @@ from ...registry import Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
-from .outputs import OUTPUTS
+from .outputs import OUTPUTS, STATISTICS
 from .params import IftommParams
 
 #: which path uses which parameters (measured: a 10 % change moves no output of a 1 s run on the other path;
@@ -49,4 +49,5 @@ SPEC = ModelSpec(
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,
     studies=Studies(threads=("mujoco",)),
+    statistics=STATISTICS,
 )

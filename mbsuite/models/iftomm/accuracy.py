@@ -37,8 +37,8 @@ def headlines(scene: Any) -> tuple[Headline, ...]:
 def values(scene: Any, res: Any) -> dict[str, float]:
     """The headline values of a run's result."""
     return {"final_angle": float(res["input_angle"][-1]),
-            "closure_residual_max": float(res.stats["closure_residual_max"]),
-            "energy_drift_max": float(res.stats["energy_drift_max"])}
+            "closure_residual_max": float(res.statistics["closure_residual_max"]),
+            "energy_drift_max": float(res.statistics["energy_drift_max"])}
 
 
 def refinement(scene: Any) -> Refinement:

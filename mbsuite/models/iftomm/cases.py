@@ -37,11 +37,12 @@ def _iftomm_fourbar(ck: Checker) -> None:
     # measured 7.5e-9 rad (DOP853 rtol 1e-10); bound 6.7x
     ck.le("Pinocchio (branch-reduced) vs closed form, crank angle (rad)",
           np.max(np.abs(ref["input_angle"] + math.pi / 2 - an.y[0])), 5e-8)
-    ck.le("MuJoCo stays on the parallelogram branch: max |coupler angle| (rad)", mj.stats["branch_angle_max"], 0.01)
-    ck.le("MuJoCo closure residual (m)", mj.stats["closure_residual_max"], 2e-4)
+    ck.le("MuJoCo stays on the parallelogram branch: max |coupler angle| (rad)", mj.statistics["branch_angle_max"],
+          0.01)
+    ck.le("MuJoCo closure residual (m)", mj.statistics["closure_residual_max"], 2e-4)
     # measured 0.36 J of 30 J kinetic energy: the soft closure (solref 4 ms, damping ratio 1) dissipates
-    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.5)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 3e-7)  # measured 4.8e-8 J; bound 6x
+    ck.le("MuJoCo energy drift over 10 s (J)", mj.statistics["energy_drift_max"], 0.5)
+    ck.le("Pinocchio energy drift (J)", ref.statistics["energy_drift_max"], 3e-7)  # measured 4.8e-8 J; bound 6x
     # against the closed form (= Pinocchio to 7.5e-9 rad): measured 7.39e-3 rad over the first 2 s; bound 4x
     ck.le("MuJoCo vs closed form, crank angle over the first 2 s (rad)",
           np.max(np.abs(mj["input_angle"] + math.pi / 2 - an.y[0])[mj.t <= 2.0]), 0.03)
@@ -59,13 +60,13 @@ def _iftomm_bricard(ck: Checker) -> None:
             rank0 == 4 and m.nv - rank0 == 1, (rank0, np.round(s0, 6).tolist()))
     ck.finite("MuJoCo and Pinocchio outputs", *mj.signals.values(), *ref.signals.values())
     ck.ge("it moves: range of joint 1 (rad)", np.ptp(ref["input_angle"]), 0.5)
-    ck.le("Pinocchio closure residual (m)", ref.stats["closure_residual_max"], 1e-6)
-    ck.le("Pinocchio energy drift (J)", ref.stats["energy_drift_max"], 5e-4)  # measured 1.03e-4 J; bound 5x
-    ck.le("MuJoCo closure residual with redundant rows (m)", mj.stats["closure_residual_max"], 5e-4)
-    ck.le("MuJoCo energy drift over 10 s (J)", mj.stats["energy_drift_max"], 0.1)
+    ck.le("Pinocchio closure residual (m)", ref.statistics["closure_residual_max"], 1e-6)
+    ck.le("Pinocchio energy drift (J)", ref.statistics["energy_drift_max"], 5e-4)  # measured 1.03e-4 J; bound 5x
+    ck.le("MuJoCo closure residual with redundant rows (m)", mj.statistics["closure_residual_max"], 5e-4)
+    ck.le("MuJoCo energy drift over 10 s (J)", mj.statistics["energy_drift_max"], 0.1)
     ck.le("MuJoCo vs Pinocchio joint 1 over 10 s (rad)", np.max(np.abs(mj["input_angle"] - ref["input_angle"])), 0.15)
     # measured 3.8e-7 rad (the penalty formulation's closure error, 3.2e-7 m); bound 5x
-    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.stats["branch_angle_max"], 2e-6)
+    ck.le("symmetric motion q1 + q3 = 0 (Pinocchio, rad)", ref.statistics["branch_angle_max"], 2e-6)
     ck.true("MuJoCo warnings", mj.stats["warnings"] == {}, mj.stats["warnings"])
 
 
@@ -143,9 +144,9 @@ class FourbarStudy(Study):
         """Physics error of one setting and its parts (the class's `physics_doc`)."""
         turns = (res["input_angle"][-1] - res["input_angle"][0]) / (2 * math.pi)
         turns_ref = (ref["angle"][-1] - ref["angle"][0]) / (2 * math.pi)
-        det = {"turns_rel": _rel(turns, turns_ref), "closure_residual": res.stats["closure_residual_max"],
-               "energy_drift_rel": res.stats["energy_drift_max"] / self.e_kin0,
-               "branch_rad": res.stats["branch_angle_max"]}
+        det = {"turns_rel": _rel(turns, turns_ref), "closure_residual": res.statistics["closure_residual_max"],
+               "energy_drift_rel": res.statistics["energy_drift_max"] / self.e_kin0,
+               "branch_rad": res.statistics["branch_angle_max"]}
         return max(det.values()), det
 
 HARD_CASES: tuple[HardCase, ...] = (

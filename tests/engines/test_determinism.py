@@ -173,7 +173,7 @@ def _blas_workloads() -> dict[str, np.ndarray]:
         params={"n_spans": 4, "x_end": 180.0, "window_start": 60.0, "window_end": 180.0})
     r = mbsuite.run(scene)
     out.update({f"catenary.{k}": v for k, v in r.signals.items()})
-    out["catenary.stats"] = np.array([r.stats[k] for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min")])
+    out["catenary.stats"] = np.array([r.statistics[k] for k in ("Fm", "sigma", "stat_max", "stat_min", "max", "min")])
     return out
 
 

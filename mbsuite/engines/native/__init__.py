@@ -6,7 +6,8 @@ One documented call makes MuJoCo know mbsuite's plugins, in any script or viewer
     >>> _ = mbsuite.native.load()              # compiles once (cached), registers the plugins with MuJoCo
     >>> m = mujoco.MjModel.from_xml_path(str(mbsuite.model_file("pantograph")))
 
-The sources are `core.c` here and every model package's `native/*.c`. They are compiled with the system
+The sources are `core.c` here, every model package's `native/*.c` and every shared component package's
+(`mbsuite/components/*/native/*.c`), in that order, each group sorted. They are compiled with the system
 C compiler (`cc`, or `$CC`) against the headers that the installed mujoco wheel ships (`mujoco/include`), linked to
 that wheel's `libmujoco`, and cached under `$MBSUITE_NATIVE_DIR` (default `$XDG_CACHE_HOME/mbsuite` or
 `~/.cache/mbsuite`) in a folder named by the hash of the sources, the compiler flags and the mujoco version: a new
@@ -28,6 +29,11 @@ arguments in ten thousand (docs/reproducibility.md has the measurements).
 determinism tests, which build the library with two `-march` settings and compare the results bit for bit. The extra
 flags come last, so they can undo the pinning ("-ffp-contract=fast -mfma" does); they are part of the cache key, so
 such a build never replaces the default one. Leave it unset for results that follow docs/reproducibility.md.
+
+Python binds the C in one way (`binding.py`): a `Declaration` per C file (its functions, the ctypes mirrors of its
+structs with the C functions returning their sizes, its ABI function and version) and `bind(declaration)`, which loads
+the library once under the lock, checks the ABI and every struct size and returns the cached `Binding`. `load()` binds
+the core's own declaration (`CORE`) the same way.
 """
 
 from __future__ import annotations
@@ -40,13 +46,14 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 from pathlib import Path
 
-from ...errors import MbsuiteError
+from .binding import LOCK as _lock
+from .binding import PACKAGE_DIR, Binding, CFunction, CStruct, Declaration, NativeBuildError, bind_with, declare
 
 HERE = Path(__file__).resolve().parent
-MODELS_DIR = HERE.parents[1] / "models"
+MODELS_DIR = PACKAGE_DIR / "models"
+COMPONENTS_DIR = PACKAGE_DIR / "components"
 LIB_NAME = "libmbsuite_native.so"
 #: compiler flags; `-fno-fast-math -ffp-contract=off` pin the floating point (module docstring)
 CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-parameter", "-fno-fast-math",
@@ -54,22 +61,37 @@ CFLAGS = ("-O2", "-fPIC", "-shared", "-std=gnu11", "-Wall", "-Wno-unused-paramet
 #: environment variable whose shell words are appended to CFLAGS (checks only; part of the cache key)
 EXTRA_CFLAGS_ENV = "MBSUITE_NATIVE_EXTRA_CFLAGS"
 ABI_VERSION = 2
+_P = ctypes.c_void_p
+#: the core's entry points (`core.c`); the mbs_job layout is checked by `mbsuite.engines.core` (`job_size`)
+CORE = Declaration("engines/native/core.c", "mbs_abi_version", ABI_VERSION, functions=(
+    CFunction("mbs_plugin_overflow", ctypes.c_int), CFunction("mbs_job_size", ctypes.c_int),
+    CFunction("mbs_plugin_fault", ctypes.c_int, (_P,) * 7), CFunction("mbs_run", ctypes.c_int, (_P, _P, _P)),
+    CFunction("mbs_signal", ctypes.c_double, (_P, ctypes.c_double)),
+    CFunction("mbs_fp_contract_probe", ctypes.c_double, (ctypes.c_double,) * 3),
+))
 
-_lock = threading.Lock()
+__all__ = ["ABI_VERSION", "CORE", "Binding", "CFunction", "CStruct", "Declaration", "NativeBuildError", "bind",
+           "build", "build_key", "cache_root", "cflags", "declare", "fuses_multiply_add", "job_size", "library_path",
+           "load", "mujoco_dirs", "plugin_names", "sources"]
+
 _lib: ctypes.CDLL | None = None
 
 
-class NativeBuildError(MbsuiteError, RuntimeError):
-    """The native library could not be compiled or loaded (no C compiler, a compile error, a stale ABI)."""
+def _native_files(pattern: str) -> list[Path]:
+    """Files matching `pattern` here, then in every model package's `native/`, then in every component package's
+    `native/`; each group sorted (an empty group is fine)."""
+    return (sorted(HERE.glob(pattern)) + sorted(MODELS_DIR.glob(f"*/native/{pattern}"))
+            + sorted(COMPONENTS_DIR.glob(f"*/native/{pattern}")))
 
 
 def sources() -> list[Path]:
-    """The C sources of the library: the core here, then every model package's `native/*.c` (sorted)."""
-    return sorted(HERE.glob("*.c")) + sorted(MODELS_DIR.glob("*/native/*.c"))
+    """The C sources of the library: the core here, then every model package's `native/*.c`, then every component
+    package's `native/*.c` (each group sorted)."""
+    return _native_files("*.c")
 
 
 def _headers() -> list[Path]:
-    return sorted(HERE.glob("*.h")) + sorted(MODELS_DIR.glob("*/native/*.h"))
+    return _native_files("*.h")
 
 
 def mujoco_dirs() -> tuple[Path, Path]:
@@ -115,9 +137,10 @@ def build_key() -> str:
 
     inc, lib = mujoco_dirs()
     h = hashlib.sha256()
-    for p in sources() + _headers():
-        h.update(p.name.encode())
-        h.update(p.read_bytes())
+    for p in sources() + _headers():  # every file's place in the package and its whole content
+        data = p.read_bytes()
+        h.update(f"{os.path.relpath(p, PACKAGE_DIR)}\0{len(data)}\0".encode())
+        h.update(data)
     h.update(" ".join(cflags()).encode())
     cc = _compiler()
     h.update(" ".join(cc).encode())
@@ -166,8 +189,10 @@ def build(force: bool = False) -> Path:
 
 def load() -> ctypes.CDLL:
     """Build (once, cached) and load the library; registers mbsuite's engine plugins with MuJoCo. Idempotent and
-    thread-safe. Returns the ctypes handle of the library (the core's entry points)."""
+    thread-safe. Returns the ctypes handle of the library, with the core's entry points (`CORE`) declared on it."""
     global _lib
+    if _lib is not None:
+        return _lib
     with _lock:
         if _lib is not None:
             return _lib
@@ -176,23 +201,20 @@ def load() -> ctypes.CDLL:
         path = build()
         mujoco.mj_loadPluginLibrary(str(path))  # dlopen: its constructors register the plugins
         lib = ctypes.CDLL(str(path))  # the same handle (dlopen is reference counted)
-        lib.mbs_abi_version.restype = ctypes.c_int
-        if lib.mbs_abi_version() != ABI_VERSION:
-            raise NativeBuildError(f"{path} has native ABI {lib.mbs_abi_version()}, mbsuite expects {ABI_VERSION}")
-        lib.mbs_plugin_overflow.restype = ctypes.c_int
-        if lib.mbs_plugin_overflow():
+        core = declare(lib, path, CORE)
+        if core.mbs_plugin_overflow():
             raise NativeBuildError("more engine plugins registered than the native core tracks (MBS_MAX_PLUGINS)")
-        lib.mbs_job_size.restype = ctypes.c_int
-        lib.mbs_plugin_fault.restype = ctypes.c_int
-        lib.mbs_plugin_fault.argtypes = [ctypes.c_void_p] * 7
-        lib.mbs_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
-        lib.mbs_run.restype = ctypes.c_int
-        lib.mbs_signal.argtypes = [ctypes.c_void_p, ctypes.c_double]
-        lib.mbs_signal.restype = ctypes.c_double
-        lib.mbs_fp_contract_probe.argtypes = [ctypes.c_double] * 3
-        lib.mbs_fp_contract_probe.restype = ctypes.c_double
+        for name in (CORE.abi_function, *(f.name for f in CORE.functions)):  # as the handle's attributes
+            setattr(lib, name, getattr(core, name))
         _lib = lib
         return lib
+
+
+def bind(declaration: Declaration) -> Binding:
+    """The binding of one C file of the library (`binding.py`): loads the library once (thread-safe), declares the
+    functions, checks the ABI and every struct size (NativeBuildError naming the C file, the function and both values on
+    a mismatch). Cached per declaration: every call and every thread gets the same `Binding`."""
+    return bind_with(declaration, load, sources)
 
 
 def fuses_multiply_add() -> bool:

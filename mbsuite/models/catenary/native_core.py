@@ -53,30 +53,24 @@ class _Job(ctypes.Structure):
     ]
 
 
-_lib: ctypes.CDLL | None = None
+_L = ctypes.c_long
+#: the catenary's C file as Python binds it (`engines.native.bind`: ABI and `_Job` layout checked)
+DECLARATION = native.Declaration(
+    "models/catenary/native/catenary.c", "mbs_cat_abi", ABI,
+    functions=tuple(native.CFunction(name, res, args) for name, res, args in (
+        ("mbs_cat_factor", _I, (_P,)), ("mbs_cat_solve", None, (_P, _P)), ("mbs_cat_place", None, (_P, _I, _D)),
+        ("mbs_cat_wire", _D, (_P, _I)), ("mbs_cat_predict", None, (_P, _D)), ("mbs_cat_local", _I, (_P,)),
+        ("mbs_cat_advance", None, (_P,)), ("mbs_cat_check", _I, (_P,)), ("mbs_cat_run", _I, (_P, _L, _L, _I)),
+        ("mbs_cat_record", None, (_P, _L, _D)), ("mbs_cat_dropper_ranges", None, (_P,)),
+    )),
+    structs=(native.CStruct(_Job, "mbs_cat_job_size"),),
+)
 
 
-def library() -> ctypes.CDLL:
-    """The native library with the catenary's entry points declared (layout checked against `_Job`)."""
-    global _lib
-    if _lib is None:
-        lib = native.load()
-        for name, res, args in (
-            ("mbs_cat_abi", _I, []), ("mbs_cat_job_size", _I, []), ("mbs_cat_factor", _I, [_P]),
-            ("mbs_cat_solve", None, [_P, _P]), ("mbs_cat_place", None, [_P, _I, _D]),
-            ("mbs_cat_wire", _D, [_P, _I]), ("mbs_cat_predict", None, [_P, _D]), ("mbs_cat_local", _I, [_P]),
-            ("mbs_cat_advance", None, [_P]), ("mbs_cat_check", _I, [_P]),
-            ("mbs_cat_run", _I, [_P, ctypes.c_long, ctypes.c_long, _I]),
-            ("mbs_cat_record", None, [_P, ctypes.c_long, _D]), ("mbs_cat_dropper_ranges", None, [_P]),
-        ):
-            fn = getattr(lib, name)
-            fn.restype, fn.argtypes = res, args
-        if lib.mbs_cat_abi() != ABI or lib.mbs_cat_job_size() != ctypes.sizeof(_Job):
-            raise native.NativeBuildError(
-                f"native/catenary.c (ABI {lib.mbs_cat_abi()}, job {lib.mbs_cat_job_size()} bytes) and "
-                f"native_core._Job (ABI {ABI}, {ctypes.sizeof(_Job)} bytes) disagree")
-        _lib = lib
-    return _lib
+def library() -> native.Binding:
+    """The catenary's entry points on the native library (loaded once, thread-safe; ABI and `_Job` layout
+    checked)."""
+    return native.bind(DECLARATION)
 
 
 def _ptr(a: np.ndarray | None) -> int | None:

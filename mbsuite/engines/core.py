@@ -113,6 +113,13 @@ class _Job(ctypes.Structure):
     ]
 
 
+#: the core's entry point as Python binds it (`native.bind`: the ABI and the `mbs_job` layout checked once, under the
+#: library's lock)
+JOB = native.Declaration("engines/native/core.c", "mbs_abi_version", native.ABI_VERSION,
+                         functions=(native.CFunction("mbs_run", ctypes.c_int, (ctypes.c_void_p,) * 3),),
+                         structs=(native.CStruct(_Job, "mbs_job_size"),))
+
+
 @dataclass
 class Trajectory:
     """What a run recorded: times `t` (rows) and one array per channel ((rows,) for size 1, else (rows, size))."""
@@ -161,9 +168,6 @@ class Stepper:
             raise ValueError("every and check_every must be >= 1")
         if self.data.signature != model.signature:
             raise ValueError(f"{what}: the MjData was not made for this MjModel (signatures differ)")
-        if native.job_size() != ctypes.sizeof(_Job):
-            raise native.NativeBuildError(f"native job layout {native.job_size()} bytes, Python's "
-                                          f"{ctypes.sizeof(_Job)}: rebuild (mbsuite.native.build(force=True))")
         self.allow_callbacks = allow_callbacks
         if not allow_callbacks:
             _refuse_python_callbacks(what)
@@ -197,7 +201,7 @@ class Stepper:
             job.hook_rec = _ptr(hook.record)
         self._job_ref = ctypes.byref(job)
         self._m_ptr, self._d_ptr = ctypes.c_void_p(self.model._address), ctypes.c_void_p(self.data._address)
-        self._mbs_run = self.lib.mbs_run
+        self._mbs_run = native.bind(JOB).mbs_run
 
     def _check_sizes(self) -> None:
         m = self.model

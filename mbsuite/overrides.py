@@ -12,6 +12,9 @@ from typing import Any
 
 from .errors import MbsuiteError
 
+#: the sections every scene has (a model adds its own: `SPEC.sections`)
+SCENE_SECTIONS = ("input", "params", "solver", "effects")
+
 
 @dataclass(frozen=True)
 class Override:

@@ -19,13 +19,13 @@ import numpy as np
 
 from ..errors import MbsuiteError
 from ..limits import Limit
+from ..overrides import SCENE_SECTIONS
 from ..schema import Rule, Section
 
 if TYPE_CHECKING:
     from ..scenes import Scene
     from .sweep import SweepOptions
 
-SCENE_SECTIONS = ("input", "params", "solver", "effects")
 
 
 @dataclass(frozen=True)

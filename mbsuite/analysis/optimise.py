@@ -582,11 +582,11 @@ def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factor
     over, maxiter, popsize, seed, workers, options)."""
     from ..scenes import Scene
 
-    scene = target if isinstance(target, Scene) else None
-    objective, against = _default(scene, "objective", objective), _default(scene, "against", against)
     lv = [LIMITS["level"].check("pareto level", x, MbsuiteError) for x in levels]
     if not lv:
         raise MbsuiteError(f"pareto levels {levels!r}: give one or more finite numbers")
+    scene = target if isinstance(target, Scene) else None
+    objective, against = _default(scene, "objective", objective), _default(scene, "against", against)
     base = [parse_bound(c) if isinstance(c, str) else c for c in kwargs.pop("constraints", ())]
     runs = [run(target, factors, objective=objective, constraints=[*base, Bound(against, lo=x)], **kwargs)
             for x in lv]

@@ -19,14 +19,13 @@ from typing import TYPE_CHECKING, Any
 
 from ..analysis.sweep.options import EXECUTORS, MAX_POINTS
 from ..errors import MbsuiteError
-from ..overrides import Override, compose, parse_override, section_of  # noqa: F401 (the rule's names)
+from ..overrides import SCENE_SECTIONS, Override, compose, parse_override, section_of  # noqa: F401 (the rule's names)
 
 if TYPE_CHECKING:
     from ..analysis.sweep import SweepOptions
     from ..scenes import Scene
 
 #: the scene sections every model has (a model adds its own: `ModelSpec.sections`)
-SCENE_SECTIONS = ("input", "params", "solver", "effects")
 #: flags of `SECTION.KEY=VALUE` entries (repeatable): argparse dest -> flag
 ENTRY_FLAGS = {"set_values": "--set", "vary": "--vary", "over": "--over"}
 #: flags that set one scene key: argparse dest -> (flag, the dotted key it sets); given when not None and not False

@@ -220,8 +220,8 @@ def test_workprecision_quick_rows_are_the_statistics_errors_of_direct_runs():
     sc = mbsuite.load_scene("catenary/en50318")
     rep = workprecision(sc, repeats=1, quick=True)
     row = find_row(rep, "fe", "trapezoidal, corrected Hermite", "h 1 m, dt 0.0004 s")
-    a = mbsuite.run(sc.replace(params={"element_length": 1.0}, solver={"timestep": 4e-4})).stats
-    b = mbsuite.run(sc).stats
+    a = mbsuite.run(sc.replace(params={"element_length": 1.0}, solver={"timestep": 4e-4})).statistics
+    b = mbsuite.run(sc).statistics
     force = max(abs(a[s] - b[s]) for s in STATS[:6])
     assert row["state_error"] == pytest.approx(force, rel=1e-12)
     assert row["physics_error"] == pytest.approx(max(force, abs(a["uplift_mm"] - b["uplift_mm"]) / 0.5,

@@ -83,7 +83,7 @@ def test_catenary_optimisation_end_to_end_on_a_short_line(tmp_path):
     assert data["start"]["design"] == {"params.F0": 120.0}
     assert data["value"] <= data["start"]["value"]
     scene = mbsuite.load_scene("catenary/en50318").replace(params=SHORT)
-    direct = mbsuite.run(point_scene(scene, data["best"])).stats
+    direct = mbsuite.run(point_scene(scene, data["best"])).statistics
     assert data["best_outputs"][0]["sigma"] == direct["sigma"] and data["best_outputs"][0]["Fm"] == direct["Fm"]
     band = optimise.band("AC").at(scene)
     assert band == pytest.approx((0.00047 * 250**2 + 60, 0.00047 * 250**2 + 90))

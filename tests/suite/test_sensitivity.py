@@ -105,7 +105,7 @@ def test_catenary_morris_end_to_end_on_a_short_line(tmp_path):
     assert len(ev) == 2 * (2 + 1)
     assert data["ranking"]["Fm"][0]["factor"] == "params.F0"  # the static uplift force moves the mean force most
     scene = mbsuite.load_scene("catenary/en50318").replace(params=SHORT)
-    direct = mbsuite.run(point_scene(scene, ev[0]["point"])).stats
+    direct = mbsuite.run(point_scene(scene, ev[0]["point"])).statistics
     assert ev[0]["outputs"]["Fm"] == direct["Fm"] and ev[0]["outputs"]["sigma"] == direct["sigma"]
     for name in ("sensitivity.csv", "evaluations.csv", "sensitivity.png"):
         assert (out / name).stat().st_size > 0

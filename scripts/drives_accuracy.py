@@ -1,10 +1,12 @@
-"""Study (not a test): the drives' declared accuracy measured on every shipped scene and both paths.
+"""Study (not a test): the declared accuracy of the drives and of the Modelica Rotational examples (the model
+`rotational`, on the same rotor library) measured on every shipped scene and both paths.
 
 For each scene and path: the headline values at the scene's settings (level 0) and refined once and twice (the
 error estimate of `mbsuite.trust.estimate`: hand path rtol / 10 per level, MuJoCo step / 2 per level), and a much finer
 run for the true error (hand path rtol 1e-12, atol 1e-14; MuJoCo the step / FINE). One Markdown row per headline:
 value, declared tolerance, estimated error, observed order, true error, estimate / true error. The tolerances of
-`mbsuite/models/drives/accuracy.py` are set a stated factor above the largest numbers of this table.
+`mbsuite/models/drives/accuracy.py` and `mbsuite/models/rotational/accuracy.py` are set a stated factor above the
+largest numbers of this table. A scene is `model/scene` (a bare name is a drives scene).
 
     nice .venv/bin/python scripts/drives_accuracy.py [scene ...] [--engines reference mujoco] [--workers 2] \
         [--json out/drives_accuracy.jsonl]
@@ -76,13 +78,14 @@ def main() -> None:
     if a.summary:
         summary(a.summary)
         return
-    names = a.scenes or sorted(load_scene("drives").spec.scene_files())
+    names = [n if "/" in n else f"drives/{n}" for n in a.scenes] or [
+        f"{model}/{n}" for model in ("drives", "rotational") for n in sorted(load_scene(model).spec.scene_files())]
     out = open(a.json, "a") if a.json else None  # noqa: SIM115 - appended row by row
     print("| scene | path | headline | value | tol | est. error | observed order | true error | est / true |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name in names:
         for eng in a.engines:
-            sc = load_scene(f"drives/{name}").replace(solver={"engine": eng, "allow_inaccurate": True})
+            sc = load_scene(name).replace(solver={"engine": eng, "allow_inaccurate": True})
             t0 = time.perf_counter()
             est = error_estimate(sc, workers=a.workers)
             t1 = time.perf_counter()

@@ -1,4 +1,5 @@
-"""Benchmark (not a test): cost per MuJoCo step of every shipped drives scene against its bare model stepped in C.
+"""Benchmark (not a test): cost per MuJoCo step of every shipped drives and rotational scene against its bare model
+stepped in C.
 
 For each scene (`--duration` s simulated, default 1 s or the scene's duration if shorter, on the MuJoCo path):
 - bare: the very MjModel the scene's `MujocoRotorSim` compiled (inertias, springs, sources set; locks inactive as in
@@ -11,7 +12,8 @@ Ratios stepping / bare and whole / bare are printed; each time is the median of 
 measurements interleaved round by round. Times are this process's CPU time (`--clock cpu`, the default: on a busy
 machine wall time also counts the other processes) or wall time (`--clock wall`).
 
-    python scripts/drives_bench.py [--duration 1] [--repeats 5] [--clock cpu|wall] [scene ...]
+    python scripts/drives_bench.py [--duration 1] [--repeats 5] [--clock cpu|wall] [scene ...]   (scene: model/name;
+    a bare name is a drives scene)
 """
 
 from __future__ import annotations
@@ -24,29 +26,27 @@ import numpy as np
 from mujoco import rollout
 
 import mbsuite
-from mbsuite.models.drives import coupled_clutches as cc
-from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
+from mbsuite.models.drives import drive
 from mbsuite.models.drives.scene_run import reference_signal
+from mbsuite.models.rotational.scene_run import setup as rotational_setup
 from mbsuite.paths import mjcf_path
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene, shipped_scenes
 
 
 def setup(scene):
-    """(sim, run arguments, make_controller) of a scene on the MuJoCo path, as `analysis.simulate_scene` builds them."""
+    """(sim, run arguments, make_controller) of a scene on the MuJoCo path, as its model's path builds them (a
+    `rotational` scene: its example, no controller)."""
+    if scene.model == "rotational":
+        s = rotational_setup(scene)
+        sim = MujocoRotorSim(s.system, mjcf_path(s.mjcf), timestep=scene.solver.timestep,
+                             integrator=scene.solver.integrator)
+        return sim, (s.q0, s.w0), lambda: None, s.sample_dt
     eff = dict(scene.effects)
     sv = scene.solver
     mech = eff["mechanism"]
-    if mech in msl.EXAMPLES:
-        ex = msl.example(mech)
-        sim = MujocoRotorSim(ex.system, mjcf_path(f"drive_{mech}"), timestep=sv.timestep, integrator=sv.integrator)
-        return sim, (ex.q0, ex.w0), lambda: None, sv.sample_dt or 5e-4
-    if mech == "coupled_clutches":
-        sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=sv.timestep,
-                             integrator=sv.integrator)
-        return sim, (cc.Q0, cc.W0), lambda: None, sv.sample_dt or 5e-4
-    p = scene.build_params().resolved(eff["param_set"])
+    p = scene.build_params().resolved()
     system = drive.build_system(mech, p, eff)
     ref = reference_signal(dict(scene.input), p["ref"] or 0.0)
 
@@ -86,7 +86,7 @@ HEAD = ["scene", "dt_s", "steps", "bare_us", "stepping_us", "stepping/bare", "wh
 
 
 def bench_scene(name: str, duration: float, repeats: int, clock) -> list:
-    sc = load_scene(f"drives/{name}")
+    sc = load_scene(name if "/" in name else f"drives/{name}")
     dur = min(duration, sc.solver.duration)
     sc = sc.replace(solver={"engine": "mujoco", "duration": dur, "t_settle": min(sc.solver.t_settle, 0.5 * dur)})
     sim, (q0, w0), make, sample_dt = setup(sc)
@@ -111,7 +111,7 @@ def main() -> None:
     ap.add_argument("--clock", choices=sorted(CLOCK), default="cpu")
     args = ap.parse_args()
     rows = []
-    for name in args.scenes or list(shipped_scenes()["drives"]):
+    for name in args.scenes or [f"{m}/{n}" for m in ("drives", "rotational") for n in shipped_scenes()[m]]:
         rows.append(bench_scene(name, args.duration, args.repeats, CLOCK[args.clock]))
         print(format_table(HEAD, rows[-1:], ".3g").splitlines()[-1], flush=True)
     print(format_table(HEAD, rows, ".3g"))

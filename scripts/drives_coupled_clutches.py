@@ -2,7 +2,8 @@
 
 Hand path: the event-exact DOP853 simulation; MuJoCo path: RK4 at `--timestep` with the stick/slip state machine as
 the native core's stepper (event times interpolated within the step). The reference is the Modelica Association's
-result in mbsuite/models/drives/data/msl/.
+result in mbsuite/models/rotational/data/msl/ (the model `rotational`; this runs `mbsuite rotational
+coupled-clutches`).
 
 Usage: .venv/bin/python scripts/drives_coupled_clutches.py [--timestep 1e-4]
 """
@@ -14,4 +15,4 @@ import sys
 from mbsuite.cli import main
 
 if __name__ == "__main__":
-    sys.exit(main(["drive", "coupled-clutches", *sys.argv[1:]]))
+    sys.exit(main(["rotational", "coupled-clutches", *sys.argv[1:]]))

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbsuite.models.drives import coupled_clutches as cc
+from mbsuite.components.rotational.event_exact import simulate_reference
+from mbsuite.components.rotational.interfaces import Friction, Part, RotorSystem, Spring
+from mbsuite.components.rotational.velocity_band import simulate_velocity_band
 from mbsuite.models.drives import drive
 from mbsuite.models.drives.analysis import simulate_scene
-from mbsuite.models.drives.event_exact import simulate_reference
-from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Spring
 from mbsuite.models.drives.scene_run import setup
-from mbsuite.models.drives.velocity_band import simulate_velocity_band
+from mbsuite.models.rotational import coupled_clutches as cc
 from mbsuite.results import format_table
 from mbsuite.scenes import load_scene
 

@@ -1,5 +1,6 @@
-"""Four Modelica Rotational examples (MSL 4.1.0) on both drives paths: mode changes (hand path, MuJoCo, the
-Modelica Association's reference where published) and the worst signal deviation relative to the regression tube.
+"""Four Modelica Rotational examples (MSL 4.1.0, the model `rotational`) on both paths of the rotor library: mode
+changes (hand path, MuJoCo, the Modelica Association's reference where published) and the worst signal deviation
+relative to the regression tube.
 
 Usage: .venv/bin/python scripts/drives_msl.py [--json FILE]   (about 10 s)
 """
@@ -9,9 +10,10 @@ from __future__ import annotations
 import argparse
 import json
 
-from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.event_exact import simulate_reference
-from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.components.rotational.energy import energy_balance
+from mbsuite.components.rotational.event_exact import simulate_reference
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
+from mbsuite.models.rotational import examples as msl
 from mbsuite.paths import mjcf_path
 from mbsuite.results import format_table
 
@@ -32,7 +34,7 @@ def study(name: str) -> dict:
         out["events"].append({"element": rh["element"], "from": rh["from"], "to": rh["to"], "hand": rh["t"],
                               "mujoco": rm["t"], "reference": rh["t_ref"] if ref is not None else None})
     for path, res in (("hand", hand), ("mujoco", mj)):
-        bal = drive.energy_balance(ex.system, res)
+        bal = energy_balance(ex.system, res)
         out[f"energy_residual_{path}"] = bal.residual / bal.input
         if ref is not None:
             tube = msl.tube_check(ex, res, ref)

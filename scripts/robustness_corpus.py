@@ -224,11 +224,11 @@ def scene_attempts() -> Iterator[Attempt]:
     a = "scene"
     yield scene("scene-ok-control", a, "a valid short pantograph scene (control)", PANTO, "ok")
     yield scene("scene-ok-drives-profile", "signals", "a valid step_up_down profile scene (control)",
-                MODEL_SCENES["drives"].replace('mechanism = "step_up"', 'mechanism = "step_up_down"\n'
-                                               'param_set = "design_100w"').replace(
+                MODEL_SCENES["drives"].replace('mechanism = "step_up"', 'mechanism = "step_up_down"').replace(
                     'controller = "pwm"', 'controller = "energy_packet"\nclosed_loop = true').replace(
-                    "duty = 0.5\nt_l = 0.2\n", "").replace('type = "reference"\n', 'type = "reference"\n'
-                                                           "profile = [[0.0, 300.0], [0.5, 300.0], [1.0, 200.0]]\n"),
+                    "duty = 0.5\nt_l = 0.2\n", 'set = "design_100w"\n').replace(
+                    'type = "reference"\n',
+                    'type = "reference"\nprofile = [[0.0, 300.0], [0.5, 300.0], [1.0, 200.0]]\n'),
                 "ok", timeout=120)
     for model, text in MODEL_SCENES.items():
         if model not in ("catenary", "pantograph"):
@@ -302,9 +302,11 @@ def scene_attempts() -> Iterator[Attempt]:
                 culprit="viscous")
     for model, eff, val in (("coupler", "friction", '"yes"'), ("drives", "controller", '"pid"'),
                             ("iftomm", "mechanism", '"stewart"'), ("catenary", "droppers", '"rigid"'),
-                            ("drives", "param_set", '"table_9_9"'), ("catenary", "pantograph", '"faiveley"')):
+                            ("catenary", "pantograph", '"faiveley"')):
         yield scene(f"effect-{model}-{eff}", a, f"{model}: {eff} = {val}",
                     with_lines(MODEL_SCENES[model], "effects", f"{eff} = {val}"), culprit=eff)
+    yield scene("param-drives-set", a, 'drives: [params] set = "table_9_9"',
+                with_lines(MODEL_SCENES["drives"], "params", 'set = "table_9_9"'), culprit="set")
     yield scene("param-unknown", a, "unknown parameter", PANTO + "[params]\nmass = 3.0\n", culprit="mass")
     for p, v, why in (("l1", "nan", "NaN"), ("l1", "inf", "infinite"), ("l1", "-inf", "minus infinity"),
                       ("l1", "-1.95", "negative length"), ("l1", "0.0", "zero length"), ("m1", '"heavy"', "a string"),
@@ -423,9 +425,9 @@ def input_attempts() -> Iterator[Attempt]:
     for prof, why in (("[[0.0]]", "rows of one number"), ("[[1.0, 2.0], [0.0, 3.0]]", "times going back"),
                       ('"abc"', "a string"), ("[]", "empty"), ("[[0.0, nan], [1.0, 2.0]]", "NaN value"),
                       ("[[0.0, 1.0, 2.0]]", "rows of three")):
-        susd = dr.replace('mechanism = "step_up"', 'mechanism = "step_up_down"\nparam_set = "design_100w"').replace(
+        susd = dr.replace('mechanism = "step_up"', 'mechanism = "step_up_down"').replace(
             'controller = "pwm"', 'controller = "energy_packet"\nclosed_loop = true').replace(
-            "duty = 0.5\nt_l = 0.2\n", "")
+            "duty = 0.5\nt_l = 0.2\n", 'set = "design_100w"\n')
         yield scene(f"drives-profile-{why.replace(' ', '_')}", a, f"drives step_up_down reference profile = {prof} "
                     f"({why})", with_lines(susd, "input", f"profile = {prof}"), culprit="profile")
     it = MODEL_SCENES["iftomm"]
@@ -766,8 +768,8 @@ def cli_attempts() -> Iterator[Attempt]:
                   ("drive", "efficiency", "drives/step_up_efficiency", "--loads", v, "--duration", "1"),
                   culprit="loads|load", timeout=120)
     for v in ("0", "-1", "nan", "inf", "10", "1e-9"):
-        yield cli(f"drive-coupled-clutches-timestep={v}", a, f"drive coupled-clutches --timestep {v}",
-                  ("drive", "coupled-clutches", "--timestep", v), culprit="timestep")
+        yield cli(f"rotational-coupled-clutches-timestep={v}", a, f"rotational coupled-clutches --timestep {v}",
+                  ("rotational", "coupled-clutches", "--timestep", v), culprit="timestep")
     # catenary
     for flag, v in (("--speed", "0"), ("--speed", "-1"), ("--speed", "nan"), ("--speed", "inf"),
                     ("--speed", "1e6"), ("--timestep", "0"), ("--timestep", "nan"), ("--timestep", "1"),

@@ -15,7 +15,6 @@ import pytest
 from mbsuite.errors import SceneError
 from mbsuite.models.drives.config import (
     CONTROLLERS,
-    MODELICA_EFFECTS,
     OPTIONAL,
     SET_MECHANISMS,
     check_scene,
@@ -45,11 +44,11 @@ def _combos():
 
 
 def _scene(mech, kind, closed, bearings, delays, added, matching, ref, params):
-    eff = {"mechanism": mech, "param_set": BASE[mech], "controller": kind, "closed_loop": closed,
+    eff = {"mechanism": mech, "controller": kind, "closed_loop": closed,
            "bearing_friction": bearings, "clutch_delays": delays, "added_motor_inertia": added,
            "clutch_matching": matching}
     inp = {"type": "reference", **({"value": 300.0} if ref else {})}
-    return scene_from_dict({"model": "drives", "effects": eff, "params": params, "input": inp,
+    return scene_from_dict({"model": "drives", "effects": eff, "params": {"set": BASE[mech], **params}, "input": inp,
                             "solver": {"duration": 0.2, "t_settle": 0.0}})
 
 
@@ -91,13 +90,6 @@ def test_refused_effects():
         run_setup(load_scene("drives/susd_500w_open").replace(effects={"clutch_matching": True}))
     with pytest.raises(SceneError, match="input.value"):
         run_setup(sc.replace(input={"value": 100.0}))
-    cc = load_scene("drives/coupled_clutches")
-    for k, v in MODELICA_EFFECTS.items():
-        other = {"param_set": "table_4_2", "controller": "pwm"}.get(k, not v)
-        with pytest.raises(SceneError, match=k):
-            run_setup(cc.replace(effects={k: other}))
-    with pytest.raises(SceneError, match=r"\['J_m'\]"):
-        run_setup(cc.replace(params={"J_m": 2.0}))
 
 
 @pytest.mark.parametrize("ps", sorted(SET_MECHANISMS))
@@ -115,12 +107,12 @@ def test_every_parameter_set_is_complete_for_its_mechanisms(ps):
 
 def test_another_mechanisms_set_is_refused_by_name():
     """The 500 W step-up/step-down set on the step-up drive (once `TypeError: '>=' ... NoneType` inside the run)."""
-    sc = load_scene("drives/step_up_pwm").replace(effects={"param_set": "example_500w"}, params={"tau_b": 2.0})
+    sc = load_scene("drives/step_up_pwm")
     with pytest.raises(SceneError, match=r"parameter set 'example_500w' .* lacks \['tau_c', 'twist_tol'\] needed by "
                                          r"mechanism 'step_up'"):
-        run_setup(sc)
+        run_setup(sc.replace(params={"set": "example_500w", "tau_b": 2.0}))  # refused as the scene loads
     # giving what it lacks makes it a step-up drive (duty and t_l are the scene's already)
-    run_setup(sc.replace(params={"tau_c": 20.0, "twist_tol": 0.5}))
+    run_setup(sc.replace(params={"set": "example_500w", "tau_b": 2.0, "tau_c": 20.0, "twist_tol": 0.5}))
 
 
 @pytest.mark.slow
@@ -150,8 +142,8 @@ def test_unused_parameters_change_nothing(combo):
 def test_rotor_inertia_floor(key):
     """Below the declared floor 1e-9 kg m^2 a rotor inertia is refused naming it (once MuJoCo's singular-inertia
     warnings); at the floor the MuJoCo model is built with it (diag(M) holds it: `MujocoRotorSim`'s own check)."""
+    from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
     from mbsuite.errors import ParameterError
-    from mbsuite.models.drives.mujoco import MujocoRotorSim
     from mbsuite.paths import mjcf_path
 
     sc = load_scene("drives/step_up_pwm")

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from mbsuite.cli import main
+from mbsuite.components.rotational.commands import CommandQueue
 from mbsuite.errors import SceneError
 from mbsuite.models.drives import controllers as C
 from mbsuite.models.drives import drive
 from mbsuite.models.drives.analysis import simulate_scene
-from mbsuite.models.drives.commands import CommandQueue
 from mbsuite.scenes import load_scene
 from mbsuite.trust import robustness as stability
 

@@ -177,7 +177,7 @@ def test_cli_design_and_run(capsys):
     assert json.loads(capsys.readouterr().out)["V"] == pytest.approx(8.409e-5, rel=1e-3)
 
 
-_CC = ["drive", "coupled-clutches"]
+_CC = ["rotational", "coupled-clutches"]
 _GAINS = ["drive", "design", "gains", "--Jl", "0.0023", "--ts", "0.069", "--taul", "0.15", "--btotal", "2.5e-4"]
 
 

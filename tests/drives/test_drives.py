@@ -30,18 +30,17 @@ def _sim(name, **solver):
 def test_spec_and_scenes_registered():
     spec = get_model("drives")
     assert spec.paths and all(path.run is not None for path in spec.paths.values())
-    assert {"coupled_clutches", "step_up_pwm", "susd_100w_design", "susd_500w_step"} <= set(spec.scene_files())
+    assert {"step_up_pwm", "susd_100w_design", "susd_500w_step"} <= set(spec.scene_files())
 
 
 @pytest.mark.parametrize("name", sorted(get_model("drives").scene_files()))
 def test_shipped_scenes_close_their_energy_balance(name):
     """Every shipped scene on MuJoCo (the suite's menagerie test steps them; here the physical invariant): input -
-    output - losses - stored energy change = 0. Measured over 0.15 s (0.7 s for the MSL examples, which start
-    moving later): <= 7.2e-8 of the energy turnover (msl_friction; step-up scenes 5.3e-8); bound 5e-7, 7x. No MuJoCo
-    warning, no callback left installed."""
-    msl_scene = name.startswith("msl_")
+    output - losses - stored energy change = 0. Measured over 0.15 s: <= 5.3e-8 of the energy turnover (step-up
+    scenes); bound 5e-7, 9x. No MuJoCo warning, no callback left installed (the Modelica examples:
+    tests/rotational/test_scenes.py)."""
     sc = load_scene(f"drives/{name}")
-    sc = sc.replace(solver={"engine": "mujoco", "duration": 0.7 if msl_scene else 0.15, "t_settle": 0.0})
+    sc = sc.replace(solver={"engine": "mujoco", "duration": 0.15, "t_settle": 0.0})
     res, _, sys_ = simulate_scene(sc)
     bal = drive.energy_balance(sys_, res)
     assert max(abs(bal.input), abs(bal.output), abs(bal.stored)) > 1e-3  # the scene moved: a balance to check
@@ -254,7 +253,7 @@ def test_susd_100w_design_reproduction(susd_design):
     assert abs(cs["mean_load_speed"] / 400 - 1) < 0.05  # +-400 rad/s reached (Sec. 6.2); measured -0.76 %
     assert abs(cs["switching_rate"] / 14.5 - 1) < 0.15  # documented deviation (-11.7 %), see the docstring
     assert 4.5 <= cs["max_extension"] < 5.5  # "~5 rad" (Sec. 6.2) to its printed precision; measured 4.90
-    p = sc.build_params().resolved(sc.effects["param_set"])
+    p = sc.build_params().resolved()
     free = ph["wait_extraction"] + ph["wait_transfer"] + ph["transfer"] + ph["restart"]
     assert abs(free / (2 * math.pi * math.sqrt(p["J_s"] / p["K"]) + 1 / p["fs"]) - 1) < 0.02
     sc2, res2, ctrl2, _ = _sim("susd_100w_reverse")
@@ -320,7 +319,7 @@ def test_bad_parameter_combinations():
 
 def test_delay_samples_one_conversion():
     """0.3 ms at 10 kHz is 3 samples everywhere (int(0.0003 * 10000) = 2 in binary floating point)."""
-    from mbsuite.models.drives.commands import CommandQueue, delay_samples
+    from mbsuite.components.rotational.commands import CommandQueue, delay_samples
 
     assert int(0.0003 * 10000) == 2  # the trap
     assert delay_samples(0.0003, 10000.0) == 3
@@ -348,7 +347,7 @@ def test_anti_windup_default_and_printed_variant():
     sc = load_scene("drives/susd_500w_step")
     with open(spec.scene_files()["susd_500w_step"], "rb") as fh:
         assert "anti_windup" not in tomllib.load(fh)["effects"]  # the scene does not ask: the default applies
-    p = sc.build_params().resolved(sc.effects["param_set"])
+    p = sc.build_params().resolved()
     unset = {k: v for k, v in sc.effects.items() if k != "anti_windup"}
     assert drive.build_controller("step_up_down", "energy_packet", p, unset).anti_windup is True
     _, ctrl, _ = simulate_scene(sc.replace(solver={"duration": 0.6, "t_settle": 0.0}))
@@ -396,7 +395,7 @@ def test_motor_resonant_keeps_motor_in_band():
     inside the scene's band [min_vel, max_vel] = [40, 60] rad/s (measured 52.9)."""
     sc, res, ctrl, sys_ = _sim("step_up_motor_resonant", duration=4.0, t_settle=2.0)
     cs = drive.cycle_stats(res, ctrl, 2.0)
-    p = sc.build_params().resolved(sc.effects["param_set"])
+    p = sc.build_params().resolved()
     assert p["min_vel"] < cs["mean_motor_speed"] < p["max_vel"]
     assert cs["n_cycles"] >= 8
     _balance_ok(sys_, res)
@@ -406,9 +405,9 @@ def test_velocity_band_scheme_compares():
     """The thesis' 0.01 rad/s locking band on CoupledClutches, against the Dymola result every 0.1 s: its error
     (measured 6.2e-3 rad/s) stays below 2e-2 (3.2x) and is at least 10x that of the event-exact hand path on the same
     grid (measured 6.0e-5: 103x) - the scheme creeps where the exact path holds."""
-    from mbsuite.models.drives import coupled_clutches as cc
-    from mbsuite.models.drives.event_exact import simulate_reference
-    from mbsuite.models.drives.velocity_band import simulate_velocity_band
+    from mbsuite.components.rotational.event_exact import simulate_reference
+    from mbsuite.components.rotational.velocity_band import simulate_velocity_band
+    from mbsuite.models.rotational import coupled_clutches as cc
 
     band = simulate_velocity_band(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
     exact = simulate_reference(cc.build_system(), cc.Q0, cc.W0, 1.5, sample_dt=5e-4)
@@ -430,7 +429,7 @@ def test_storage_time_nearest_sample_over_grid():
     arithmetic (decimal strings as fractions; ties up), over a grid of duty x t_l x fs, through the controller."""
     from fractions import Fraction
 
-    from mbsuite.models.drives.commands import time_to_samples
+    from mbsuite.components.rotational.commands import time_to_samples
 
     q = w = np.zeros(3)
     n_trap = 0

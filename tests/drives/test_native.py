@@ -1,4 +1,4 @@
-"""The MuJoCo path's native stepper (`native/drives.c` in the native core) against its Python twin and the event-exact
+"""The MuJoCo path's native stepper (`native/rotors.c` in the native core) against its Python twin and the event-exact
 hand path; threads; a chattering state machine; bad input; the step objects of both paths."""
 
 from __future__ import annotations
@@ -6,14 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mbsuite.components.rotational.event_exact import ReferenceSimulator, simulate_reference
+from mbsuite.components.rotational.interfaces import Friction, Part, RotorSystem, Source
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
 from mbsuite.engines.inputs import Pulse, Step
 from mbsuite.errors import ParameterError, SceneError, SolverError
-from mbsuite.models.drives import coupled_clutches as cc
 from mbsuite.models.drives import drive
 from mbsuite.models.drives.analysis import simulate_scene
-from mbsuite.models.drives.event_exact import ReferenceSimulator, simulate_reference
-from mbsuite.models.drives.mujoco import MujocoRotorSim
-from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Source
+from mbsuite.models.rotational import coupled_clutches as cc
 from mbsuite.paths import mjcf_path
 from mbsuite.scenes import load_scene
 
@@ -189,8 +189,8 @@ def test_bad_input_named():
 
 def test_rotor_stepper_step_and_advance():
     """The Python twin as a step object: advancing in pieces (and single steps) is the run in one go."""
-    from mbsuite.models.drives.rotor_run import RotorRun
-    from mbsuite.models.drives.stepper import RotorStepper
+    from mbsuite.components.rotational.rotor_run import RotorRun
+    from mbsuite.components.rotational.stepper import RotorStepper
 
     sim = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=DT)
     whole = sim.run(cc.Q0, cc.W0, 0.8, sample_dt=1e-3, stepper="python")
@@ -221,8 +221,8 @@ def test_reference_simulator_step_object():
 def test_step_objects_meet_the_protocol():
     """The hand path's `ReferenceSimulator` and the Python twin `RotorStepper` are `mbsuite.stepping.StepObject`s;
     `run(t_end)` steps to t_end and `status` says when the run is finished."""
-    from mbsuite.models.drives.rotor_run import RotorRun
-    from mbsuite.models.drives.stepper import RotorStepper
+    from mbsuite.components.rotational.rotor_run import RotorRun
+    from mbsuite.components.rotational.stepper import RotorStepper
     from mbsuite.stepping import StepObject
 
     ref = ReferenceSimulator(cc.build_system(), cc.Q0, cc.W0, 0.2, sample_dt=5e-4)

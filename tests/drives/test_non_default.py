@@ -5,7 +5,7 @@ factor in 0.8-1.25 (a swapped, dropped or mis-scaled parameter in one path shows
 and where a value enters only the controller both paths share (gains, clamps, the controller's spring rate and
 frequency, speed thresholds) the controller's output is checked against a closed form evaluated here. The spring
 damper D (0 in every set of the thesis) is checked on both paths at a non-zero value, and the 100 W design set
-(`param_set = "design_100w"`) against the thesis' printed numbers (Table 4.2, Sec. 6.2, Table 6.2)."""
+(`[params] set = "design_100w"`) against the thesis' printed numbers (Table 4.2, Sec. 6.2, Table 6.2)."""
 
 from __future__ import annotations
 
@@ -16,11 +16,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from mbsuite.components.rotational.event_exact import simulate_reference
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
 from mbsuite.models.drives import controllers as C
 from mbsuite.models.drives import drive
 from mbsuite.models.drives.analysis import simulate_scene
-from mbsuite.models.drives.event_exact import simulate_reference
-from mbsuite.models.drives.mujoco import MujocoRotorSim
 from mbsuite.models.drives.params import DESIGN_100W, TABLE_4_2
 from mbsuite.models.drives.scene_run import setup as run_setup  # a module-level `setup` is pytest's xunit hook
 from mbsuite.paths import mjcf_path
@@ -289,8 +289,8 @@ def test_spring_damper_on_both_paths(damped_pair):
 # ---- the 100 W design set against the thesis' printed numbers --------------------------------------------------------
 @pytest.mark.literal_inputs("the load speed against its closed form in the literal constants to 5e-14")
 def test_design_100w_set_is_the_thesis_design():
-    """The shipped `susd_100w_design` scene (param_set `design_100w`, hand path) against numbers printed in the thesis,
-    written here, not read from the parameter set:
+    """The shipped `susd_100w_design` scene (parameter set `design_100w`, hand path) against numbers printed in the
+    thesis, written here, not read from the parameter set:
     * motor run-up with both clutches open (Eq 4.1): K_t = 0.1101 N m/A, K_e = 0.1043 V s/rad, R = 1.1 ohm (Table
       4.2) at V_s = 21 V, J = 1.4e-4 + 1.6e-3 kg m^2 (added inertia), bearings x2 of Table 4.2 (Sec. 6.2):
       w = w_inf (1 - exp(-t/T)); measured 2.9e-11 relative, bound 3e-10 (10x);

@@ -10,8 +10,8 @@ from mbsuite.errors import ParameterError, SceneError
 from mbsuite.models.drives import design as D
 from mbsuite.models.drives.scene_run import check_profile
 
-SUSD = ('model = "drives"\n[effects]\nmechanism = "step_up_down"\nparam_set = "design_100w"\n'
-        'controller = "energy_packet"\nclosed_loop = true\n[input]\ntype = "reference"\nprofile = {profile}\n'
+SUSD = ('model = "drives"\n[effects]\nmechanism = "step_up_down"\ncontroller = "energy_packet"\nclosed_loop = true\n'
+        '[params]\nset = "design_100w"\n[input]\ntype = "reference"\nprofile = {profile}\n'
         '[solver]\nengine = "mujoco"\nduration = 1.0\n')
 
 

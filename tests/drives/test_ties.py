@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mbsuite.components.rotational import event_exact as F
 from mbsuite.models.drives import drive
-from mbsuite.models.drives import event_exact as F
 from mbsuite.models.drives.analysis import simulate_scene
 from mbsuite.models.drives.scene_run import DRIVE_ENERGY_BOUND
 from mbsuite.scenes import load_scene

@@ -27,13 +27,13 @@ def test_hardcases_run_one_and_model_filter(capsys):
 
 def test_workprecision_writes_table_csv_png(tmp_path, capsys):
     out = tmp_path / "wp"
-    assert main(["workprecision", "drives/coupled_clutches", "--quick", "--repeats", "1", "--out", str(out)]) == 0
+    assert main(["workprecision", "rotational/coupled_clutches", "--quick", "--repeats", "1", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "cheapest setting" in text and "event-exact DOP853" in text
     assert (out / "workprecision.csv").stat().st_size > 0 and (out / "workprecision.png").stat().st_size > 0
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["results"]["rows"] and summary["scene"]["model"] == "drives"
-    assert main(["workprecision", "drives/coupled_clutches", "--repeats", "0"]) == 2
+    assert summary["results"]["rows"] and summary["scene"]["model"] == "rotational"
+    assert main(["workprecision", "rotational/coupled_clutches", "--repeats", "0"]) == 2
 
 
 def _kinds(lines: list[str]) -> list[str]:

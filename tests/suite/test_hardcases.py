@@ -25,7 +25,7 @@ def test_registry_is_complete_and_described():
     # the situations the suite promises to cover: stick-slip (3 kinds), orifice dp -> 0 and choked,
     # coupler e_y -> 0 and e_y < R alpha,
     # phi_bc = pi/2, both clutches locked, mismatch engagement, over-large timesteps, 100 s drift, two IFToMM gates
-    required = {"pantograph_stick_slip_2hz", "drives_clutch_lock_unlock", "drives_load_reversal",
+    required = {"pantograph_stick_slip_2hz", "rotational_clutch_lock_unlock", "drives_load_reversal",
                 "pantograph_orifice_dp0", "pantograph_orifice_choked", "coupler_ey_to_zero", "coupler_ey_below_R_alpha",
                 "coupler_double_phibc90", "drives_both_clutches_locked", "drives_engagement_mismatch",
                 "pantograph_over_large_timestep", "coupler_over_large_timestep", "drives_over_large_timestep",

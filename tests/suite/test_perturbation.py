@@ -20,8 +20,9 @@ from mbsuite.trust import perturbation
 from mbsuite.trust import robustness as stability
 
 FAST_SCENES = [("pantograph/lab", 1.0), ("coupler/double_friction", 1.0), ("drives/step_up_motor_resonant", 4.0),
-               ("drives/susd_100w_design", 1.0), ("iftomm/fourbar", 1.0), ("catenary/en50318", None)]
-FAST_CASES = ["drives_clutch_lock_unlock", "drives_engagement_mismatch", "pantograph_stick_slip_2hz",
+               ("drives/susd_100w_design", 1.0), ("iftomm/fourbar", 1.0), ("catenary/en50318", None),
+               ("rotational/coupled_clutches", 1.0)]
+FAST_CASES = ["rotational_clutch_lock_unlock", "drives_engagement_mismatch", "pantograph_stick_slip_2hz",
               "coupler_ey_to_zero"]
 
 
@@ -99,11 +100,11 @@ def test_the_check_catches_a_last_bit_discontinuity(monkeypatch):
     sc = load_scene("catenary/en50318")
     rep = stability.check_scene(sc, eps=1e-12, draws=2)
     assert not rep.ok
-    assert "stats.sigma" in {o.name for o in rep.jumps()}
+    assert "statistics.sigma" in {o.name for o in rep.jumps()}
     # a jump a model declares (pattern -> why) is accepted and reported with its reason; the others still fail
-    declared = stability.check_scene(sc, eps=1e-12, draws=2, base=rep.base, jumps={"stats.*": "declared"})
-    assert {o.jump for o in declared.jumps() if o.name.startswith("stats.")} == {"declared"}
-    assert not declared.ok and all(o.ok for o in declared.outputs if o.name.startswith("stats."))
+    declared = stability.check_scene(sc, eps=1e-12, draws=2, base=rep.base, jumps={"statistics.*": "declared"})
+    assert {o.jump for o in declared.jumps() if o.name.startswith("statistics.")} == {"declared"}
+    assert not declared.ok and all(o.ok for o in declared.outputs if o.name.startswith("statistics."))
 
 
 def _z(seed: int, key: str, x: float) -> float:
@@ -163,7 +164,7 @@ def test_check_scene_kappa_and_verdict_against_a_hand_computed_case(monkeypatch)
 
     def fake_run(scene):
         y = law["f"](scene.build_params().ks)
-        return SimpleNamespace(stats={"y": y}, events=[], signals={}, units={}, health=[])
+        return SimpleNamespace(stats={"y": y}, statistics={}, events=[], signals={}, units={}, health=[])
 
     monkeypatch.setattr(stability, "run", fake_run)
     zs = [_z(s, "PantographParams.ks", ks0) for s in (0, 1)]

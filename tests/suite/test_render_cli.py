@@ -52,7 +52,7 @@ def test_render_writes_the_scene_as_mujoco_draws_it(tmp_path, scene):
 def test_render_refuses_a_model_without_mujoco_by_name(tmp_path, capsys):
     from mbsuite.cli import main
 
-    assert main(["render", "drives/coupled_clutches", "--out", str(tmp_path / "x.png")]) == 2
-    assert "model 'drives' has no MuJoCo model" in capsys.readouterr().err
+    assert main(["render", "rotational/coupled_clutches", "--out", str(tmp_path / "x.png")]) == 2
+    assert "model 'rotational' has no MuJoCo model" in capsys.readouterr().err
     assert main(["render", "pantograph", "--out", str(tmp_path / "x.jpg")]) == 2
     assert "give a .png file" in capsys.readouterr().err

@@ -1,10 +1,12 @@
 """Switched-mode mechanical drives (Oldaker 1997): step-up and step-up/step-down three-mass models with event-exact
-clutches, switching controllers, losses and Chapter 5 design tools; plus Modelica's CoupledClutches as an outside check.
+clutches, switching controllers, losses and Chapter 5 design tools, on the shared rotor library
+(`mbsuite.components.rotational`; the Modelica Rotational examples on the same library are the model `rotational`).
 
-Two independent paths (`SPEC.paths`): the hand-derived event-exact stick/slip simulation (`reference.run` on
-`event_exact.simulate_reference`) and MuJoCo (`mujoco.run` on `mujoco.MujocoRotorSim`, hinge rotors with real equality
-locks, its state machine a native stepper of mbsuite's C core). Suite declarations (hard cases, work-precision study,
-random inputs) in `cases.py`. See README.md (its Files table says where everything is).
+Two independent paths (`SPEC.paths`): the hand-derived event-exact stick/slip simulation (`reference.run` on the
+library's `event_exact.simulate_reference`) and MuJoCo (`mujoco.run` on the library's `mujoco_sim.MujocoRotorSim`,
+hinge rotors with real equality locks, its state machine a native stepper of mbsuite's C core). Suite declarations
+(hard cases, work-precision study, random inputs) in `cases.py`. See README.md (its Files table says where
+everything is).
 """
 
 from __future__ import annotations
@@ -17,21 +19,17 @@ from ...registry import Effect, ModelSpec, RunPath
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
-from .params import PARAM_SETS, DriveParams
+from .params import DriveParams
 from .scene_run import PROFILE, SIGNALS
 
 SPEC = ModelSpec(
     name="drives",
-    summary="switched-mode mechanical drives (step-up, step-up/step-down) with exact clutches; CoupledClutches",
+    summary="switched-mode mechanical drives (step-up, step-up/step-down) with exact clutches",
     params_cls=DriveParams,
     effects={
-        "mechanism": Effect(("step_up", "step_up_down", "coupled_clutches", "msl_friction", "msl_one_way_clutch",
-                             "msl_one_way_clutch_disengaged", "msl_simple_gear_shift"), "step_up",
-                            "which rotor system: Fig 3.3, Fig 3.4, or a Modelica Rotational example (CoupledClutches, "
-                            "Friction, OneWayClutch, OneWayClutchDisengaged, SimpleGearShift)"),
-        "param_set": Effect(tuple(PARAM_SETS), "table_4_2",
-                            "parameter set (Table 4.2, 100 W design/prototype, App. J)"),
-        "controller": Effect(("none", "pwm", "resonant", "motor_resonant", "energy_packet"), "pwm",
+        "mechanism": Effect(("step_up", "step_up_down"), "step_up",
+                            "which drive: step-up (Fig 3.3) or step-up/step-down (Fig 3.4)"),
+        "controller": Effect(("pwm", "resonant", "motor_resonant", "energy_packet"), "pwm",
                              "switching algorithm (App. E / App. F)"),
         "clutch_matching": Effect((True, False), False,
                                   "step-up: delay clutch engagement to the velocity match (Eq 2.1)"),
@@ -66,4 +64,8 @@ SPEC = ModelSpec(
     cases="mbsuite.models.drives.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),
+    commands="mbsuite.models.drives.cli",
+    moved_scenes={name: f"rotational/{name}" for name in (
+        "coupled_clutches", "msl_friction", "msl_one_way_clutch", "msl_one_way_clutch_disengaged",
+        "msl_simple_gear_shift")},
 )

@@ -5,15 +5,11 @@ Headlines (`headlines(scene)`; names are `[accuracy]` keys):
   refinement must not add or drop one. Its tolerance is 0.5 (the counts of all three levels equal); a count that
   differs is an estimate >= 1 and fails first (it is the first headline), so event times of lists of different
   lengths are never passed as an accuracy;
-- the thesis drives (step-up, step-up/step-down): the mean load and motor speeds over [t_settle, T] (the angle
+- the mean load and motor speeds over [t_settle, T] (the angle
   travelled over the time, `drive.mean_speeds`: no quadrature error of the output grid), the efficiency E_out/E_in
   over the same window (Eq 3.22 corrected; where the scene has a load torque), and the first lock-up at or after
   t_settle of each switched element (brake and clutch of the step-up drive, clutches a and b of the step-up/step-down
-  drive): the event the work-precision study's physics metric compares (`cases.DrivesStudy`);
-- the Modelica examples (CoupledClutches and the four `msl_*`): every lock-up of the mode sequence the Modelica
-  Association's reference results (CoupledClutches, Friction, OneWayClutch) or the MSL equations' closed forms
-  (OneWayClutchDisengaged, SimpleGearShift) give (`LOCKUPS`; k-th lock-up of an element: `t_lock_<element>_<k>`), and
-  the speed of every inertia at the end of the run (`w_end_<inertia>`).
+  drive): the event the work-precision study's physics metric compares (`cases.DrivesStudy`).
 
 Refinement: the hand path (event-exact, DOP853 between events) by dividing rtol and atol by 10 per level
 (`rtol_refinement`: nominal order 1 in the tolerance); MuJoCo by halving the step (`REFINE_ORDER`, see there).
@@ -40,22 +36,6 @@ from .drive import T0_TOL
 SWITCHED = {"step_up": {"brake": "spring_ground", "clutch": "clutch"},
             "step_up_down": {"clutch_a": "clutch_a", "clutch_b": "clutch_b"}}
 
-#: lock-ups per element of each Modelica example: CoupledClutches, Friction and OneWayClutch from the Modelica
-#: Association's reference results (`data/msl/`), OneWayClutchDisengaged and SimpleGearShift from the MSL
-#: equations' closed forms (tests/drives/test_msl.py); a test reads them back from those sources
-LOCKUPS = {"coupled_clutches": {"clutch1": 2, "clutch2": 1, "clutch3": 1},
-           "msl_friction": {"clutch": 3, "brake": 1},
-           "msl_one_way_clutch": {"oneWayClutch": 5},
-           "msl_one_way_clutch_disengaged": {"oneWayClutch": 4},
-           "msl_simple_gear_shift": {"clutch": 1}}
-
-#: inertias whose end speed is a headline (signal `<name>.w`)
-INERTIAS = {"coupled_clutches": ("J1", "J2", "J3", "J4"),
-            "msl_friction": ("inertia1", "inertia2", "inertia3"),
-            "msl_one_way_clutch": ("inertiaIn", "inertiaOut"),
-            "msl_one_way_clutch_disengaged": ("inertiaIn", "inertiaOut"),
-            "msl_simple_gear_shift": ("engine", "load")}
-
 #: nominal order of the MuJoCo path in the step: whatever the integrator, lock-ups are applied at the step after the
 #: slip changes sign and sliding torques are held over a step, so lock-up times and everything they move converge at
 #: first order (the scenes' comments: "lock timing first-order in dt")
@@ -64,23 +44,20 @@ REFINE_ORDER = 1.0
 #: count tolerance: the number of events must be the same at every level
 COUNT_TOL = 0.5
 
-#: declared tolerances at the shipped settings, per path and kind, measured on all 18 shipped scenes at their defaults
+#: declared tolerances at the shipped settings, per path, measured on all 13 shipped scenes at their defaults
 #: (`nice .venv/bin/python scripts/drives_accuracy.py`: the estimate of `--error-estimate` and the true error against
 #: the hand path at rtol 1e-12 / MuJoCo at 1/16 of the step; README, Declared accuracy). Hand path (rtol 1e-9):
-#: speeds 3.3e-5 rad/s (susd_100w_efficiency), efficiency 8.3e-8 (same), lock-ups 2.5e-9 s (the OneWayClutch's
-#: grazing lock; thesis drives <= 1.0e-9), end speeds 1.6e-8 rad/s (CoupledClutches): bounds 9x, 12x, 4x, 6x.
-#: MuJoCo (RK4 at the scenes' 1e-4 / 2e-5 / 1e-5 s), Modelica examples: lock-ups 3.1e-4 s (the grazing lock, 3 steps;
-#: others <= 2.8e-5), end speeds 4.0e-5 rad/s (CoupledClutches): bounds 3.2x, 5x. MuJoCo, open-loop thesis drives:
+#: speeds 3.3e-5 rad/s (susd_100w_efficiency), efficiency 8.3e-8 (same), lock-ups <= 1.0e-9 s: bounds 9x, 12x,
+#: 10x.
+#: MuJoCo (RK4 at the scenes' 1e-4 / 2e-5 / 1e-5 s), open-loop drives:
 #: speeds 1.09 rad/s (susd_500w_open; true 0.52), efficiency 1.9e-3 (same), lock-ups 3.0e-3 s estimated
 #: (susd_100w_reverse: a computed wait truncating to the next controller sample between the levels) and 4.1e-3 s true
 #: (step_up_motor_resonant: two 2 ms samples, at 1/16 of the step only, which no estimate from the step and its halves
 #: can see): bounds 3.7x, 5.3x, 3.7x (of the true 4.1e-3). The closed-loop scenes on MuJoCo change their number of
 #: events under refinement (n_events fails: README).
-TOL: dict[tuple[str, str], dict[str, float]] = {
-    ("reference", "drive"): {"speed": 3e-4, "efficiency": 1e-6, "t_lock": 1e-8},
-    ("reference", "modelica"): {"t_lock": 1e-8, "w_end": 1e-7},
-    ("mujoco", "drive"): {"speed": 4.0, "efficiency": 1e-2, "t_lock": 1.5e-2},
-    ("mujoco", "modelica"): {"t_lock": 1e-3, "w_end": 2e-4},
+TOL: dict[str, dict[str, float]] = {
+    "reference": {"speed": 3e-4, "efficiency": 1e-6, "t_lock": 1e-8},
+    "mujoco": {"speed": 4.0, "efficiency": 1e-2, "t_lock": 1.5e-2},
 }
 
 
@@ -90,31 +67,25 @@ def _path(scene: Any) -> str:
 
 def _has_load_torque(scene: Any) -> bool:
     """A drive with a Coulomb load torque tau_l > 0 (its output work defines the efficiency)."""
-    p = scene.build_params().resolved(scene.effects["param_set"])
+    p = scene.build_params().resolved()
     return bool(p["tau_l"])
 
 
 def headlines(scene: Any) -> tuple[Headline, ...]:
     """The scene's headlines (module docstring), tolerances of its path."""
     mech = scene.effects["mechanism"]
-    tol = TOL[_path(scene), "drive" if mech in SWITCHED else "modelica"]
-    out = [Headline("n_events", "1", COUNT_TOL, "number of mode changes of the run (must not change under refinement)")]
-    if mech in SWITCHED:
-        out += [Headline("mean_load_speed", "rad/s", tol["speed"], "mean load speed over [t_settle, T]"),
-                Headline("mean_motor_speed", "rad/s", tol["speed"], "mean motor speed over [t_settle, T]")]
-        if _has_load_torque(scene):
-            out.append(Headline("efficiency", "1", tol["efficiency"], "E_out / E_in over [t_settle, T]"))
-        out += [Headline(f"t_lock_{k}", "s", tol["t_lock"], f"first lock-up of the {k.replace('_', ' ')} at "
-                         "t >= t_settle (none in the window: NaN, an infinite estimate)") for k in SWITCHED[mech]]
-        return tuple(out)
-    for el, n in LOCKUPS[mech].items():
-        out += [Headline(f"t_lock_{el}_{k}", "s", tol["t_lock"], f"lock-up {k} of {el}") for k in range(1, n + 1)]
-    out += [Headline(f"w_end_{b}", "rad/s", tol["w_end"], f"speed of {b} at the end of the run")
-            for b in INERTIAS[mech]]
+    tol = TOL[_path(scene)]
+    out = [Headline("n_events", "1", COUNT_TOL, "number of mode changes of the run (must not change under refinement)"),
+           Headline("mean_load_speed", "rad/s", tol["speed"], "mean load speed over [t_settle, T]"),
+           Headline("mean_motor_speed", "rad/s", tol["speed"], "mean motor speed over [t_settle, T]")]
+    if _has_load_torque(scene):
+        out.append(Headline("efficiency", "1", tol["efficiency"], "E_out / E_in over [t_settle, T]"))
+    out += [Headline(f"t_lock_{k}", "s", tol["t_lock"], f"first lock-up of the {k.replace('_', ' ')} at "
+                     "t >= t_settle (none in the window: NaN, an infinite estimate)") for k in SWITCHED[mech]]
     return tuple(out)
 
 
-def _locks(events: list[dict], element: str, t0: float = -math.inf) -> list[float]:
+def _locks(events: list[dict], element: str, t0: float) -> list[float]:
     return [float(e["t"]) for e in events if e["element"] == element and e["to"] == "stuck" and e["t"] >= t0]
 
 
@@ -129,22 +100,14 @@ def values(scene: Any, res: Any) -> dict[str, float]:
     """The headline values of a run's result (NaN for a lock-up that did not happen)."""
     mech = scene.effects["mechanism"]
     out = {"n_events": float(len(res.events))}
-    if mech in SWITCHED:
-        cyc = res.stats.get("cycles", {})
-        out["mean_load_speed"] = float(cyc.get("mean_load_speed", math.nan))
-        out["mean_motor_speed"] = float(cyc.get("mean_motor_speed", math.nan))
-        if _has_load_torque(scene):
-            out["efficiency"] = float(cyc.get("efficiency", math.nan))
-        for k, el in SWITCHED[mech].items():
-            t = _locks(res.events, el, scene.solver.t_settle - T0_TOL)
-            out[f"t_lock_{k}"] = t[0] if t else math.nan
-        return out
-    for el, n in LOCKUPS[mech].items():
-        t = _locks(res.events, el)
-        for k in range(1, n + 1):
-            out[f"t_lock_{el}_{k}"] = t[k - 1] if len(t) >= k else math.nan
-    for b in INERTIAS[mech]:
-        out[f"w_end_{b}"] = float(res.stats["final"][f"{b}.w"])
+    cyc = res.stats.get("cycles", {})
+    out["mean_load_speed"] = float(cyc.get("mean_load_speed", math.nan))
+    out["mean_motor_speed"] = float(cyc.get("mean_motor_speed", math.nan))
+    if _has_load_torque(scene):
+        out["efficiency"] = float(cyc.get("efficiency", math.nan))
+    for k, el in SWITCHED[mech].items():
+        t = _locks(res.events, el, scene.solver.t_settle - T0_TOL)
+        out[f"t_lock_{k}"] = t[0] if t else math.nan
     return out
 
 

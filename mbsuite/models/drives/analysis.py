@@ -10,15 +10,13 @@ from typing import Any
 
 import numpy as np
 
-from ...analysis.errorestimate import run_values
+from ...components.rotational.interfaces import RefResult, RotorSystem
 from ...errors import SceneError
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
 from ...trust.health import judge
-from . import coupled_clutches as cc
 from . import design as D
 from . import drive, mujoco, reference
-from .rotor_system import RefResult, RotorSystem
 
 #: each path's simulation of a scene, returning (result, controller, rotor system) for the analyses: the runs behind
 #: `SPEC.paths` ("reference" = `reference.run`, "mujoco" = `mujoco.run`) before their `SimResult` is assembled
@@ -49,7 +47,7 @@ def _efficiency_point(scene: Scene, res: RefResult, ctrl: Any, system: RotorSyst
     cs = drive.cycle_stats(res, ctrl, t0=t0) if ctrl is not None else {}
     means = drive.mean_speeds(res, t0)
     out = {
-        "tau_l": float(scene.build_params().resolved(scene.effects["param_set"])["tau_l"] or 0.0),
+        "tau_l": float(scene.build_params().resolved()["tau_l"] or 0.0),
         "load_speed": means.get("mean_load_speed", float("nan")),
         "motor_speed": means.get("mean_motor_speed", float("nan")),
         "P_in": bal.input / T, "P_out": bal.output / T,
@@ -128,8 +126,6 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
     parallel batch) and its efficiency-curve headlines (`EFFICIENCY_HEADLINES`) get an estimated error: a table per
     point and `data["points"][i]["error_estimate"]`; an estimate past its tolerance is an `AccuracyError` naming the
     point (a warning in `data["warnings"]` when the scene allows inaccurate results)."""
-    if scene.effects["mechanism"] == "coupled_clutches":
-        raise SceneError("efficiency needs a drive scene (mechanism step_up or step_up_down)")
     if scene.effects.get("closed_loop"):
         raise SceneError("efficiency curves are open-loop runs: use a scene with closed_loop = false")
     pts, scenes, bases = [], [], []
@@ -246,41 +242,3 @@ def design_tables() -> Report:
     return Report(data, table + "\n'ours' and 'thesis' are in the unit of the row.", write)
 
 
-def coupled_clutches_table(timestep: float = 1e-4, *, error_estimate: bool = False, workers: int = 0,
-                           scene: Scene | None = None) -> dict[str, Any]:
-    """Both paths against the Dymola reference: mode sequence with event times, and w1..w4 every 0.1 s. The runs are
-    the scene `drives/coupled_clutches` (or `scene`) on each path, MuJoCo at `timestep`: the settings of
-    `mbsuite run drives/coupled_clutches [--engine mujoco]`. `error_estimate`: each path's headlines (`accuracy.py`)
-    also get their estimated error from the scene refined once and twice (`out[path]["error_estimate"]`, an
-    `ErrorEstimate`)."""
-    from ...scenes import load_scene
-
-    base = scene if scene is not None else load_scene("drives/coupled_clutches")
-    ref = cc.load_reference()
-    rev = cc.reference_events(ref)
-    out: dict[str, Any] = {"reference_events": rev}
-    grid = np.round(np.arange(0.0, cc.T_END + 1e-9, 0.1), 10)
-    j_ref = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
-    out["grid"] = grid.tolist()
-    out["w_ref"] = ref["w"][:, j_ref].T.tolist()
-    scenes = {"reference": base.replace(solver={"engine": "reference"}),
-              "mujoco": base.replace(solver={"engine": "mujoco", "timestep": timestep})}
-    bases = {}
-    for eng, sc in scenes.items():
-        run = simulate_scene(sc)
-        res = run[0]
-        bases[eng] = _headlines_of(sc, *run)
-        ev = cc.events_as_codes(res.events)
-        rows = cc.match_events(ev, rev)
-        idx = [int(np.argmin(np.abs(res.t - tt))) for tt in grid]
-        w = res.w[:, idx].T
-        dts = [r["t"] - r["t_ref"] for r in rows if r["t"] is not None and r["t_ref"] is not None]
-        out[eng] = {"events": rows, "w": w.tolist(),
-                    "same_sequence": all(r["t"] is not None and r["t_ref"] is not None for r in rows),
-                    "max_event_dt": float(max(abs(x) for x in dts)) if dts else math.nan,
-                    "max_w_err": float(np.max(np.abs(w - np.asarray(out["w_ref"]))))}
-    if error_estimate:
-        ests = estimate_points(list(scenes.values()), list(bases.values()), run_values, None, workers)
-        for eng, est in zip(scenes, ests, strict=True):
-            out[eng]["error_estimate"] = est
-    return out

@@ -10,56 +10,19 @@ import numpy as np
 
 from ... import load_scene, run
 from ...analysis.workprecision import Setting, Study, _rel
+from ...components.rotational.event_exact import simulate_reference
+from ...components.rotational.interfaces import Friction, Part, RotorSystem, Source, Spring
+from ...components.rotational.mujoco_sim import MujocoRotorSim
 from ...engines.inputs import Step
 from ...errors import SceneError
 from ...hardcases import Checker, HardCase
 from ...paths import mjcf_path
 from ...scenes import Scene
-from . import coupled_clutches as cc
-from .event_exact import simulate_reference
-from .mujoco import MujocoRotorSim
-from .rotor_system import Friction, Part, RotorSystem, Source, Spring
 
 
 # ================================================================================================ hard cases
 # Each case is the one source of truth for its situation (the model tests do not re-test it). Bounds carry the value
 # measured when they were set (hand path DOP853 at the default rtol, MuJoCo RK4) and the factor above it.
-def _drives_coupled_clutches(ck: Checker) -> None:
-    ref = cc.load_reference()
-    rev = cc.reference_events(ref)
-    hand = simulate_reference(cc.build_system(), cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
-    mj = MujocoRotorSim(cc.build_system(), mjcf_path("coupled_clutches"), timestep=1e-4).run(
-        cc.Q0, cc.W0, cc.T_END, sample_dt=5e-4)
-    # vs Dymola: hand 1e-5 s (measured 4.1e-6; the reference's own event accuracy at DASSL tol 1e-6 is a few us);
-    # MuJoCo within one timestep, 1e-4 s (measured 4.7e-5; the path resolves an event only to its step)
-    for name, res, tol in (("hand path", hand, 1e-5), ("MuJoCo", mj, 1e-4)):
-        rows = cc.match_events(cc.events_as_codes(res.events), rev)
-        same = all(r["t"] is not None and r["t_ref"] is not None for r in rows)
-        ck.true(f"{name}: same clutch mode sequence as Dymola (lock/unlock x {len(rows)})", same and len(rows) == 9)
-        dts = [abs(r["t"] - r["t_ref"]) for r in rows if r["t"] is not None and r["t_ref"] is not None]
-        ck.le(f"{name}: max |event time - Dymola| (s)", max(dts) if dts else math.inf, tol)
-        ck.finite(f"{name} speeds", res.w)
-    # MuJoCo vs the event-exact hand path: interpolated event time within one step (measured 4.7e-5 s), the step at
-    # which the change is applied within two (measured 1.5e-4 s)
-    same = [(a["element"], a["from"], a["to"]) for a in mj.events] == [(b["element"], b["from"], b["to"])
-                                                                       for b in hand.events]
-    ck.true("MuJoCo: same events as the hand path", same)
-    if same:
-        ck.le("MuJoCo vs hand: max |t_event| (s)", max(abs(a["t"] - b["t"]) for a, b in zip(mj.events, hand.events,
-                                                                                             strict=True)), 1e-4)
-        ck.le("MuJoCo vs hand: max |t_applied - t_event| (s)",
-              max(abs(a["t_step"] - b["t"]) for a, b in zip(mj.events, hand.events, strict=True)), 2e-4)
-    # speeds every 0.1 s: hand vs Dymola 1e-4 rad/s (measured 6.0e-5, the reference's accuracy); MuJoCo vs hand
-    # 2e-4 rad/s (measured 4.6e-5, 4x)
-    grid = np.round(np.arange(0, cc.T_END + 1e-9, 0.1), 10)
-    j = [int(np.nonzero(np.isclose(ref["t"], tt))[0][-1]) for tt in grid]
-    i = [int(np.argmin(np.abs(hand.t - tt))) for tt in grid]
-    ck.le("hand vs Dymola: max |w| on the 0.1 s grid (rad/s)", np.max(np.abs(hand.w[:, i] - ref["w"][:, j])), 1e-4)
-    ck.le("MuJoCo vs hand: max |w| on the 0.1 s grid (rad/s)", np.max(np.abs(mj.w[:, i] - hand.w[:, i])), 2e-4)
-    ck.true("MuJoCo warnings", not mj.stats["warnings"], mj.stats["warnings"])
-    ck.le("hand path RHS calls (measured 2664)", hand.stats.get("nfev", 0), 10_000)
-
-
 def _rotors(frictions, J, springs=(), sources=(), breaks=()):
     return RotorSystem(names=["motor", "spring", "load"], J=np.asarray(J, float), B=np.zeros(3),
                        frictions=list(frictions), springs=list(springs), sources=list(sources), breaks=list(breaks))
@@ -177,71 +140,7 @@ def _drives_energy_balance(ck: Checker) -> None:
                 res.stats["energy_balance"]["relative"]), 2e-7)
 
 
-def _drives_freewheel_grazing(ck: Checker) -> None:
-    """The OneWayClutch released at t_r = 7/6 + asin(3e-5)/(6 pi) (holding torque 5 sin(6 pi (t - 7/6)) reaching
-    tau0_max_low = 1.5e-4) closes again tangentially at 8/3 - t_r and is released at 1.5 + asin(3e-5)/(6 pi)."""
-    from . import msl
-
-    s = math.asin(3e-5) / (6 * math.pi)
-    closed = {"release": 7 / 6 + s, "lock": 1.5 - s, "release2": 1.5 + s}
-    ex = msl.example("msl_one_way_clutch")
-    hand = simulate_reference(ex.system, ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
-    mj = MujocoRotorSim(ex.system, mjcf_path("drive_msl_one_way_clutch"), timestep=1e-4).run(
-        ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
-    # hand path 1e-9 s (measured 1.1e-10 at the default rtol, 2e-12 at rtol 1e-10); MuJoCo 2 steps, 2e-4 s
-    # (measured 1.24e-4: the release is applied up to 1.5 steps late and t_lock = 8/3 - t_release carries it over)
-    for name, res, tol in (("hand path", hand, 1e-9), ("MuJoCo", mj, 2e-4)):
-        got = {"release": [e["t"] for e in res.events if e["to"] == "forward" and abs(e["t"] - 7 / 6) < 1e-3],
-               "lock": [e["t"] for e in res.events if e["to"] == "stuck" and abs(e["t"] - 1.5) < 1e-3],
-               "release2": [e["t"] for e in res.events if e["to"] == "forward" and abs(e["t"] - 1.5) < 1e-3]}
-        ck.true(f"{name}: one release near 7/6 s, one lock and one release at the tangency near 1.5 s",
-                all(len(v) == 1 for v in got.values()), got)
-        ck.le(f"{name}: max |t - closed form| of those three (s)",
-              max((abs(v[0] - closed[k]) for k, v in got.items() if v), default=math.inf), tol)
-        ck.true(f"{name}: 9 mode changes (as the reference)", len(res.events) == 9, len(res.events))
-        ck.finite(f"{name} speeds", res.w)
-
-
-def _drives_planetary_handover(ck: Checker) -> None:
-    from . import msl
-
-    ex = msl.example("msl_simple_gear_shift")
-    hand = simulate_reference(ex.system, ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
-    mj = MujocoRotorSim(ex.system, mjcf_path("drive_msl_simple_gear_shift"), timestep=1e-4).run(
-        ex.q0, ex.w0, ex.t_end, sample_dt=1e-3)
-    for name, res in (("hand path", hand), ("MuJoCo", mj)):
-        seq = [(e["element"], e["to"]) for e in res.events]
-        ck.true(f"{name}: clutch engages, brake slips, brake free, clutch locks", seq == [
-            ("clutch", "backward"), ("brake", "forward"), ("brake", "free"), ("clutch", "stuck")], seq)
-        # rigid 1:1 after the clutch lock: measured 8.8e-16 (hand), 7.2e-13 (MuJoCo, the soft lock's residual)
-        ck.le(f"{name}: final |w_engine - w_load| / w_load (rigid 1:1 after the shift)",
-              abs(res.w[0, -1] - res.w[1, -1]) / abs(res.w[1, -1]), 1e-10)
-    same = len(hand.events) == len(mj.events)
-    ck.le("MuJoCo vs hand: max event time difference (s)",
-          max(abs(a["t"] - b["t"]) for a, b in zip(hand.events, mj.events, strict=True)) if same else math.inf,
-          1e-4 + 1e-12)
-
-
 HARD_CASES: tuple[HardCase, ...] = (
-    HardCase("drives_freewheel_grazing_lock", "drives",
-             "a freewheel whose slip touches zero tangentially (the input torque reverses as the speeds meet)",
-             "drives/msl_one_way_clutch at 1.5 s, both paths",
-             "the release near 7/6 s and the lock and release at the tangency at their closed-form "
-             "times within 1e-9 s (hand) / 2e-4 s (MuJoCo); 9 mode changes",
-             _drives_freewheel_grazing),
-    HardCase("drives_planetary_handover", "drives",
-             "clutch/brake hand-over across an ideal planetary with a massless ring (general elements, tendon locks)",
-             "drives/msl_simple_gear_shift, 5 s, both paths",
-             "the MSL sequence (clutch bwd, brake fwd, brake free, clutch stuck); 1:1 after the shift within "
-             "1e-10; paths within one MuJoCo step (1e-4 s; the engagement at 2.0+ s lands on the next step: measured "
-             "exactly one)",
-             _drives_planetary_handover),
-    HardCase("drives_clutch_lock_unlock", "drives",
-             "clutch stick/slip with nested mode changes (Modelica CoupledClutches)",
-             "drives/coupled_clutches machinery, both paths vs the Dymola result",
-             "same mode sequence; event times vs Dymola within 1e-5 s (hand) / 1e-4 s (MuJoCo), MuJoCo vs hand 1e-4 s; "
-             "speeds every 0.1 s within 1e-4 (hand vs Dymola) / 2e-4 rad/s (MuJoCo vs hand); hand RHS calls <= 1e4",
-             _drives_coupled_clutches),
     HardCase("drives_load_reversal", "drives",
              "Coulomb load on a spring reversing direction: chatter or stall at every reversal",
              "rotor system: load with 0.05 N m Coulomb friction on a 1 N m/rad spring, 2 s",
@@ -277,29 +176,20 @@ class DrivesStudy(Study):
     1e-12 (checked against rtol 1e-11; the hand path has one integrator, so the MuJoCo rows are the different-method
     comparison). State error: max |w - w_ref| / max |w_ref| over the rotors. Physics metric: relative errors of the
     cycle-mean load speed and of the efficiency E_out/E_in over [t_settle, T], and the lock-up time error (max over
-    matched stick events) over the energy-cycle period (CoupledClutches: over 0.1 s)."""
+    matched stick events) over the energy-cycle period."""
 
     HAND_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
     MJ_INTEGRATORS = ("rk4", "euler")
     MJ_STEPS = (1e-4, 5e-5, 2e-5)
     state_doc = "max_t |w_i - w_i,ref| / max_t,i |w_ref| over the rotor speeds, on the output grid"
     physics_doc = ("max(rel. error of cycle-mean load speed and of efficiency E_out/E_in over [t_settle, T]; max "
-                   "lock-up time error / energy-cycle period (CoupledClutches: / 0.1 s))")
+                   "lock-up time error / energy-cycle period)")
 
     def __init__(self, scene: Scene, quick: bool = False, duration: float | None = None):
         super().__init__(scene, quick)
-        from . import msl
-
-        mech = scene.effects["mechanism"]
-        is_cc = mech == "coupled_clutches" or mech in msl.EXAMPLES  # no controller: lock times over 0.1 s
-        self.cc = is_cc
         T = min(scene.solver.duration, duration or (1.0 if quick else 2.0))
-        ts = 0.0 if is_cc else T / 2
-        if mech in msl.EXAMPLES:
-            ex = msl.example(mech)
-            self.speeds = [k for k in ex.signals if ex.units[k] == "rad/s"]
-        else:
-            self.speeds = ["w1", "w2", "w3", "w4"] if is_cc else ["w_motor", "w_spring", "w_load"]
+        ts = T / 2
+        self.speeds = ["w_motor", "w_spring", "w_load"]
         # the study measures the error of loose settings: a health figure past its bound is kept, not refused
         self.base = scene.replace(solver={"duration": T, "t_settle": ts, "allow_inaccurate": True},
                                   outputs=[*self.speeds, "E_in", "E_out"])
@@ -341,21 +231,20 @@ class DrivesStudy(Study):
         period), relative; returns (error, details)."""
         det = {}
         period = 0.1
-        if not self.cc:
-            cr, cf = res.stats.get("cycles", {}), ref.stats.get("cycles", {})
-            if abs(cf.get("mean_load_speed", 0.0)) > 0:
-                det["load_speed_rel"] = _rel(cr.get("mean_load_speed", math.nan), cf["mean_load_speed"])
-            if cf.get("switching_rate"):
-                period = 1.0 / cf["switching_rate"]
+        cr, cf = res.stats.get("cycles", {}), ref.stats.get("cycles", {})
+        if abs(cf.get("mean_load_speed", 0.0)) > 0:
+            det["load_speed_rel"] = _rel(cr.get("mean_load_speed", math.nan), cf["mean_load_speed"])
+        if cf.get("switching_rate"):
+            period = 1.0 / cf["switching_rate"]
 
-            def eff(r):
-                m = r.t >= self.ts
-                ein = r["E_in"][m][-1] - r["E_in"][m][0]
-                return (r["E_out"][m][-1] - r["E_out"][m][0]) / ein if ein else math.nan
+        def eff(r):
+            m = r.t >= self.ts
+            ein = r["E_in"][m][-1] - r["E_in"][m][0]
+            return (r["E_out"][m][-1] - r["E_out"][m][0]) / ein if ein else math.nan
 
-            e_ref = eff(ref)
-            if math.isfinite(e_ref) and e_ref > 0:  # a scene without an output torque has no efficiency to compare
-                det["efficiency_rel"] = _rel(eff(res), e_ref)
+        e_ref = eff(ref)
+        if math.isfinite(e_ref) and e_ref > 0:  # a scene without an output torque has no efficiency to compare
+            det["efficiency_rel"] = _rel(eff(res), e_ref)
         lr, lf = self._locks(res), self._locks(ref)
         by_el: dict[str, tuple[list, list]] = {}
         for el, t in lf:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import textwrap
 from functools import partial
 from pathlib import Path
@@ -17,18 +16,17 @@ from ...errors import MbsuiteError, SceneError
 from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
-from ...scenes import DEFAULT_MAX_STEPS, load_scene, scene_from_dict
+from ...scenes import scene_from_dict
 from ...trust.health import judge
 from . import accuracy
-from . import coupled_clutches as cc
 from . import design as D
-from .analysis import coupled_clutches_table, design_tables, efficiency, simulate_scene
+from .analysis import design_tables, efficiency, simulate_scene
 from .design_scene import BASE_SETS, DesignInputs, design_scene, scene_toml
-from .plots import cadjs_figure, coupled_clutches_figure, loss_label, run_figure
+from .plots import cadjs_figure, loss_label, run_figure
 from .scene_run import sim_result
 
 #: the commands `register` adds (read by the command line's light parser without importing the model)
-CLI_COMMANDS = {"drive": "switched-mode drives: design tools, runs, efficiency, CoupledClutches",
+CLI_COMMANDS = {"drive": "switched-mode drives: design tools, runs, efficiency",
                 "drives": "switched-mode drives (as `mbsuite drive`)"}
 
 #: names and units of the cycle statistics of a drive run (`drive.cycle_stats`)
@@ -42,8 +40,6 @@ CYCLE_QUANTITIES = {"n_cycles": ("energy cycles in the window t >= t_settle", ""
 STUDY_UNITS = {**{k: u for k, (_, u) in CYCLE_QUANTITIES.items()}, "input": "J", "output": "J", "stored": "J",
                "residual": "J", "relative": "1", "duration": "s", "P_in": "W", "P_out": "W"}
 
-#: most time steps of `drive coupled-clutches` (scene runs are guarded by the scene's solver.max_steps)
-MAX_STEPS = DEFAULT_MAX_STEPS
 #: most entries of a comma list option (--srmin, --js, --loads)
 MAX_LIST = 1000
 
@@ -70,7 +66,6 @@ OPTION_LIMITS: dict[str, Limit] = {
     "--btotal": Limit(lo=0.0, hi=1e5, unit="N m s", doc="total viscous coefficient"),
     "--duration": Limit(**_POS, hi=1e5, unit="s", doc="simulated time"),
     "--loads": Limit(lo=-1e4, hi=1e4, unit="N m", doc="load torque"),
-    "--timestep": Limit(**_POS, hi=1e-2, unit="s", doc="MuJoCo timestep"),
     "--wop": Limit(lo=0.0, hi=1e5, unit="rad/s", doc="operating speed of the design's scene"),
     "--pmotor": Limit(**_POS, hi=1e7, unit="W", doc="largest motor power (at --vm)"),
     "--scene-duration": Limit(**_POS, hi=1e5, unit="s", doc="simulated time of the design's scene"),
@@ -129,14 +124,6 @@ def _check_speed_range(wmin: float, wmax: float) -> None:
                            "[w_min, w_max] of the design)")
 
 
-def _check_steps(flag: str, duration: float, dt: float) -> None:
-    """Size guard: duration / dt time steps (or samples) at most MAX_STEPS."""
-    n = duration / dt
-    if n > MAX_STEPS:
-        raise MbsuiteError(f"{flag}: {duration:g} s at a step of {dt:g} s is {n:.3g} steps; at most {MAX_STEPS:.3g} "
-                           "(shorten the run or enlarge the step)")
-
-
 def _csv_writer(name: str, columns: list[tuple[str, str, list]], figure=None):
     """A `Report.write`: `name`.csv from `(column, unit, values)` and, if `figure` (a callable returning a Figure)
     is given, `name`.png."""
@@ -159,10 +146,10 @@ def _quantity_table(items: list[tuple[str, str, float | str, str]]) -> str:
 
 def register(sub, add_common, emit) -> str:
     """Add the `drive` command group (alias `drives`) to the top-level parser: design tools, scene runs, efficiency
-    sweeps and the CoupledClutches check; returns the group's command name. Every command prints a table with units;
+    sweeps; returns the group's command name. Every command prints a table with units;
     `--out DIR` writes CSV (SI units in the header), a PNG where a figure makes sense and summary.json."""
     p = sub.add_parser("drive", aliases=["drives"],
-                       help="switched-mode drives: design tools, runs, efficiency, CoupledClutches")
+                       help="switched-mode drives: design tools, runs, efficiency")
     dsub = p.add_subparsers(dest="drive_command", required=True)
 
     # -- design --------------------------------------------------------------------------------------------------
@@ -247,13 +234,6 @@ def register(sub, add_common, emit) -> str:
     add_study_options(q)
     add_common(q)
     q.set_defaults(func=partial(efficiency_cmd, emit))
-
-    q = dsub.add_parser("coupled-clutches", help="Modelica CoupledClutches: both paths vs the Dymola reference")
-    q.add_argument("--timestep", type=float, default=1e-4, help="MuJoCo step (s; the scene's default)")
-    add_scene_options(q)
-    add_error_estimate(q)
-    add_common(q)
-    q.set_defaults(func=partial(coupled_clutches_cmd, emit))
     return "drive"
 
 
@@ -437,73 +417,12 @@ def efficiency_of(sc, a: argparse.Namespace) -> Report:
     return rep
 
 
-def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
-    """`drive coupled-clutches`: both paths against the Dymola reference (`analysis.coupled_clutches_table`)."""
-    _check_options(a, "--timestep")
-    _check_steps("--timestep", cc.T_END, a.timestep)
-    scene = _solver_options(load_scene("drives/coupled_clutches"), a)
-    d = coupled_clutches_table(timestep=a.timestep, error_estimate=a.error_estimate, scene=scene)
-    estimates = ""
-    for eng in ("reference", "mujoco"):  # each path's estimate against its tolerances (AccuracyError naming it)
-        est = d[eng].pop("error_estimate", None)
-        if est is None:
-            continue
-        d[eng]["error_estimate"] = est.to_dict()
-        warned = judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
-                       what=f"drives coupled-clutches, path {eng}")
-        estimates += f"\n\n{eng} path: " + est.table() + "".join("\n" + w for w in warned)
-    mode = {v: k for k, v in cc.MODE_CODE.items()}
-    rows = []
-    for i, r in enumerate(d["reference"]["events"]):
-        m = d["mujoco"]["events"][i]
-        rows.append([r["element"], mode.get(r["from"], r["from"]), mode.get(r["to"], r["to"]), r["t_ref"],
-                     r["t"], m["t"], None if r["t"] is None else r["t"] - r["t_ref"],
-                     None if m["t"] is None or r["t"] is None else m["t"] - r["t"]])
-    t1 = format_table(["clutch", "from", "to", "t_Dymola [s]", "t_hand [s]", "t_MuJoCo [s]", "hand-Dym [s]",
-                       "MuJoCo-hand [s]"], [r[:6] + [_e(x) for x in r[6:]] for r in rows], ".10g")
-    w_ref, w_h, w_m = (np.asarray(x) for x in (d["w_ref"], d["reference"]["w"], d["mujoco"]["w"]))
-    rows2 = [[g, *(np.round(wr, 6) + 0.0), _e(np.max(np.abs(wh - wr))), _e(np.max(np.abs(wm - wh)))]
-             for g, wr, wh, wm in zip(d["grid"], w_ref, w_h, w_m, strict=True)]
-    t2 = format_table(["t [s]"] + [f"w{k} [rad/s]" for k in range(1, 5)]
-                      + ["dw hand-Dym [rad/s]", "dw MuJoCo-hand [rad/s]"], rows2, ".6g")
-    t2 += ("\nw1..w4: speeds of the inertias J1..J4 (Dymola reference, rounded to 1e-6); dw: largest"
-           " |difference|\nover w1..w4 (every path's values: --out DIR, coupled_clutches_w.csv).")
-    ev_cols = [("clutch", "", [r[0] for r in rows]), ("from", "", [r[1] for r in rows]),
-               ("to", "", [r[2] for r in rows])]
-    ev_cols += [(n, "s", [_nan(r[i]) for r in rows]) for i, n in enumerate(
-        ("t_dymola", "t_hand", "t_mujoco", "hand_minus_dymola", "mujoco_minus_hand"), start=3)]
-    w_cols = [("t", "s", d["grid"])] + [(f"{src}_w{k + 1}", "rad/s", w[:, k]) for src, w in
-                                        (("dymola", w_ref), ("hand", w_h), ("mujoco", w_m)) for k in range(4)]
-    ref = cc.load_reference()
-    write = partial(_write_coupled_clutches, d, ref["t"], ref["w"], ev_cols, w_cols)
-    text = "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2 + estimates
-    emit(Report({"options": _options(a), **d}, text, write), a, scene.to_dict())
-
-
-def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,
-                            out: Path) -> list[Path]:
-    """The files of `drive coupled-clutches --out`: events and speeds as CSV, the comparison figure."""
-    fig = coupled_clutches_figure(d, ref_t, ref_w)
-    return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
-            write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),
-            save(fig, Path(out) / "coupled_clutches.png")]
-
-
 def _options(a: argparse.Namespace) -> dict:
-    """The options of a scene command as given (`--loads`, `--engine`, `--duration`, `--timestep`,
+    """The options of a scene command as given (`--loads`, `--engine`, `--duration`,
     `--error-estimate`, `--allow-inaccurate`, `--max-steps`; None: not given): with the scene, what reruns it."""
     return {flag: getattr(a, flag[2:].replace("-", "_")) for flag in (
-        "--loads", "--engine", "--duration", "--timestep", "--error-estimate", "--allow-inaccurate",
+        "--loads", "--engine", "--duration", "--error-estimate", "--allow-inaccurate",
         "--max-steps") if hasattr(a, flag[2:].replace("-", "_"))}
-
-
-def _e(x: float | None) -> str:
-    """A small difference for a table: 3 significant digits in exponent form, '-' for none."""
-    return "-" if x is None else f"{x:.2e}"
-
-
-def _nan(x: float | None) -> float:
-    return math.nan if x is None else float(x)
 
 
 def _scene(a: argparse.Namespace):

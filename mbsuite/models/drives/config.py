@@ -17,17 +17,10 @@ SET_MECHANISMS: dict[str, tuple[str, ...]] = {
     "proto_100w": ("step_up_down",),
     "proto_50w": ("step_up_down",),
     "example_500w": ("step_up_down",),
-    "modelica": ("coupled_clutches", "msl_friction", "msl_one_way_clutch", "msl_one_way_clutch_disengaged",
-                 "msl_simple_gear_shift"),
 }
 #: the controllers of each drive mechanism
 CONTROLLERS: dict[str, tuple[str, ...]] = {"step_up": ("pwm", "resonant", "motor_resonant"),
                                            "step_up_down": ("energy_packet",)}
-#: the effect values of a Modelica example (it carries its own parameters, sources and friction: a drive's
-#: controller, bearings, delays or PI do not apply)
-MODELICA_EFFECTS: dict[str, Any] = {"param_set": "modelica", "controller": "none", "closed_loop": False,
-                                    "clutch_matching": False, "anti_windup": True, "clutch_delays": False,
-                                    "bearing_friction": False, "added_motor_inertia": False}
 #: parameters that may stay unset (None) in a set: the controller then takes a documented default
 #: (max_tk = t_l / 2; K_ctrl = K, Omega_ctrl = sqrt(K/J_s), spring_max = min(tau_c1, tau_c2) / K; speeds 70 and 0
 #: rad/s), or the reference comes from the scene's input
@@ -39,13 +32,11 @@ MOTOR_LINE = ("tau_0", "tau_slope")
 
 def used_params(mechanism: str, effects: Mapping[str, Any], inp: Mapping[str, Any],
                 straight_line_motor: bool) -> set[str]:
-    """The `DriveParams` fields a drive of this configuration reads (empty for the Modelica examples).
+    """The `DriveParams` fields a drive of this configuration reads.
     `straight_line_motor`: the motor is App. J's tau_0 + tau_slope w (tau_0 set) rather than Eq 4.1."""
-    if mechanism not in CONTROLLERS:
-        return set()
     kind = effects["controller"]
     closed = bool(effects.get("closed_loop", False))
-    used = {"J_m", "J_s", "J_l", "K", "tau_l", "fs", "peak"}
+    used = {"set", "J_m", "J_s", "J_l", "K", "tau_l", "fs", "peak"}
     used |= set(MOTOR_LINE if straight_line_motor else MOTOR_EQ_4_1)
     if effects.get("bearing_friction", True):
         used |= {"B_m", "B_s", "B_l", "C_m", "C_s", "C_l"}
@@ -75,23 +66,14 @@ def used_params(mechanism: str, effects: Mapping[str, Any], inp: Mapping[str, An
     return used
 
 
-def check_scene(scene, resolved: Mapping[str, Any] | None) -> None:
+def check_scene(scene, resolved: Mapping[str, Any]) -> None:
     """Refuse a scene whose configuration does not read something it sets (a parameter, an input key, an effect),
     or whose parameter set lacks something the configuration reads: a `SceneError` naming the key, its value and
-    what would read it. `resolved`: the scene's parameters merged with its set (None for a Modelica example)."""
+    what would read it. `resolved`: the scene's parameters merged with its set."""
     eff = scene.effects
     mech = eff["mechanism"]
     # the scene by name (a value may have come from its file, from Python or from the command line)
     where = f" (scene {scene.name!r})" if scene.name else ""
-    if mech not in CONTROLLERS:
-        bad = {k: eff[k] for k, v in MODELICA_EFFECTS.items() if eff[k] != v}
-        if bad:
-            raise SceneError(f"effect(s) {bad}{where} do not apply to the Modelica example {mech!r} (it carries its "
-                             f"own parameters, sources and friction); its effects are {MODELICA_EFFECTS}")
-        if scene.params:
-            raise SceneError(f"parameter(s) {sorted(scene.params)}{where} are not read by the Modelica example "
-                             f"{mech!r} (its parameters are the Modelica Standard Library's); remove [params]")
-        return
     kind = eff["controller"]
     if kind not in CONTROLLERS[mech]:
         raise SceneError(f"effects.controller = {kind!r}{where} does not drive mechanism {mech!r}; valid: "
@@ -112,7 +94,6 @@ def check_scene(scene, resolved: Mapping[str, Any] | None) -> None:
         raise SceneError(f"input.value = {scene.input['value']!r} rad/s{where} has no effect on the open-loop step-up "
                          f"drive (controller {kind!r} switches on its duty/timing parameters); leave input.value out, "
                          "or set effects.closed_loop = true for the PI on t_k to track it")
-    assert resolved is not None
     line = resolved.get("tau_0") is not None
     used = used_params(mech, eff, scene.input, line)
     config = f"mechanism {mech!r}, controller {kind!r}, closed_loop = {str(closed).lower()}"
@@ -127,7 +108,8 @@ def check_scene(scene, resolved: Mapping[str, Any] | None) -> None:
                          f"read by this configuration ({config}){extra}; remove them. Read: {sorted(used)}")
     missing = sorted(k for k in used - OPTIONAL if resolved.get(k) is None)
     if missing:
-        ps = eff["param_set"]
+        ps = resolved["set"]
         made = [s for s, m in SET_MECHANISMS.items() if mech in m]
         raise SceneError(f"parameter set {ps!r}{where} is made for {list(SET_MECHANISMS.get(ps, ()))} and lacks "
-                         f"{missing} needed by {config}; set them in [params] or use a set for {mech!r}: {made}")
+                         f"{missing} needed by {config}; set them in [params] or use a set for {mech!r} "
+                         f"([params] set = one of {made})")

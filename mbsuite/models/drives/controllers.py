@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from ...components.rotational.commands import delay_samples, time_to_samples
 from ...errors import ParameterError
-from .commands import delay_samples, time_to_samples
 
 STEP_UP_CONTROLLERS = ("pwm", "resonant", "motor_resonant")
 

@@ -31,6 +31,7 @@ from ...errors import ParameterError, SceneError
 from ...limits import Limit, param, positive
 from ...schema import Rule, Section, of_dataclass
 from . import design as D
+from .config import check_scene
 from .params import PARAM_SETS, DriveParams
 
 #: the parameter sets whose motor, bearings, delays and controller rate a design scene may take (step-up/step-down)
@@ -146,14 +147,14 @@ def design_scene(inp: DesignInputs, name: str = "") -> dict[str, Any]:
         raise ParameterError(f"the design's free oscillation period 2 pi sqrt(J_s/K) = {period:.4g} s is not longer "
                              f"than the clutch delay {max(base['d_on'], base['d_off'])} s of the base set "
                              f"{inp.base!r}: choose a larger clutch torque tau_c or spring-system inertia J_s")
-    params = {"J_s": v["J_s"], "K": v["K"], "tau_c1": v["tau_c"], "tau_c2": v["tau_c"], "spring_max": v["x_max"],
-              "J_l": v["J_l"], "tau_l": v["tau_l"], "Kp": v["Kp"], "Ki": v["Ki"], "tau_0": v["tau_0"],
-              "tau_slope": v["tau_slope"]}
+    params = {"set": inp.base, "J_s": v["J_s"], "K": v["K"], "tau_c1": v["tau_c"], "tau_c2": v["tau_c"],
+              "spring_max": v["x_max"], "J_l": v["J_l"], "tau_l": v["tau_l"], "Kp": v["Kp"], "Ki": v["Ki"],
+              "tau_0": v["tau_0"], "tau_slope": v["tau_slope"]}
     desc = (f"{inp.P:g} W step-up/step-down drive designed by CADJS (Sr_min {inp.Sr_min:g} /s, load speed "
             f"{inp.w_min:g}-{inp.w_max:g} rad/s, motor {inp.V_m:g} rad/s), closed loop at {v['w_op']:g} rad/s")
     return {
         "model": "drives", "name": name, "description": desc,
-        "effects": {"mechanism": "step_up_down", "param_set": inp.base, "controller": "energy_packet",
+        "effects": {"mechanism": "step_up_down", "controller": "energy_packet",
                     "closed_loop": True, "added_motor_inertia": bool(base.get("J_add"))},
         "params": params,
         "input": {"type": "reference", "value": v["w_op"]},
@@ -232,9 +233,11 @@ SCENE_FROM_DESIGN = {"J_s": "J_s", "K": "K", "tau_c1": "tau_c", "tau_c2": "tau_c
 
 
 def scene_params(scene: Any) -> DriveParams:
-    """The `DriveParams` of a drives scene (`ModelSpec.params_builder`). A scene that carries a `[design]` record
-    must run what it records: each [params] value (and input.value) a design sets must equal its [design.derived]
-    value (to `DERIVED_RTOL`), else a SceneError names both keys."""
+    """The `DriveParams` of a drives scene (`ModelSpec.params_builder`, run when the scene loads). A scene that carries
+    a `[design]` record must run what it records: each [params] value (and input.value) a design sets must equal its
+    [design.derived] value (to `DERIVED_RTOL`), else a SceneError names both keys. Then the configuration's rules
+    (`config.check_scene`): a parameter, input key or effect the configuration does not read, or a parameter it reads
+    that the set lacks, is a SceneError naming it, when the scene loads."""
     design = scene.sections.get("design")
     if design is not None:
         v = design["derived"]
@@ -246,7 +249,9 @@ def scene_params(scene: Any) -> DriveParams:
                                  f"(relative tolerance {DERIVED_RTOL:g}): a scene edited by hand away from its design; "
                                  "remove [design] or write the scene again (mbsuite drive design cadjs ... "
                                  "--scene-out)")
-    return DriveParams(**dict(scene.params))
+    params = DriveParams(**dict(scene.params))
+    check_scene(scene, params.resolved())
+    return params
 
 
 def _toml_value(v: Any) -> str:

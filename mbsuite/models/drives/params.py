@@ -1,8 +1,9 @@
 """Parameters of the switched-mode drives (R. S. Oldaker, The Design and Control of Mechanical Switched Mode Drives,
-PhD thesis, University of Hull, 1997) and of Modelica's CoupledClutches.
+PhD thesis, University of Hull, 1997).
 
-`DriveParams` holds scene overrides (SI units); every field left at None takes the value of the scene's parameter set
-(`PARAM_SETS`, chosen by the `param_set` effect). `Lnnn` are line numbers of the thesis' plain-text transcription.
+`DriveParams` holds scene overrides (SI units); every field left at None takes the value of the scene's parameter set:
+the data table `PARAM_SETS`, a set chosen by name in the scene's `[params] set` (a declared value: an unknown name is an
+error listing the valid ones). `Lnnn` are line numbers of the thesis' plain-text transcription.
 """
 
 from __future__ import annotations
@@ -57,7 +58,6 @@ EXAMPLE_500W: dict[str, float] = dict(
     tau_c1=20.0, tau_c2=20.0, d_on=0.004, d_off=0.004, fs=1000.0,
     Kp=0.00222, Ki=0.075, ref=400.0, min_motor_vel=70.0, min_load_vel=0.0, spring_max=2.86,
 )
-MODELICA: dict[str, float] = dict(J_m=1.0)
 
 PARAM_SETS: dict[str, dict[str, float]] = {
     "table_4_2": TABLE_4_2,
@@ -65,7 +65,6 @@ PARAM_SETS: dict[str, dict[str, float]] = {
     "proto_100w": PROTO_100W,
     "proto_50w": PROTO_50W,
     "example_500w": EXAMPLE_500W,
-    "modelica": MODELICA,
 }
 
 
@@ -87,6 +86,10 @@ class DriveParams:
     Every field declares its valid range (`mbsuite.limits.param`); a set value outside it is a ParameterError naming
     the field, the value and the range."""
 
+    # the parameter set the other fields override (a row of the data table PARAM_SETS)
+    set: str = param("table_4_2", kind=str, choices=tuple(PARAM_SETS),
+                     doc="parameter set: table_4_2 (Table 4.2, step-up prototype), design_100w (Sec. 6.2, 100 W "
+                         "design), proto_100w / proto_50w (Sec. 6.4.3 fits), example_500w (App. J)")
     # motor (Eq 4.1: tau = K_t (V_s - K_e w) / R, or tau = tau_0 + tau_slope w)
     K_t: float | None = _p(0.0, 100.0, "N m/A", "motor torque constant (Eq 4.1)", lo_open=True)
     K_e: float | None = _p(0.0, 100.0, "V s/rad", "motor back-emf constant (Eq 4.1)")
@@ -147,16 +150,19 @@ class DriveParams:
         if self.min_vel is not None and self.max_vel is not None and self.min_vel > self.max_vel:
             raise ParameterError(f"parameter min_vel = {self.min_vel!r} must not exceed max_vel = {self.max_vel!r}")
 
-    def resolved(self, param_set: str) -> dict[str, Any]:
-        """The parameter set with the overrides applied, validated as a whole (the declared ranges, and
-        min_vel <= max_vel). Combinations that depend on the mechanism and effects (delay vs PWM cycle / free
-        oscillation period, twist_tol vs the friction-held twist) are checked by `drive.build_controller`."""
+    def resolved(self, param_set: str | None = None) -> dict[str, Any]:
+        """The parameter set (`param_set`, default the scene's `set`) with the overrides applied, validated as a whole
+        (the declared ranges, and min_vel <= max_vel). Combinations that depend on the mechanism and effects (delay vs
+        PWM cycle / free oscillation period, twist_tol vs the friction-held twist) are checked by
+        `drive.build_controller`."""
+        param_set = self.set if param_set is None else param_set
         if param_set not in PARAM_SETS:
             raise ParameterError(f"unknown parameter set {param_set!r}; valid: {sorted(PARAM_SETS)}")
         p: dict[str, Any] = {f.name: None for f in dataclasses.fields(self)}
         p.update(PARAM_SETS[param_set])
         p.update({k: v for k, v in dataclasses.asdict(self).items() if v is not None})
         p["peak"] = p["peak"] if p["peak"] is not None else 1.0
+        p["set"] = param_set
         DriveParams(**p)  # validate the merged set too
         return p
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from ...components.rotational.event_exact import simulate_reference
+from ...components.rotational.interfaces import RefResult, RotorSystem
 from ...results import SimResult
 from ...scenes import Scene
-from .event_exact import simulate_reference
-from .rotor_system import RefResult, RotorSystem
 from .scene_run import setup, sim_result
 
 

@@ -1,6 +1,6 @@
 """A drives scene as a run of a rotor system: what both paths share - the system, initial state, controller and output
 grid a scene asks for (`setup`), and the `SimResult` of a run (`sim_result`: signals, energy balance, cycle statistics,
-mode changes, the energy-residual health figure). The paths themselves: `reference.py` (hand) and `mujoco.py`."""
+the energy-residual health figure). The paths themselves: `reference.py` (hand) and `mujoco.py`."""
 
 from __future__ import annotations
 
@@ -9,30 +9,22 @@ from typing import Any
 
 import numpy as np
 
+from ...components.rotational.commands import Controller
+from ...components.rotational.interfaces import RefResult, RotorSystem
 from ...errors import SceneError
 from ...limits import Limit
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from ...schema import Items, Rule, check_value
-from ...trust import perturbation
 from ...trust.health import Figure
-from . import coupled_clutches as cc
-from . import drive, msl
+from . import drive
 from .accuracy import window_efficiency
-from .commands import Controller
-from .config import check_scene
-from .rotor_system import RefResult, RotorSystem
 
 SIGNALS = {
     "w_motor": "rad/s", "w_spring": "rad/s", "w_load": "rad/s",
     "theta_motor": "rad", "theta_spring": "rad", "theta_load": "rad", "extension": "rad",
-    "w1": "rad/s", "w2": "rad/s", "w3": "rad/s", "w4": "rad/s",
-    "J1.w": "rad/s", "J2.w": "rad/s", "J3.w": "rad/s", "J4.w": "rad/s",  # CoupledClutches on the reference's names
     "E_in": "J", "E_out": "J", "E_loss": "J", "u_brake": "1", "u_clutch": "1", "u_clutch_a": "1", "u_clutch_b": "1",
-    **msl.SIGNAL_UNITS,
 }
-#: energy_residual bound (|input - output - losses - stored change| / input over the run) of the Modelica scenes
-ENERGY_BOUND = {"reference": 1e-6, "mujoco": 1e-5}
 #: energy_residual bound of the thesis drives, both paths: their rotors turn through thousands of radians, so the
 #: solver's relative tolerance on the angles sets the floor (measured on every shipped scene at its defaults:
 #: <= 3.0e-7 hand path, <= 2.3e-7 MuJoCo; in copies perturbed by 1e-9 up to 1.4e-5, one step whose spring twist is
@@ -73,15 +65,10 @@ def reference_signal(inp: dict[str, Any], default: float):
     return float(inp.get("value", default))
 
 
-def _initial(q0, w0) -> tuple[np.ndarray, np.ndarray]:
-    """The initial angles and speeds (perturbed inside the stability check, `mbsuite.trust.perturbation`)."""
-    return perturbation.state(q0, "q0"), perturbation.state(w0, "w0")
-
-
 @dataclass
 class RunSetup:
-    """What a scene asks either path to simulate: the rotor system, its initial state, the controller (None for the
-    Modelica examples), the output sample interval [s] and the stem of its MJCF file (`mjcf/<stem>.xml`)."""
+    """What a scene asks either path to simulate: the rotor system, its initial state, the controller, the output
+    sample interval [s] and the stem of its MJCF file (`mjcf/<stem>.xml`)."""
 
     system: RotorSystem
     q0: np.ndarray
@@ -92,21 +79,11 @@ class RunSetup:
 
 
 def setup(scene: Scene) -> RunSetup:
-    """The run a scene asks for (any engine): a Modelica example, CoupledClutches, or a drive (Eqs 3.1-3.6) with its
-    controller and speed reference."""
+    """The run a scene asks for (any engine): a drive (Eqs 3.1-3.6) with its controller and speed reference."""
     eff = dict(scene.effects)
     mech = eff["mechanism"]
     sv = scene.solver
-    if mech not in ("step_up", "step_up_down"):
-        check_scene(scene, None)
-    if mech in msl.EXAMPLES:
-        ex = msl.example(mech)
-        return RunSetup(ex.system, *_initial(ex.q0, ex.w0), None, sv.sample_dt or 5e-4, f"drive_{mech}")
-    if mech == "coupled_clutches":
-        system = cc.build_system()
-        return RunSetup(system, *_initial(cc.Q0, cc.W0), None, sv.sample_dt or 5e-4, "coupled_clutches")
-    p = scene.build_params().resolved(eff["param_set"])
-    check_scene(scene, p)  # nothing set that the configuration does not read, nothing it reads missing
+    p = scene.build_params().resolved()  # checked: nothing set the configuration does not read (config.check_scene)
     system = drive.build_system(mech, p, eff)
     ref = reference_signal(dict(scene.input), p["ref"] or 0.0)
     kind = eff["controller"]
@@ -123,20 +100,13 @@ def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> 
     statistics and mode changes in `stats`; the energy residual as a health figure, judged by `mbsuite.run`)."""
     mech = scene.effects["mechanism"]
     sig: dict[str, np.ndarray] = {}
-    if mech in msl.EXAMPLES:
-        sig.update(msl.signals_of(msl.example(mech), res))
-    elif mech == "coupled_clutches":
-        for i in range(4):
-            sig[f"w{i + 1}"] = res.w[i]
-            sig[f"J{i + 1}.w"] = res.w[i]
-    else:
-        for i, nm in enumerate(("motor", "spring", "load")):
-            sig[f"w_{nm}"] = res.w[i]
-            sig[f"theta_{nm}"] = res.q[i]
-        sig["extension"] = res.q[0] - res.q[1] if mech == "step_up" else res.q[1]
-        names = {"brake": "u_brake", "clutch": "u_clutch", "ca": "u_clutch_a", "cb": "u_clutch_b"}
-        for c, v in res.u.items():
-            sig[names[c]] = v
+    for i, nm in enumerate(("motor", "spring", "load")):
+        sig[f"w_{nm}"] = res.w[i]
+        sig[f"theta_{nm}"] = res.q[i]
+    sig["extension"] = res.q[0] - res.q[1] if mech == "step_up" else res.q[1]
+    names = {"brake": "u_brake", "clutch": "u_clutch", "ca": "u_clutch_a", "cb": "u_clutch_b"}
+    for c, v in res.u.items():
+        sig[names[c]] = v
     outputs = {p.label for f in system.frictions for p in f.parts if p.output}
     sig["E_in"] = res.energy["source"]
     sig["E_out"] = sum((res.energy[k] for k in outputs), np.zeros_like(res.t))
@@ -155,16 +125,9 @@ def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> 
         stats["cycles"] = cs
     # the scene's outputs in its order (an output of the other mechanisms is not computed, so not kept)
     ordered = {k: sig[k] for k in scene.outputs if k in sig}
-    health = []
-    if mech in msl.EXAMPLES or mech == "coupled_clutches":  # the Modelica examples: mode changes, final values
-        stats["mode_changes"] = [{"t": e["t"], "component": e["element"], "from": e["from"], "to": e["to"]}
-                                 for e in res.events]
-        stats["final"] = {k: float(v[-1]) for k, v in sig.items() if k in msl.SIGNAL_UNITS or "." in k}
-    eng = scene.solver.engine
-    bound = ENERGY_BOUND[eng] if mech in msl.EXAMPLES or mech == "coupled_clutches" else DRIVE_ENERGY_BOUND
-    health.append(Figure(
-        "energy_residual", abs(bal.residual) / max(abs(bal.input), 1e-300), bound, "1",
+    health = [Figure(
+        "energy_residual", abs(bal.residual) / max(abs(bal.input), 1e-300), DRIVE_ENERGY_BOUND, "1",
         "energy balance |input - output - losses - change of stored energy| / input over the run",
-        "tighten solver.rtol/atol (reference) or reduce solver.timestep (mujoco)"))
+        "tighten solver.rtol/atol (reference) or reduce solver.timestep (mujoco)")]
     return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats,
                     health=health)

@@ -1,18 +1,18 @@
 """Friction/clutch machinery: the CoupledClutches reference data, the closed-form early phase and event convergence,
-a clutch below and above breakaway (both paths), bad input. CoupledClutches against Dymola on both paths, the
-engagement loss, nested locks and the Coulomb load reversal are hard cases (`mbsuite.models.drives.cases`, run by
-`tests/suite/test_hardcases.py`): one source of truth each."""
+a clutch below and above breakaway (both paths), bad input. CoupledClutches against Dymola on both paths is a hard
+case of `mbsuite.models.rotational.cases`, the engagement loss, nested locks and the Coulomb load reversal are hard
+cases of `mbsuite.models.drives.cases` (run by `tests/suite/test_hardcases.py`): one source of truth each."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from mbsuite.components.rotational.event_exact import simulate_reference
+from mbsuite.components.rotational.interfaces import Friction, Part, RotorSystem, Source, Spring
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
 from mbsuite.errors import ParameterError
-from mbsuite.models.drives import coupled_clutches as cc
-from mbsuite.models.drives.event_exact import simulate_reference
-from mbsuite.models.drives.mujoco import MujocoRotorSim
-from mbsuite.models.drives.rotor_system import Friction, Part, RotorSystem, Source, Spring
+from mbsuite.models.rotational import coupled_clutches as cc
 from mbsuite.paths import mjcf_path
 
 

@@ -1,9 +1,9 @@
-/* The drives' stick/slip state machine as a native stepper of the core (an mbs_hook_fn): friction elements with
+/* The rotor library's stick/slip state machine as a native stepper of the core (an mbs_hook_fn): friction elements with
  * real MuJoCo locks, their lock trials, event times, the energy bookkeeping and the recorded row, per step in C.
  *
  * The semantics are those of Modelica's Rotational PartialFriction (modes -1 backward, 0 stuck, 1 forward, 2 free)
- * on a MuJoCo model whose rotors are hinge joints (mbsuite/models/drives/mujoco.py describes the MJCF
- * conventions). mbsuite/models/drives/stepper.py (RotorStepper) is the readable Python twin of this file, statement
+ * on a MuJoCo model whose rotors are hinge joints (mbsuite/components/rotational/mujoco_sim.py describes the MJCF
+ * conventions). mbsuite/components/rotational/stepper.py (RotorStepper) is the readable Python twin of this file, statement
  * for statement; a test holds the two equal.
  *
  * Per step k (t = k dt), at MBS_STAGE_POST_FORWARD (the core has just run mj_forward at the state and the control of
@@ -52,7 +52,7 @@ enum {
 
 #define DRV_ZERO_SLIP 1e-12 /* rad/s: a free element engaging at a smaller slip is tried for a lock */
 
-/* Layout mirrored by mbsuite.models.drives.native_stepper._Drives (ctypes). Arrays are numpy buffers owned by the
+/* Layout mirrored by mbsuite.components.rotational.native_stepper._Rotors (ctypes). Arrays are numpy buffers owned by the
  * Python side, which keeps them alive during the run. */
 typedef struct {
   int n, ne, npart, nsrc, neq, timevar, chatter_n, chatter_window;
@@ -137,22 +137,22 @@ typedef struct {
   /* work space of the general plastic impact: ne (ne + 1) + ne doubles, 2 ne ints */
   double* gmat;
   int* gidx;
-} mbs_drives;
+} mbs_rotors;
 
-static int fail(mbs_drives* S, int code, int index, double t, double value) {
+static int fail(mbs_rotors* S, int code, int index, double t, double value) {
   S->err_index = index;
   S->err_time = t;
   S->err_value = value;
   return code;
 }
 
-static inline double w_of(const mjData* d, const mbs_drives* S, int i) { return d->qvel[S->dof[i]]; }
-static inline double q_of(const mjData* d, const mbs_drives* S, int i) { return d->qpos[S->qadr[i]]; }
+static inline double w_of(const mjData* d, const mbs_rotors* S, int i) { return d->qvel[S->dof[i]]; }
+static inline double q_of(const mjData* d, const mbs_rotors* S, int i) { return d->qpos[S->qadr[i]]; }
 
 static inline int sliding(int mode) { return mode == DRV_FWD || mode == DRV_BWD; }
 
 /* sliding torque of every part and element at time t under the current commands */
-static int levels(mbs_drives* S, double t, double* lv, double* el) {
+static int levels(mbs_rotors* S, double t, double* lv, double* el) {
   for (int e = 0; e < S->ne; e++) el[e] = 0.0;
   for (int p = 0; p < S->npart; p++) {
     double v = S->level[p];
@@ -168,7 +168,7 @@ static int levels(mbs_drives* S, double t, double* lv, double* el) {
   return 0;
 }
 
-static int source_shape(mbs_drives* S, int s, double t, double* out) {
+static int source_shape(mbs_rotors* S, int s, double t, double* out) {
   if (S->shape[s] < 0) {
     *out = 1.0;
     return 0;
@@ -179,7 +179,7 @@ static int source_shape(mbs_drives* S, int s, double t, double* out) {
   return 0;
 }
 
-static void slips(const mjData* d, mbs_drives* S) {
+static void slips(const mjData* d, mbs_rotors* S) {
   for (int e = 0; e < S->ne; e++) {
     if (S->general) {
       double v = 0.0;
@@ -192,19 +192,19 @@ static void slips(const mjData* d, mbs_drives* S) {
 }
 
 /* breakaway torque of element e at levels el (a disengaged one-way clutch: its hold torque) */
-static inline double capacity(const mbs_drives* S, int e, const double* el) {
+static inline double capacity(const mbs_rotors* S, int e, const double* el) {
   if (S->oneway[e] && el[e] <= S->free_tol[e]) return S->hold[e];
   return S->peak[e] * el[e];
 }
 
 /* how far a lock force is past the breakaway torque (> 1: it breaks); a one-way clutch holds any negative force */
-static inline double overload(const mbs_drives* S, int e, const double* el) {
+static inline double overload(const mbs_rotors* S, int e, const double* el) {
   double lam = S->oneway[e] ? (S->lam[e] > 0.0 ? S->lam[e] : 0.0) : fabs(S->lam[e]);
   return lam / capacity(S, e, el);
 }
 
 /* lock forces of the friction elements from the last forward (first row of each equality; 0 where inactive) */
-static int lock_forces(const mjData* d, mbs_drives* S, double t) {
+static int lock_forces(const mjData* d, mbs_rotors* S, double t) {
   int* seen = S->scratch + 2 * S->n + 2 + S->ne;
   for (int e = 0; e < S->ne; e++) {
     S->lam[e] = 0.0;
@@ -234,7 +234,7 @@ static int find(int* parent, int i) {
 /* general systems: the plastic impact is the M-orthogonal projection of the speeds onto the stuck elements'
  * constraints, w -= M^-1 G^T (G M^-1 G^T)^-1 G w (M = diag J), by Gaussian elimination with partial pivoting;
  * a dependent constraint (pivot below 1e-12 of the largest diagonal) carries no impulse. */
-static double project(mjData* d, mbs_drives* S) {
+static double project(mjData* d, mbs_rotors* S) {
   const int n = S->n, ne = S->ne;
   int* rows = S->gidx; /* the stuck elements (ne) */
   int k = 0;
@@ -298,7 +298,7 @@ static double project(mjData* d, mbs_drives* S) {
   return dke;
 }
 
-static double engage(const mjModel* mc, mjData* d, mbs_drives* S) {
+static double engage(const mjModel* mc, mjData* d, mbs_rotors* S) {
   mjModel* m = (mjModel*)mc; /* the lock offsets live in the run's own model */
   const int n = S->n;
   if (S->general) {
@@ -374,7 +374,7 @@ static double engage(const mjModel* mc, mjData* d, mbs_drives* S) {
 
 /* sliding torques of the elements at levels el, sources at time t; a quadratic source's torque at the speed now
  * (mid = 0) or predicted at mid-step from the last forward's acceleration (mid = 1; held over the step) */
-static int set_ctrl(mjData* d, mbs_drives* S, double t, const double* el, int mid) {
+static int set_ctrl(mjData* d, mbs_rotors* S, double t, const double* el, int mid) {
   for (int e = 0; e < S->ne; e++) {
     double tau = sliding(S->modes[e]) ? S->modes[e] * el[e] : 0.0;
     d->ctrl[S->act[e]] = S->act_sign[e] * tau;
@@ -395,7 +395,7 @@ static int set_ctrl(mjData* d, mbs_drives* S, double t, const double* el, int mi
 }
 
 /* a mode change of element e at step k: time interpolated in the event function, chatter check */
-static int note(mbs_drives* S, long k, double t, int e, int from, int to) {
+static int note(mbs_rotors* S, long k, double t, int e, int from, int to) {
   double te = t, gp = S->gprev[e], gn = S->gnow[e];
   if (isfinite(gp) && isfinite(gn) && gp != gn) {
     double frac = gn / (gn - gp);
@@ -418,7 +418,7 @@ static int note(mbs_drives* S, long k, double t, int e, int from, int to) {
 }
 
 /* event function of each element: slip in the sliding direction, or breakaway - |lock force| when stuck */
-static void event_function(mbs_drives* S, double* g, int stuck_too) {
+static void event_function(mbs_rotors* S, double* g, int stuck_too) {
   for (int e = 0; e < S->ne; e++) {
     int md = S->modes[e];
     if (sliding(md)) {
@@ -431,7 +431,7 @@ static void event_function(mbs_drives* S, double* g, int stuck_too) {
   }
 }
 
-static void fill_record(const mjData* d, mbs_drives* S) {
+static void fill_record(const mjData* d, mbs_rotors* S) {
   const int n = S->n, ne = S->ne;
   double* r = S->rec;
   for (int i = 0; i < n; i++) r[i] = q_of(d, S, i);
@@ -443,7 +443,7 @@ static void fill_record(const mjData* d, mbs_drives* S) {
   r[2 * n + ne + S->ncmd + na] = S->reset_energy;
 }
 
-static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
+static int decide(const mjModel* m, mjData* d, mbs_rotors* S, long k) {
   const int n = S->n, ne = S->ne;
   const double dt = S->dt, t = (double)k * dt;
   for (int i = 0; i < n; i++) {
@@ -567,7 +567,7 @@ static int decide(const mjModel* m, mjData* d, mbs_drives* S, long k) {
   return 0;
 }
 
-static int work(mjData* d, mbs_drives* S, long k) {
+static int work(mjData* d, mbs_rotors* S, long k) {
   const int n = S->n;
   const double dt = S->dt, tm = (double)k * dt + 0.5 * dt;
   double* acc = S->acc;
@@ -610,8 +610,8 @@ static int work(mjData* d, mbs_drives* S, long k) {
   return 0;
 }
 
-int mbs_drives_hook(const mjModel* m, mjData* d, void* ud, long k, int stage) {
-  mbs_drives* S = (mbs_drives*)ud;
+int mbs_rotors_hook(const mjModel* m, mjData* d, void* ud, long k, int stage) {
+  mbs_rotors* S = (mbs_rotors*)ud;
   if (stage == MBS_STAGE_POST_FORWARD) {
     if (S->decided) return 0; /* the same step again (a repeated final forward): nothing new */
     S->decided = 1;
@@ -622,4 +622,4 @@ int mbs_drives_hook(const mjModel* m, mjData* d, void* ud, long k, int stage) {
 }
 
 /* the size of the struct, for the Python side's layout check */
-int mbs_drives_struct_size(void) { return (int)sizeof(mbs_drives); }
+int mbs_rotors_struct_size(void) { return (int)sizeof(mbs_rotors); }

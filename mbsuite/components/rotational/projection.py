@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotor_system import RotorSystem
+from .interfaces import RotorSystem
 
 
 class StuckProjection:

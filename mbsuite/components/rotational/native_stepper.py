@@ -1,9 +1,9 @@
-"""The drives' native stepper: a `RotorRun` packed into the C struct of `native/drives.c` and run by the native core.
+"""The rotor library's native stepper: a `RotorRun` packed into the C struct of `native/rotors.c`, run by the core.
 
 `NativeRotorRun(run).run()` packs the rotor system (rotor dof/qpos addresses, inertias, friction elements with their
 rotors, breakaway factors, locks and actuators, parts with levels, commands and schedules, sources with c0, c1 and
 shapes) into numpy buffers the C struct points into (kept alive by this object), runs `core.Stepper` with the C
-function `mbs_drives_hook` as its native stepper and the controller as its `between` callable at the controller's
+function `mbs_rotors_hook` as its native stepper and the controller as its `between` callable at the controller's
 period, drains the C event buffer between the chunks, and returns the `RefResult`. Nothing in here is global: two
 runs in two threads never mix.
 """
@@ -17,15 +17,15 @@ import numpy as np
 
 from ...engines import core, mujoco_engine, native
 from ...engines.inputs import Signal
+from .interfaces import FREE
 from .rotor_run import CHATTER_N, CHATTER_WINDOW, CHUNK, HINT, RotorRun
-from .rotor_system import FREE
 
 _P = ctypes.c_void_p
 _LONG = np.dtype(f"i{ctypes.sizeof(ctypes.c_long)}")
 
 
-class _Drives(ctypes.Structure):
-    """Mirror of `mbs_drives` (native/drives.c); the library's `mbs_drives_struct_size` checks the layout."""
+class _Rotors(ctypes.Structure):
+    """Mirror of `mbs_rotors` (native/rotors.c); the library's `mbs_rotors_struct_size` checks the layout."""
 
     _fields_ = [
         ("n", ctypes.c_int), ("ne", ctypes.c_int), ("npart", ctypes.c_int), ("nsrc", ctypes.c_int),
@@ -54,18 +54,18 @@ _hook_lib: ctypes.CDLL | None = None
 
 
 def library() -> ctypes.CDLL:
-    """The native library with the drives' entry points declared (and the struct layout checked)."""
+    """The native library with the rotor stepper's entry points declared (and the struct layout checked)."""
     global _hook_lib
     if _hook_lib is None:
         lib = native.load()
-        lib.mbs_drives_struct_size.argtypes = []
-        lib.mbs_drives_struct_size.restype = ctypes.c_int
-        lib.mbs_drives_hook.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_int]
-        lib.mbs_drives_hook.restype = ctypes.c_int
-        size = lib.mbs_drives_struct_size()
-        if size != ctypes.sizeof(_Drives):
-            raise native.NativeBuildError(f"mbs_drives is {size} bytes in C, {ctypes.sizeof(_Drives)} in Python: "
-                                          "native/drives.c and native_stepper._Drives disagree")
+        lib.mbs_rotors_struct_size.argtypes = []
+        lib.mbs_rotors_struct_size.restype = ctypes.c_int
+        lib.mbs_rotors_hook.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_int]
+        lib.mbs_rotors_hook.restype = ctypes.c_int
+        size = lib.mbs_rotors_struct_size()
+        if size != ctypes.sizeof(_Rotors):
+            raise native.NativeBuildError(f"mbs_rotors is {size} bytes in C, {ctypes.sizeof(_Rotors)} in Python: "
+                                          "native/rotors.c and native_stepper._Rotors disagree")
         _hook_lib = lib
     return _hook_lib
 
@@ -138,7 +138,7 @@ class NativeRotorRun:
                 b[k] = a = np.zeros(1, a.dtype)
             assert a.flags.c_contiguous, k
         self.buffers = b
-        s = _Drives()
+        s = _Rotors()
         s.n, s.ne, s.npart, s.nsrc, s.neq = n, ne, len(parts), len(sys.sources), m.neq
         s.timevar, s.chatter_n, s.chatter_window, s.dt = int(run.timevar), CHATTER_N, CHATTER_WINDOW, run.dt
         for k, a in b.items():
@@ -150,7 +150,7 @@ class NativeRotorRun:
         s.general, s.ndamp = int(sim.general), len(run.dampers)
         self.struct = s
         lib = library()
-        self.hook = core.NativeHook(fn=lib.mbs_drives_hook, ud=ctypes.addressof(s), record=self.rec,
+        self.hook = core.NativeHook(fn=lib.mbs_rotors_hook, ud=ctypes.addressof(s), record=self.rec,
                                     keep=(s, b, self.rec, self.ev), describe=self.describe)
 
     def drain_events(self) -> None:
@@ -171,7 +171,7 @@ class NativeRotorRun:
         """Run on mbsuite's native core with the C state machine; returns the `RefResult`."""
         run = self.run_
         stepper = core.Stepper(run.m, run.d, [core.Channel("rec", "hook", 0, run.nrec)], every=run.every,
-                               check_every=1, hook=self.hook, what="drives MuJoCo path", hint=HINT)
+                               check_every=1, hook=self.hook, what="rotor MuJoCo path", hint=HINT)
         tr = stepper.run(run.nstep, between=self._between, period=self.chunk)
         self.drain_events()
         rows = tr["rec"]

@@ -1,4 +1,4 @@
-"""Modelica Rotational examples (MSL 4.1.0) as drives scenes, on the hand path and MuJoCo.
+"""Modelica Rotational examples (MSL 4.1.0) as rotational scenes, on the hand path and MuJoCo.
 
 Friction and OneWayClutch: against the Modelica Association's reference results (`data/msl/`): the same mode
 sequence, every mode change within 1e-5 s (hand path; the reference is a tolerance-1e-6 DASSL result, its event times
@@ -7,7 +7,7 @@ every compared signal inside the Association's regression tube (2e-3 of the sign
 on both paths). OneWayClutchDisengaged and SimpleGearShift have no published reference: closed forms of their
 phases (freewheel, rigid planetary) and the mode sequence derived from the MSL equations are the checks. Energy
 balance per example about 10x its measured residual; the `energy_residual` health figure. The freewheel's grazing
-lock and the planetary hand-over are hard cases (`mbsuite.models.drives.cases`).
+lock and the planetary hand-over are hard cases (`mbsuite.models.rotational.cases`).
 """
 
 from __future__ import annotations
@@ -19,11 +19,13 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from mbsuite.components.rotational import components
+from mbsuite.components.rotational.energy import energy_balance
+from mbsuite.components.rotational.event_exact import simulate_reference
+from mbsuite.components.rotational.mujoco_sim import MujocoRotorSim
 from mbsuite.errors import ParameterError
-from mbsuite.models.drives import drive, msl
-from mbsuite.models.drives.analysis import simulate_scene
-from mbsuite.models.drives.event_exact import simulate_reference
-from mbsuite.models.drives.mujoco import MujocoRotorSim
+from mbsuite.models.rotational import examples as msl
+from mbsuite.models.rotational.analysis import simulate_scene
 from mbsuite.paths import mjcf_path
 from mbsuite.scenes import load_scene
 
@@ -47,7 +49,7 @@ def _run(name: str, engine: str):
 
 # the OneWayClutch's grazing lock: released at t_r = 7/6 + asin(3e-5)/(6 pi) (holding torque 5 sin(6 pi (t - 7/6))
 # reaching tau0_max_low = 1.5e-4), the free slip w_rel = (10/6pi)(cos 6 pi t - cos 6 pi t_r) closes again at
-# t = 8/3 - t_r, where the input torque is about to reverse: a tangency (hard case drives_freewheel_grazing_lock)
+# t = 8/3 - t_r, where the input torque is about to reverse: a tangency (hard case rotational_freewheel_grazing_lock)
 T_GRAZE = 1.5 - math.asin(3e-5) / (6 * math.pi)
 
 
@@ -63,16 +65,17 @@ def test_mode_sequence_matches_reference(name):
         assert all(r["t"] is not None and r["t_ref"] is not None for r in rows), (path, rows)
         for r in rows:
             if abs(r["t_ref"] - T_GRAZE) < 1e-3 and name == "msl_one_way_clutch" and r["to"] == 0:
-                continue  # the grazing lock: against its closed form in the hard case drives_freewheel_grazing_lock
+                continue  # the grazing lock: against its closed form in the hard case rotational_freewheel_grazing_lock
             tol = 1e-5 if path == "hand" else DT
             assert abs(r["t"] - r["t_ref"]) <= tol, (path, r)
 
 
 def test_reference_grazing_lock_offset_explained():
     """The tangential lock at t = 1.5 s: both paths against the closed form are the hard case
-    `drives_freewheel_grazing_lock` (one source of truth). Here the reference itself: it has the lock 3.0e-4 s early,
-    explained by its w_rel error of ~1e-5 rad/s at a tangency where the slip's curvature is 188 rad/s^3, which moves
-    the crossing by sqrt(2 x 8.5e-6 / 188) = 3.0e-4 s (asserted 2.5e-4 ... 3.5e-4 s, the spread of that estimate)."""
+    `rotational_freewheel_grazing_lock` (one source of truth). Here the reference itself: it has the lock 3.0e-4 s
+    early, explained by its w_rel error of ~1e-5 rad/s at a tangency where the slip's curvature is 188 rad/s^3, which
+    moves the crossing by sqrt(2 x 8.5e-6 / 188) = 3.0e-4 s (asserted 2.5e-4 ... 3.5e-4 s, the spread of that
+    estimate)."""
     ex = msl.example("msl_one_way_clutch")
     ref = msl.reference_events(ex, msl.load_reference(ex))
     t_ref = [r["t"] for r in ref if abs(r["t"] - 1.4997) < 1e-3 and r["to"] == 0]
@@ -102,7 +105,7 @@ BALANCE_BOUND = {"msl_friction": (1e-6, 1e-5), "msl_one_way_clutch": (3e-8, 2e-8
 def test_energy_balance(name):
     for engine, bound in zip(("reference", "mujoco"), BALANCE_BOUND[name], strict=True):
         ex, res = _run(name, engine)
-        bal = drive.energy_balance(ex.system, res)
+        bal = energy_balance(ex.system, res)
         assert bal.input > 0.1
         assert abs(bal.residual) <= bound * bal.input, (engine, bal)
 
@@ -154,7 +157,7 @@ def test_simple_gear_shift_phases():
     lets the ring go forward as its normal force falls, is free at 2.1 s, and the clutch locks sun and ring (ratio 1).
     Closed forms: before 2 s, 16.25 w_l' = 50 - k w_l^2 (J_l + (1 + r)^2 J_e, torque (1 + r) 20, k = 20/w_n^2); after
     the clutch lock, 11 w' = 20 - k w^2. The sequence, the 1:1 end state and the paths' event times against each other
-    are the hard case `drives_planetary_handover`.
+    are the hard case `rotational_planetary_handover`.
 
     Measured, relative to the closed form's asymptote (hand path rtol 1e-10 / MuJoCo RK4 1e-4 s): before 2 s
     2.8e-13 / 4.0e-12, gear constraint 1.3e-15 / 7.8e-13; after the lock 7.1e-12 / 4.0e-11, 1:1 8.5e-16 / 1.5e-12.
@@ -186,26 +189,26 @@ def test_scenes_run_with_health_and_mode_list():
     import mbsuite
 
     for name in sorted(msl.EXAMPLES):
-        sc = load_scene(f"drives/{name}")
+        sc = load_scene(f"rotational/{name}")
         res = mbsuite.run(sc.replace(solver={"duration": 0.7}))
         fig = [h for h in res.health if h.name == "energy_residual"]
         assert len(fig) == 1 and fig[0].bound == 1e-6 and fig[0].ok
         assert all({"t", "component", "from", "to"} <= set(e) for e in res.stats["mode_changes"])
         assert set(res.stats["final"]) >= set(msl.example(name).compared)
-    sc = load_scene("drives/msl_friction")
-    out, _, _ = simulate_scene(sc.replace(solver={"engine": "mujoco", "duration": 0.2}))
+    sc = load_scene("rotational/msl_friction")
+    out, _ = simulate_scene(sc.replace(solver={"engine": "mujoco", "duration": 0.2}))
     assert [e["element"] for e in out.events][:2] == ["clutch", "clutch"]
 
 
 def test_components_refuse_bad_input():
     with pytest.raises(ParameterError, match="planetary ratio"):
-        msl.planetary_ring_row(0.0, 0, 1, 2)
+        components.planetary_ring_row(0.0, 0, 1, 2)
     with pytest.raises(ParameterError, match="w_nominal"):
-        msl.quadratic_speed_torque("q", 0, -20.0, 0.0)
+        components.quadratic_speed_torque("q", 0, -20.0, 0.0)
     with pytest.raises(ParameterError, match="fn_max"):
-        msl.clutch("c", 0, 1, -1.0)
+        components.clutch("c", 0, 1, -1.0)
     with pytest.raises(ParameterError, match="gear ratio"):
-        msl.ideal_gear_row(0.0, 0, 2)
+        components.ideal_gear_row(0.0, 0, 2)
     with pytest.raises(ParameterError, match="unknown MSL example"):
         msl.example("msl_nothing")
 

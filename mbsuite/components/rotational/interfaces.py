@@ -4,7 +4,7 @@ A `RotorSystem` is a set of rigid rotors (inertia J_i, viscous bearing B_i to gr
 two rotors or a rotor and ground), torque sources tau = c0*shape(t) + c1*w, and *friction elements* (clutches between
 two rotors, brakes/bearings/Coulomb loads between a rotor and ground). The modes follow Modelica's
 `Rotational.Interfaces.PartialFriction`: -1 backward sliding, 0 stuck, 1 forward sliding, 2 free (the state machines:
-`event_exact.py` for the hand path, `native/drives.c` and `stepper.py` for MuJoCo).
+`event_exact.py` for the hand path, `native/rotors.c` and `stepper.py` for MuJoCo).
 
 Sign convention: an element between rotor a and rotor b (b = -1: ground) acts with +tau_e on a and -tau_e on b.
 """
@@ -91,7 +91,7 @@ class Source:
 @dataclass
 class RotorSystem:
     """Coaxial rotors (inertias J, viscous B) with friction elements, springs and torque sources: the
-    system both paths simulate (Eqs 3.1-3.6 for the drives; the Modelica examples)."""
+    system both paths simulate (a model builds it: e.g. a drive of Oldaker 1997, Eqs 3.1-3.6, or a Modelica example)."""
     names: list[str]
     J: np.ndarray
     B: np.ndarray

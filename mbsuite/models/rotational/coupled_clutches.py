@@ -1,4 +1,4 @@
-"""Modelica's `Rotational.Examples.CoupledClutches` rebuilt with the drives' friction machinery (an outside check).
+"""Modelica's `Rotational.Examples.CoupledClutches` (MSL 4.1.0) on the shared rotor library's friction machinery.
 
 torque 10 sin(2 pi 5 t) -> J1 -> clutch1 -> J2 -> clutch2 -> J3 -> clutch3 -> J4, J1..J4 = 1 kg m^2, J1.w(0) = 10 rad/s.
 Clutch k: fn = fn_max * f_norm_k(t) with fn_max = 20 N, sliding torque mu * cgeo * fn (mu = 0.5, cgeo = 1), breakaway
@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ...components.rotational.interfaces import Friction, Part, RotorSystem, Source
 from ...engines.inputs import Signal, Sine, Step
-from . import msl
-from .rotor_system import Friction, Part, RotorSystem, Source
+from .examples import data_file
 
 T_END = 1.5
 FN_MAX = 20.0
@@ -55,7 +55,7 @@ REFERENCE_CSV = "CoupledClutches_MSL-4.1.0_reference.csv"
 def reference_path() -> Path:
     """The Modelica Association's reference result (MSL 4.1.0), shipped inside the package in `data/msl/`
     (provenance and licence in the README there)."""
-    return msl.data_file(REFERENCE_CSV)
+    return data_file(REFERENCE_CSV)
 
 
 def load_reference(path: Path | None = None) -> dict[str, np.ndarray]:

@@ -1,4 +1,4 @@
-"""The drives' stick/slip state machine in Python: the readable twin of `native/drives.c`, as a step object.
+"""The rotor library's stick/slip state machine in Python: the readable twin of `native/rotors.c`, as a step object.
 
 `RotorStepper(run)` holds the state of a MuJoCo run of a rotor system (modes, armed flags, event functions, energy
 terms, lock-impact energy, events) and `step()` makes one step exactly as the native core does with the C stepper:
@@ -11,7 +11,7 @@ checked. `run(t)` steps up to t and `result()` makes the final decision at t_end
 Every method mirrors the C function of the same name statement for statement (plain loops, the same floating-point
 operations in the same order), so that a test can hold the two paths equal. It exists to be read and to check the
 native stepper; runs use the native one (`MujocoRotorSim.run(..., stepper="python")` selects this one). About 530
-lines: it mirrors `native/drives.c` function for function and is kept in one file to be read beside it.
+lines: it mirrors `native/rotors.c` function for function and is kept in one file to be read beside it.
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ import mujoco
 import numpy as np
 
 from ...errors import SolverError
+from .interfaces import BWD, FREE, FWD, STUCK, RefResult
 from .rotor_run import CHATTER_N, CHATTER_WINDOW, HINT, RotorRun
-from .rotor_system import BWD, FREE, FWD, STUCK, RefResult
 
 ZERO_SLIP = 1e-12  # rad/s: a free element engaging at a smaller slip is tried for a lock
 _INTEGRATE = {
@@ -114,7 +114,7 @@ class RotorStepper:
             if sig is not None:
                 s = sig(t)
                 if not math.isfinite(s):
-                    raise SolverError(f"drives MuJoCo path: the schedule of friction part '{pt.label}' is not finite "
+                    raise SolverError(f"rotor MuJoCo path: the schedule of friction part '{pt.label}' is not finite "
                                       f"({s!r}) at t = {t:.6g} s")
                 v *= s if s > 0.0 else 0.0
             lv.append(v)
@@ -323,7 +323,7 @@ class RotorStepper:
         self.events.append(self.rotor_run.event(te, t, e, old, new))
         ring = self.chatter[e]
         if len(ring) == CHATTER_N and k - ring[0] < CHATTER_WINDOW:
-            raise SolverError(f"drives MuJoCo path: the stick/slip state machine does not settle: friction element "
+            raise SolverError(f"rotor MuJoCo path: the stick/slip state machine does not settle: friction element "
                               f"'{self.fr[e].name}' changed mode {CHATTER_N + 1} times within {k - ring[0]} steps "
                               f"(mode chattering: the torque on it reverses within a few steps; {HINT}) at t = "
                               f"{t:.6g} s")
@@ -339,7 +339,7 @@ class RotorStepper:
         t = k * dt
         for i in range(self.n):
             if not (math.isfinite(self.w(i)) and math.isfinite(self.q(i))):
-                raise SolverError(f"drives MuJoCo path: the speed or position of rotor "
+                raise SolverError(f"rotor MuJoCo path: the speed or position of rotor "
                                   f"'{self.rotor_run.sys.names[i]}' is not finite at t = {t:.6g} s; {HINT}")
         lv, el = self.levels(t)
         self.slips()
@@ -426,7 +426,7 @@ class RotorStepper:
                 return
             self.modes[worst] = FWD if self.lam[worst] > 0.0 else BWD
             self.armed[worst] = False
-        raise SolverError(f"drives MuJoCo path: the lock trials did not settle at t = {t:.6g} s")
+        raise SolverError(f"rotor MuJoCo path: the lock trials did not settle at t = {t:.6g} s")
 
     def work(self, k: int) -> None:
         """Energy terms of step k: held torques x integrated displacement, velocity terms trapezoidal (C: work)."""
@@ -474,10 +474,10 @@ class RotorStepper:
         d = self.d
         for w, n0 in zip(_BROKEN, self._warn0, strict=True):
             if d.warning[w].number > n0:
-                raise SolverError(f"drives MuJoCo path: MuJoCo diverged (warning {w.name[7:].lower()}) at t = "
+                raise SolverError(f"rotor MuJoCo path: MuJoCo diverged (warning {w.name[7:].lower()}) at t = "
                                   f"{d.time:.6g} s; {HINT}")
         if not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))):
-            raise SolverError(f"drives MuJoCo path: MuJoCo diverged (non-finite state) at t = {d.time:.6g} s; {HINT}")
+            raise SolverError(f"rotor MuJoCo path: MuJoCo diverged (non-finite state) at t = {d.time:.6g} s; {HINT}")
 
     def step(self) -> None:
         """Step k -> k + 1 (module docstring)."""

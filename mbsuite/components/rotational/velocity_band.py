@@ -10,8 +10,8 @@ from scipy.integrate import solve_ivp
 
 from ...errors import ParameterError, SolverError
 from .commands import CommandQueue, Controller
+from .interfaces import BWD, FREE, FWD, STUCK, RefResult, RotorSystem
 from .projection import StuckProjection
-from .rotor_system import BWD, FREE, FWD, STUCK, RefResult, RotorSystem
 
 
 def simulate_velocity_band(

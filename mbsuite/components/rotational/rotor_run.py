@@ -1,5 +1,5 @@
 """One MuJoCo run of a rotor system, as both steppers share it: the run's set-up (`RotorRun`), its signals and the
-constants of the stick/slip state machine (`native_stepper.py` packs it for `native/drives.c`, `stepper.py` is the
+constants of the stick/slip state machine (`native_stepper.py` packs it for `native/rotors.c`, `stepper.py` is the
 Python twin, `mujoco.py` compiles the model and runs it)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 from ...engines.inputs import Signal, Table
 from ...errors import ParameterError, SceneError
 from .commands import CommandQueue, Controller
-from .rotor_system import MODE_NAME, RefResult, RotorSystem
+from .interfaces import MODE_NAME, RefResult, RotorSystem
 
 HINT = "reduce solver.timestep"
 #: steps between two drains of the native event buffer when no controller sets the pace
@@ -24,7 +24,7 @@ CHATTER_N, CHATTER_WINDOW = 16, 64
 
 
 class CompiledRotors(Protocol):
-    """A rotor system on its compiled MJCF (`mujoco.MujocoRotorSim`): the model and data with the system's numbers,
+    """A rotor system on its compiled MJCF (`mujoco_sim.MujocoRotorSim`): the model and data with the system's numbers,
     and the MuJoCo indices of its rotors, locks, actuators and sources."""
 
     sys: RotorSystem

@@ -30,8 +30,8 @@ from scipy.optimize import brentq
 
 from ...errors import ParameterError, SolverError
 from .commands import CommandQueue, Controller
+from .interfaces import BWD, FREE, FWD, MODE_NAME, STUCK, Friction, RefResult, RotorSystem
 from .projection import StuckProjection
-from .rotor_system import BWD, FREE, FWD, MODE_NAME, STUCK, Friction, RefResult, RotorSystem
 
 
 def _const(y: np.ndarray):

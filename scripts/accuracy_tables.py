@@ -26,7 +26,7 @@ from mbsuite.analysis.workprecision import TOLS, Row, workprecision
 
 SCENES = ("pantograph/lab", "pantograph/unilateral", "pantograph/nonlinear_cylinder", "coupler/double_lateral",
           "coupler/double_massless", "coupler/double_inclined", "coupler/double_phibc90", "coupler/double_friction",
-          "drives/coupled_clutches", "drives/step_up_pwm", "drives/step_up_resonant_matched",
+          "rotational/coupled_clutches", "drives/step_up_pwm", "drives/step_up_resonant_matched",
           "drives/susd_100w_design", "drives/susd_500w_open", "iftomm/fourbar", "catenary/en50318",
           "catenary/en50318_two_pantographs")
 #: tolerance levels of a model whose physics error is not relative (the catenary's: in units of its declared

@@ -102,7 +102,7 @@ COMMANDS: tuple[Command, ...] = (
 )
 
 # (row label, command key, name patterns): the headline groups of docs/reproducibility.md
-_MEANS = (r"^stats\.cycles\.mean_(load|motor)_speed$",)
+_MEANS = (r"^statistics\.mean_(load|motor)_speed$",)
 _BOOKS = (r"^signals\.E_in\.final$", r"^stats\.energy_balance\.(input|stored|losses\..+)$")
 _FOURBAR = (r"^signals\.(input_angle|input_rate|energy)\.(min|max|final|mean|std)$",)
 _DRIFT = (r"^stats\.energy_drift_max$", r"^signals\.energy_drift\.final$")

@@ -104,7 +104,7 @@ def test_designed_drive_keeps_its_promise(tmp_path):
     assert p_out == pytest.approx(200.0, rel=0.03)
     w = res["w_load"][m]
     assert 0.0 <= w.min() and w.max() <= 400.0
-    cyc = res.stats["cycles"]
+    cyc = res.statistics
     assert cyc["mean_load_speed"] == pytest.approx(300.0, rel=0.03)
     assert 15.0 <= cyc["switching_rate"] <= sc.sections["design"]["derived"]["Sr_max"]
 

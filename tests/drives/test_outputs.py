@@ -105,10 +105,10 @@ def test_drive_run_study_point_is_the_single_run(tmp_path, capsys):
     assert main([*base, "--set", "params.duty=0.3", "--json"]) == 0
     one = json.loads(capsys.readouterr().out)
     (point,) = [p for p in study["points"] if p["values"]["params.duty"] == 0.3]
-    want = one["stats"]["cycles"]["mean_load_speed"]
-    assert point["results"]["stats.cycles.mean_load_speed"] == want
+    want = one["statistics"]["mean_load_speed"]
+    assert point["results"]["statistics.mean_load_speed"] == want
     other = [p for p in study["points"] if p["values"]["params.duty"] == 0.5][0]
-    assert other["results"]["stats.cycles.mean_load_speed"] != want  # the axis acts
+    assert other["results"]["statistics.mean_load_speed"] != want  # the axis acts
     assert (tmp_path / "study.csv").stat().st_size > 0 and (tmp_path / "study.png").stat().st_size > 10_000
     assert main([*base, "--set", "params.t_n=0.03"]) == 2  # PWM reads no dead time: refused, not ignored
     assert "t_n" in capsys.readouterr().err
@@ -123,6 +123,6 @@ def test_drive_efficiency_point_is_the_run_at_that_load(capsys):
     assert main(["drive", "efficiency", base[0], "--loads", "0.1", *base[1:]]) == 0
     (pt,) = json.loads(capsys.readouterr().out)["points"]
     assert main(["drive", "run", base[0], "--set", "params.tau_l=0.1", *base[1:]]) == 0
-    cyc = json.loads(capsys.readouterr().out)["stats"]["cycles"]
+    cyc = json.loads(capsys.readouterr().out)["statistics"]
     assert pt["tau_l"] == 0.1 and pt["load_speed"] == pytest.approx(cyc["mean_load_speed"], rel=1e-12)
     assert pt["efficiency"] == pytest.approx(cyc["efficiency"], rel=1e-9)

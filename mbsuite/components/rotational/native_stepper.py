@@ -50,24 +50,21 @@ class _Rotors(ctypes.Structure):
     ]
 
 
-_hook_lib: ctypes.CDLL | None = None
+#: the ABI of native/rotors.c (`mbs_rotors_abi`): bump both with any change of `mbs_rotors` or of a signature
+ABI = 1
+#: rotors.c as Python binds it (`engines.native.bind`: loaded once under the library's lock, ABI and `_Rotors` layout
+#: checked)
+DECLARATION = native.Declaration(
+    "components/rotational/native/rotors.c", "mbs_rotors_abi", ABI,
+    functions=(native.CFunction("mbs_rotors_hook", ctypes.c_int,
+                                (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_int)),),
+    structs=(native.CStruct(_Rotors, "mbs_rotors_struct_size"),),
+)
 
 
-def library() -> ctypes.CDLL:
-    """The native library with the rotor stepper's entry points declared (and the struct layout checked)."""
-    global _hook_lib
-    if _hook_lib is None:
-        lib = native.load()
-        lib.mbs_rotors_struct_size.argtypes = []
-        lib.mbs_rotors_struct_size.restype = ctypes.c_int
-        lib.mbs_rotors_hook.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_int]
-        lib.mbs_rotors_hook.restype = ctypes.c_int
-        size = lib.mbs_rotors_struct_size()
-        if size != ctypes.sizeof(_Rotors):
-            raise native.NativeBuildError(f"mbs_rotors is {size} bytes in C, {ctypes.sizeof(_Rotors)} in Python: "
-                                          "native/rotors.c and native_stepper._Rotors disagree")
-        _hook_lib = lib
-    return _hook_lib
+def library() -> native.Binding:
+    """The rotor stepper's entry points on the native library (`DECLARATION`)."""
+    return native.bind(DECLARATION)
 
 
 class NativeRotorRun:

@@ -15,12 +15,12 @@ from pathlib import Path
 
 from ...deferred import Deferred
 from ...limits import Limit
-from ...registry import Effect, ModelSpec, RunPath
+from ...registry import Effect, ModelSpec, RunPath, Studies
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
 from .params import DriveParams
-from .scene_run import PROFILE, SIGNALS
+from .scene_run import PROFILE, SIGNALS, STATISTICS
 
 SPEC = ModelSpec(
     name="drives",
@@ -65,6 +65,8 @@ SPEC = ModelSpec(
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=2.0),
     commands="mbsuite.models.drives.cli",
+    statistics=STATISTICS,
+    studies=Studies(threads=("mujoco",)),
     moved_scenes={name: f"rotational/{name}" for name in (
         "coupled_clutches", "msl_friction", "msl_one_way_clutch", "msl_one_way_clutch_disengaged",
         "msl_simple_gear_shift")},

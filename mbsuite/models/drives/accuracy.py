@@ -100,7 +100,7 @@ def values(scene: Any, res: Any) -> dict[str, float]:
     """The headline values of a run's result (NaN for a lock-up that did not happen)."""
     mech = scene.effects["mechanism"]
     out = {"n_events": float(len(res.events))}
-    cyc = res.stats.get("cycles", {})
+    cyc = res.statistics
     out["mean_load_speed"] = float(cyc.get("mean_load_speed", math.nan))
     out["mean_motor_speed"] = float(cyc.get("mean_motor_speed", math.nan))
     if _has_load_torque(scene):

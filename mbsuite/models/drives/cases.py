@@ -231,7 +231,7 @@ class DrivesStudy(Study):
         period), relative; returns (error, details)."""
         det = {}
         period = 0.1
-        cr, cf = res.stats.get("cycles", {}), ref.stats.get("cycles", {})
+        cr, cf = res.statistics, ref.statistics
         if abs(cf.get("mean_load_speed", 0.0)) > 0:
             det["load_speed_rel"] = _rel(cr.get("mean_load_speed", math.nan), cf["mean_load_speed"])
         if cf.get("switching_rate"):

@@ -378,7 +378,7 @@ def run_of(sc, a: argparse.Namespace) -> Report:
     res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate,
                               what=f"drives scene {sc.name or sc.source or ''}".strip()))
     eb = res.stats["energy_balance"]
-    cyc = res.stats.get("cycles", {})
+    cyc = res.statistics
     rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
             ["events", "clutch/brake mode changes", len(res.events), ""]]
     rows += [[k, *CYCLE_QUANTITIES.get(k, (k, ""))[:1], v, CYCLE_QUANTITIES.get(k, (k, ""))[1]]
@@ -393,8 +393,9 @@ def run_of(sc, a: argparse.Namespace) -> Report:
         table += "\n\n" + res.error_estimate.table()
     if res.warnings:
         table += "\n\n" + "\n".join(res.warnings)
-    summary = {k: v for k, v in res.summary().items() if k not in ("stats", "input", "solver")}  # once, not twice
-    return Report({"options": _options(a), "summary": summary, "stats": res.stats}, table, partial(_write_run, res))
+    summary = {k: v for k, v in res.summary().items() if k not in ("stats", "statistics", "input", "solver")}  # once
+    return Report({"options": _options(a), "summary": summary, "statistics": res.statistics, "stats": res.stats},
+                  table, partial(_write_run, res))
 
 
 def _write_run(res, out: Path) -> list[Path]:

@@ -16,9 +16,25 @@ from ...limits import Limit
 from ...results import SimResult, assemble
 from ...scenes import Scene
 from ...schema import Items, Rule, check_value
+from ...statistics import Statistic
 from ...trust.health import Figure
 from . import drive
 from .accuracy import window_efficiency
+
+#: the window of a drive's statistics: the settled part of the run
+WINDOW = "t >= solver.t_settle (controller times within drive.T0_TOL count in)"
+#: the statistics of a drive run (`SPEC.statistics`; `SimResult.statistics`): `drive.cycle_stats`,
+#: `accuracy.window_efficiency` (Oldaker 1997, Sec. 3.3 and Eqs 3.21-3.24 corrected)
+STATISTICS = {
+    "n_cycles": Statistic("-", "energy cycles completed (from the controller's log)", WINDOW),
+    "switching_rate": Statistic("1/s", "switching rate Sr: energy cycles per second, first to last cycle start",
+                                WINDOW),
+    "mean_load_speed": Statistic("rad/s", "time-mean load speed: the angle travelled over the time", WINDOW),
+    "mean_motor_speed": Statistic("rad/s", "time-mean motor speed: the angle travelled over the time", WINDOW),
+    "packets": Statistic("J", "the energy packet of each cycle (energy-packet controller)", WINDOW, kind="numbers"),
+    "max_extension": Statistic("rad", "largest spring twist at a transfer", WINDOW),
+    "efficiency": Statistic("1", "efficiency E_out / E_in (Eq 3.22 corrected; a scene with a load torque)", WINDOW),
+}
 
 SIGNALS = {
     "w_motor": "rad/s", "w_spring": "rad/s", "w_load": "rad/s",
@@ -96,8 +112,9 @@ def setup(scene: Scene) -> RunSetup:
 
 
 def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> SimResult:
-    """The `SimResult` of a run of the scene (speeds, angles, twist, energies, commands; energy balance, cycle
-    statistics and mode changes in `stats`; the energy residual as a health figure, judged by `mbsuite.run`)."""
+    """The `SimResult` of a run of the scene (speeds, angles, twist, energies, commands as signals; the cycle
+    statistics in `statistics` (`STATISTICS`); the energy balance and the solver's counters in `stats`; the energy
+    residual as a health figure, judged by `mbsuite.run`)."""
     mech = scene.effects["mechanism"]
     sig: dict[str, np.ndarray] = {}
     for i, nm in enumerate(("motor", "spring", "load")):
@@ -117,12 +134,12 @@ def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> 
     stats.pop("reset_energy", None)  # it is the balance's lock_impact term
     stats["energy_balance"] = {"input": bal.input, "output": bal.output, "stored": bal.stored,
                                "losses": bal.losses, "residual": bal.residual, "relative": bal.relative}
+    statistics: dict[str, Any] = {}
     if ctrl is not None:
-        cs = drive.cycle_stats(res, ctrl, t0=scene.solver.t_settle)
-        cs.pop("packets", None)
+        statistics = drive.cycle_stats(res, ctrl, t0=scene.solver.t_settle)
+        statistics.pop("packets", None)
         if outputs:  # a load torque: the efficiency over the same window (Eq 3.22 corrected)
-            cs["efficiency"] = window_efficiency(res.t, sig["E_in"], sig["E_out"], scene.solver.t_settle)
-        stats["cycles"] = cs
+            statistics["efficiency"] = window_efficiency(res.t, sig["E_in"], sig["E_out"], scene.solver.t_settle)
     # the scene's outputs in its order (an output of the other mechanisms is not computed, so not kept)
     ordered = {k: sig[k] for k in scene.outputs if k in sig}
     health = [Figure(
@@ -130,4 +147,4 @@ def sim_result(scene: Scene, res: RefResult, ctrl: Any, system: RotorSystem) -> 
         "energy balance |input - output - losses - change of stored energy| / input over the run",
         "tighten solver.rtol/atol (reference) or reduce solver.timestep (mujoco)")]
     return assemble(scene, res.t, ordered, engine=scene.solver.engine, events=res.events, stats=stats,
-                    health=health)
+                    statistics=statistics, health=health)

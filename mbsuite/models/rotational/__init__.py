@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...deferred import Deferred
-from ...registry import Effect, ModelSpec, RunPath
+from ...registry import Effect, ModelSpec, RunPath, Studies
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
@@ -44,4 +44,5 @@ SPEC = ModelSpec(
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     solver=SolverSettings(engine="reference", integrator="rk4", timestep=1e-4, rtol=1e-9, atol=1e-11, duration=1.5),
     commands="mbsuite.models.rotational.cli",
+    studies=Studies(threads=("mujoco",)),
 )

@@ -621,5 +621,7 @@ int mbs_rotors_hook(const mjModel* m, mjData* d, void* ud, long k, int stage) {
   return work(d, S, k);
 }
 
-/* the size of the struct, for the Python side's layout check */
+/* the size of the struct and the ABI, for the Python side's checks (native_stepper.DECLARATION) */
+#define ROT_ABI 1 /* bump with any change of mbs_rotors or of an mbs_rotors_* signature (native_stepper.ABI) */
 int mbs_rotors_struct_size(void) { return (int)sizeof(mbs_rotors); }
+int mbs_rotors_abi(void) { return ROT_ABI; }

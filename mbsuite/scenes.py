@@ -219,18 +219,55 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     """Validate a scene dictionary against its model's spec. Errors name the offending key and list valid ones, and
     say where the value came from: "in SOURCE" (the file; "in the scene dictionary" without one), or `origin` (a
     phrase such as "set in Python" or "on the command line (--set)") for the keys in `changed` (section -> keys,
-    None: the whole section; without `changed`, every value). Values are taken as `plain` makes them."""
+    None: the whole section; without `changed`, every value). Values are taken as `plain` makes them.
+
+    The checks run in this order, one step each: the model, the shape of the top-level keys, the model's own sections,
+    effects, params, input, outputs, solver (then the values the scene's effects leave unused), the accuracy
+    tolerances, and the parameters and accuracy names across fields."""
     base = f" in {source}" if source else " in the scene dictionary"
     if origin and changed is None:
         base, changed = f" {origin}", {}
     where = Where(base, origin or "", dict(changed or {}))
     data = {k: plain(v) for k, v in copy.deepcopy(dict(data)).items()}
+    spec = _model_of(data, where)
+    _check_top_keys(data, spec, where)
+    extra = _model_sections(data, spec, source, where)
+    effects = _effects_of(data, spec, where)
+    params = _params_of(data, spec, where)
+    inp = _input_of(data, spec, where)
+    signals = _outputs_of(data, spec, where)
+    solver = _solver_of(data, spec, where)
+    spec.refuse_unused(effects, None, params, data.get("input") or {}, inp, extra, where)
+
+    scene = Scene(
+        model=spec.name,
+        name=str(data.get("name") or ""),
+        description=str(data.get("description") or ""),
+        effects=effects,
+        params=dict(params),
+        input=inp,
+        outputs=signals,
+        solver=solver,
+        source=source,
+        sections=extra,
+        accuracy=check_tolerances(data.get("accuracy") or {}, where("accuracy")),
+    )
+    _check_across_fields(scene, spec, where)
+    return scene
+
+
+def _model_of(data: dict[str, Any], where: Where) -> ModelSpec:
+    """The spec of the model the scene names."""
     if "model" not in data:
         raise SceneError(f"scene{where()} does not name a model; valid models: {sorted(models())}")
     if not isinstance(data["model"], str):
         raise SceneError(f"model = {data['model']!r}{where('model')} must be a model name; valid models: "
                          f"{sorted(models())}")
-    spec = get_model(data["model"])
+    return get_model(data["model"])
+
+
+def _check_top_keys(data: dict[str, Any], spec: ModelSpec, where: Where) -> None:
+    """Strings where strings are meant, tables where sections are, and no unknown top-level key."""
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
             raise SceneError(f"{key} = {data[key]!r}{where(key)} must be a string")
@@ -243,6 +280,10 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     unknown = sorted(set(data) - set(TOP_KEYS) - set(spec.sections))
     if unknown:
         raise SceneError(f"unknown scene key(s) {unknown}{where()}; valid keys: {[*TOP_KEYS, *spec.sections]}")
+
+
+def _model_sections(data: dict[str, Any], spec: ModelSpec, source: str | None, where: Where) -> dict[str, Any]:
+    """The model's own sections (`ModelSpec.sections`), each through its validator."""
     extra = {}
     for k in spec.sections:
         if k in data:
@@ -254,7 +295,11 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
                     extra[k] = check(data[k])
             except MbsuiteError as exc:
                 raise _told(exc, where(k)) from None
+    return extra
 
+
+def _effects_of(data: dict[str, Any], spec: ModelSpec, where: Where) -> dict[str, Any]:
+    """Every effect of the model: the scene's value, else its default, each checked."""
     effects_in = data.get("effects") or {}
     bad = sorted(set(effects_in) - set(spec.effects))
     if bad:
@@ -264,7 +309,11 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     effects = {}
     for name, eff in spec.effects.items():
         effects[name] = eff.check(name, effects_in.get(name, eff.default), where("effects", name))
+    return effects
 
+
+def _params_of(data: dict[str, Any], spec: ModelSpec, where: Where) -> dict[str, Any]:
+    """The `[params]` overrides, each a known parameter checked against its field (`_param_value`)."""
     params = dict(data.get("params") or {})
     valid_params = spec.param_names()
     bad = sorted(set(params) - set(valid_params))
@@ -273,7 +322,12 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
                          f"valid parameters: {valid_params}")
     for k, v in params.items():
         params[k] = _param_value(spec, k, v, where("params", k))
+    return params
 
+
+def _input_of(data: dict[str, Any], spec: ModelSpec, where: Where) -> dict[str, Any]:
+    """The `[input]`: its type (default: the model's first), its declared keys checked with their defaults resolved,
+    every other value at least finite and not a table."""
     inp = dict(data.get("input") or {})
     if spec.inputs:
         itype = inp.get("type", next(iter(spec.inputs)))
@@ -286,27 +340,36 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
                 f"unknown input key(s) {bad} for input type {itype!r}{where.any_of('input', bad)}; valid keys: "
                 f"{sorted(spec.inputs[itype])}")
         inp["type"] = itype
-        for key, decl in spec.inputs[itype].items():
-            if isinstance(decl, Items):
-                if key in inp:
-                    inp[key] = [list(r) if isinstance(r, tuple) else r for r in
-                                check_value(decl, f"input.{key}", inp[key], f"[input]{where('input', key)}",
-                                            SceneError)]
-                continue
-            if not isinstance(decl, Limit):
-                continue
-            if key in inp:
-                inp[key] = decl.check(f"input.{key}", inp[key], SceneError, where('input', key))
-            elif decl.has_default:
-                inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
-            if decl.kind is float and decl.choices is None and isinstance(inp.get(key), float):
-                inp[key] = perturbation.value(inp[key], decl, f"input.{key}")  # unchanged outside the stability check
+        _input_values(inp, spec.inputs[itype], where)
     for key, v in inp.items():  # keys without a declared Limit: at least finite, never a nested table
         if isinstance(v, float) and not math.isfinite(v):
             raise SceneError(f"input.{key} = {v!r}{where('input', key)} must be a finite number")
         if isinstance(v, Mapping):
             raise SceneError(f"input.{key}{where('input', key)} must be a value, not a table")
+    return inp
 
+
+def _input_values(inp: dict[str, Any], decls: Mapping[str, Any], where: Where) -> None:
+    """The input's declared keys in place: lists of items checked, limited values checked or set to their default."""
+    for key, decl in decls.items():
+        if isinstance(decl, Items):
+            if key in inp:
+                inp[key] = [list(r) if isinstance(r, tuple) else r for r in
+                            check_value(decl, f"input.{key}", inp[key], f"[input]{where('input', key)}",
+                                        SceneError)]
+            continue
+        if not isinstance(decl, Limit):
+            continue
+        if key in inp:
+            inp[key] = decl.check(f"input.{key}", inp[key], SceneError, where('input', key))
+        elif decl.has_default:
+            inp[key] = decl.default  # resolved defaults are part of the scene: shown in every output
+        if decl.kind is float and decl.choices is None and isinstance(inp.get(key), float):
+            inp[key] = perturbation.value(inp[key], decl, f"input.{key}")  # unchanged outside the stability check
+
+
+def _outputs_of(data: dict[str, Any], spec: ModelSpec, where: Where) -> tuple[str, ...]:
+    """The output signals (`[outputs] signals`, or a plain list), each one of the model's."""
     outputs = data.get("outputs") or {}
     if isinstance(outputs, Mapping):
         bad = sorted(set(outputs) - {"signals"})
@@ -327,7 +390,11 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     bad = [s for s in signals if s not in spec.outputs]
     if bad:
         raise SceneError(f"unknown output signal(s) {bad}{w}; valid signals: {list(spec.outputs)}")
+    return signals
 
+
+def _solver_of(data: dict[str, Any], spec: ModelSpec, where: Where) -> SolverSettings:
+    """The `[solver]` over the model's defaults (a path's label names its key), checked against its engines."""
     solver_in = dict(data.get("solver") or {})
     bad = sorted(set(solver_in) - set(SOLVER_KEYS))
     if bad:
@@ -335,22 +402,12 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
     if isinstance(solver_in.get("engine"), str):
         solver_in["engine"] = spec.path_key(solver_in["engine"])  # a path's label ("equations") names its key
     solver = dataclasses.replace(spec.solver, **solver_in)
-    solver = solver.check(spec.engines, lambda key=None: where("solver", key))
-    spec.refuse_unused(effects, None, params, data.get("input") or {}, inp, extra, where)
+    return solver.check(spec.engines, lambda key=None: where("solver", key))
 
-    scene = Scene(
-        model=spec.name,
-        name=str(data.get("name") or ""),
-        description=str(data.get("description") or ""),
-        effects=effects,
-        params=dict(params),
-        input=inp,
-        outputs=signals,
-        solver=solver,
-        source=source,
-        sections=extra,
-        accuracy=check_tolerances(data.get("accuracy") or {}, where("accuracy")),
-    )
+
+def _check_across_fields(scene: Scene, spec: ModelSpec, where: Where) -> None:
+    """The checks across fields: the parameter dataclass validates itself (d1 <= l1 etc.), and every `[accuracy]`
+    name is a headline of this scene."""
     try:
         scene.build_params()  # parameter dataclasses validate themselves across fields (d1 <= l1 etc.)
     except MbsuiteError as exc:
@@ -362,7 +419,6 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None, *, origi
             declared(scene)  # every name a headline of this scene
         except MbsuiteError as exc:
             raise _told(exc, where("accuracy")) from None
-    return scene
 
 
 def load_scene(ref: str | Path) -> Scene:

@@ -72,8 +72,11 @@ class EventExactIntegrator(Stepping):
         self.status = "running" if self.t < t_end else "finished"
 
     def _one_step(self) -> None:
-        """Integrate one smooth segment: to the next friction/contact event or to `t_end`."""
-        ode, y_w, t0, t_end, modes = self.ode, self.y_w, self.t, self.t_end, self.modes
+        """Integrate one smooth segment: to the next friction/contact event, the input's next jump or `t_end`. Its
+        parts run once per segment, not per RHS evaluation (solve_ivp's loop is the lambda in `_integrate`): the
+        segment's events (`_segment_events`) and samples (`_segment_samples`), the integration, the samples kept
+        (`_keep`), and what the event that ended it changes (`_contact_switched`, `_friction_switched`)."""
+        t0, t_end = self.t, self.t_end
         self.nsegments += 1
         if self.nsegments > self.max_events:
             raise SolverError(f"more than {self.max_events} friction/contact events before t = {t0:.6g} s (mode "
@@ -81,7 +84,35 @@ class EventExactIntegrator(Stepping):
         # a discontinuity of the input (a step) ends the segment: integrate to it on the input's left limit
         brk = next((b for b in self.breaks if b > t0), None)
         t_stop = t_end if brk is None else brk
-        u = y_w if brk is None else _left_limit(y_w, brk)
+        u = self.y_w if brk is None else _left_limit(self.y_w, brk)
+        evs, kinds = self._segment_events(u)
+        te = self._segment_samples(t0, t_stop, brk)
+        sol = self._integrate(u, t0, t_stop, te, evs)
+        at_break = brk is not None and sol.status == 0
+        x_brk = self._keep(sol, te, at_break)
+        if at_break:
+            self._cross_break(brk, x_brk)
+            return
+        if sol.status == 0:
+            self.t, self.status = t_end, "finished"
+            return
+        # a terminal event fired: find which
+        k = next(i for i, te_ in enumerate(sol.t_events) if te_.size)
+        t0 = float(sol.t_events[k][0])
+        x = sol.y_events[k][0].copy()
+        kind, j = kinds[k]
+        if kind == "contact":
+            self._contact_switched(t0)
+        else:
+            x = self._friction_switched(kind, j, t0, x)
+        self.t, self.x = t0, x
+        if self.t >= t_end:
+            self.status = "finished"
+
+    def _segment_events(self, u: Callable[[float], float]) -> tuple[list, list[tuple[str, int]]]:
+        """The segment's terminal events and their kinds: per joint with friction, its release (stuck) or its rate's
+        zero (sliding); the contact's closing or opening (unilateral contact)."""
+        ode, modes = self.ode, self.modes
         evs, kinds = [], []
         if self.exact:
             for j in range(3):
@@ -96,11 +127,21 @@ class EventExactIntegrator(Stepping):
         if self.unilateral:
             evs.append(_contact_event(ode, u, self.in_contact))
             kinds.append(("contact", -1))
+        return evs, kinds
+
+    def _segment_samples(self, t0: float, t_stop: float, brk: float | None) -> np.ndarray | None:
+        """The sample times of `t_eval` in the segment (None: every solver step)."""
         t_eval = self.t_eval
         te = None if t_eval is None else t_eval[(t_eval >= t0) & (t_eval <= t_stop)]
         if brk is not None and te is not None:  # the break's own sample belongs to the next segment
             te = np.append(te[te < brk], brk)
-        seg_modes = modes if self.exact else None
+        return te
+
+    def _integrate(self, u: Callable[[float], float], t0: float, t_stop: float, te: np.ndarray | None, evs: list):
+        """solve_ivp over the segment in the current friction modes, its cost counted and its failures a
+        SolverError."""
+        ode = self.ode
+        seg_modes = self.modes if self.exact else None
         try:
             sol = solve_ivp(lambda t, x, m=seg_modes: ode.rhs(t, x, u(t), m), (t0, t_stop), self.x,
                             t_eval=te, events=evs or None, **self._kw)
@@ -108,14 +149,19 @@ class EventExactIntegrator(Stepping):
             raise SolverError(f"reference integrator {self.method} failed to locate a friction/contact event after "
                               f"t = {t0:.6g} s ({exc}); tighten solver.rtol or choose another solver.method") from None
         self.nfev += sol.nfev
-        self.nsteps += max(len(sol.t) - 1, 0) if t_eval is None else 0
+        self.nsteps += max(len(sol.t) - 1, 0) if self.t_eval is None else 0
         if sol.status == -1:
             raise SolverError(f"reference integrator {self.method} failed at t = {sol.t[-1]:.6g} s: {sol.message}")
         if self.nfev > self.max_nfev:
             raise SolverError(f"reference integrator exceeded {self.max_nfev} RHS evaluations (step-size collapse)")
+        return sol
+
+    def _keep(self, sol, te: np.ndarray | None, at_break: bool) -> np.ndarray | None:
+        """Keep the segment's samples; at an input jump, return the state there (its sample, if sampled, is left to
+        the next segment)."""
         st = np.asarray(sol.t, dtype=float)
-        sy = np.asarray(sol.y, dtype=float).reshape(ode.n, st.size)
-        at_break = brk is not None and sol.status == 0
+        sy = np.asarray(sol.y, dtype=float).reshape(self.ode.n, st.size)
+        x_brk = None
         if at_break and te is not None:  # keep the state at the break, leave its sample to the next segment
             x_brk, st, sy = sy[:, -1].copy(), st[:-1], sy[:, :-1]
         elif at_break:
@@ -123,46 +169,41 @@ class EventExactIntegrator(Stepping):
         if st.size:
             self._t_out.append(st)
             self._x_out.append(sy)
-        if at_break:
-            self._cross_break(brk, x_brk)
-            return
-        if sol.status == 0:
-            self.t, self.status = t_end, "finished"
-            return
-        # a terminal event fired: find which
-        k = next(i for i, te_ in enumerate(sol.t_events) if te_.size)
-        t0 = float(sol.t_events[k][0])
-        x = sol.y_events[k][0].copy()
-        kind, j = kinds[k]
-        if kind == "contact":
-            self.in_contact = not self.in_contact
-            if self.in_contact:
-                self.events.append({"kind": "contact_loss", "t_start": self._loss_start,
-                                    "duration": t0 - self._loss_start})
-                self._loss_start = None
-            else:
-                self._loss_start = t0
+        return x_brk
+
+    def _contact_switched(self, t0: float) -> None:
+        """The contact closed (a loss ends and is recorded) or opened (a loss starts) at t0."""
+        self.in_contact = not self.in_contact
+        if self.in_contact:
+            self.events.append({"kind": "contact_loss", "t_start": self._loss_start,
+                                "duration": t0 - self._loss_start})
+            self._loss_start = None
         else:
-            old = modes.stuck.copy()
-            if kind == "zero_rate":
-                modes.stuck[j] = True
-            else:  # the holding torque of joint j reached c: it breaks loose in the direction the torque drives it
-                f_s = ode.contact_force(y_w(t0), ode.contact_height(x))
-                _, mu, _, _ = ode._dynamics(x, f_s, modes)
-                pos = int(np.flatnonzero(modes.stuck & (ode.c > 0)).tolist().index(j))
-                modes.stuck[j] = False
-                modes.direction[j] = -math.copysign(1.0, mu[pos])
-            modes = self.modes = _decide_modes(ode, x, y_w(t0), modes)
-            x = _project_stuck(ode, x, modes)
-            changed = np.flatnonzero(old != modes.stuck)
-            for jj in changed:
-                self.events.append({"kind": "stick" if modes.stuck[jj] else "slip", "joint": JOINT_NAMES[jj],
-                                    "t": t0})
-            if kind == "zero_rate" and not modes.stuck[j]:
-                self.events.append({"kind": "reversal", "joint": JOINT_NAMES[j], "t": t0})
-        self.t, self.x = t0, x
-        if self.t >= t_end:
-            self.status = "finished"
+            self._loss_start = t0
+
+    def _friction_switched(self, kind: str, j: int, t0: float, x: np.ndarray) -> np.ndarray:
+        """Joint j's rate reached zero (`zero_rate`: it sticks) or its holding torque reached c (`release`: it breaks
+        loose in the direction the torque drives it); the modes re-decided, the state projected onto them and the
+        stick/slip/reversal events recorded. Returns the projected state."""
+        ode, y_w, modes = self.ode, self.y_w, self.modes
+        old = modes.stuck.copy()
+        if kind == "zero_rate":
+            modes.stuck[j] = True
+        else:  # the holding torque of joint j reached c: it breaks loose in the direction the torque drives it
+            f_s = ode.contact_force(y_w(t0), ode.contact_height(x))
+            _, mu, _, _ = ode._dynamics(x, f_s, modes)
+            pos = int(np.flatnonzero(modes.stuck & (ode.c > 0)).tolist().index(j))
+            modes.stuck[j] = False
+            modes.direction[j] = -math.copysign(1.0, mu[pos])
+        modes = self.modes = _decide_modes(ode, x, y_w(t0), modes)
+        x = _project_stuck(ode, x, modes)
+        changed = np.flatnonzero(old != modes.stuck)
+        for jj in changed:
+            self.events.append({"kind": "stick" if modes.stuck[jj] else "slip", "joint": JOINT_NAMES[jj],
+                                "t": t0})
+        if kind == "zero_rate" and not modes.stuck[j]:
+            self.events.append({"kind": "reversal", "joint": JOINT_NAMES[j], "t": t0})
+        return x
 
     def _cross_break(self, t0: float, x: np.ndarray) -> None:
         """At a jump of the input: re-decide the friction modes (a stuck joint whose holding torque jumped past c

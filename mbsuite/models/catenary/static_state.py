@@ -1,0 +1,138 @@
+"""The static state of a line (catenary.md, "Choices mbsuite fixes"): no pre-sag; the CW is held level (w = 0) at
+every dropper and support and sags under its own weight between them. The constraint reactions at the droppers are
+the droppers' static tensions; those at the supports are the steady arms' static pre-loads (constant, they cancel in
+the dynamics). `check_compression` refuses a slack dropper in compression in it.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from ...errors import ParameterError
+from .line import Line
+
+
+def check_compression(line: Line, T0: np.ndarray, slack: np.ndarray) -> None:
+    """A `ParameterError` naming the first dropper of mask `slack` whose static tension is negative."""
+    bad = np.nonzero(slack & (T0 < 0))[0]
+    if bad.size:
+        d = line.droppers[int(bad[0])]
+        raise ParameterError(
+            f"line {line.name!r}: the dropper at x = {d.x} m ({d.upper} -> {d.lower}) is in compression in the static "
+            f"state (T0 = {T0[int(bad[0])]:.4g} N): a slack dropper cannot hold the wire there (give it law = "
+            "'linear' if it is a strut, or change the line)")
+
+
+def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarray, up: np.ndarray,
+                 low: np.ndarray, K: sp.csr_matrix, f: np.ndarray, pinned: list[int]
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The static state of every wire (catenary.md, "Choices mbsuite fixes", generalised): each dropper holds its
+    lower wire at its design height (the contact wire: `Line.design_height`, the presag; another wire: 0), the contact
+    wire is held at its design height at every support, and the droppers' tensions and the steady arms' pre-loads are
+    the holds' reactions r = K w - f. Wires joined by clamps form a group (`wire_groups`); a group is solved once every
+    dropper hanging from it has its tension (the contact wire's group first), those tensions loading it where they
+    hang: the simple line's contact wire is solved alone, exactly as before, and the messenger then carries its
+    droppers. K holds the beams, the clamps and the ground springs of the wires other than the contact wire. Returns
+    the full static state, the dropper tensions and the support reactions."""
+    nd = up.size
+    wi = {w.name: k for k, w in enumerate(line.wires)}
+    group = wire_groups(line)
+    d_up = np.array([group[wi[d.upper]] for d in line.droppers], dtype=int)
+    d_low = np.array([group[wi[d.lower]] for d in line.droppers], dtype=int)
+    if np.any(d_up == d_low):
+        j = int(np.nonzero(d_up == d_low)[0][0])
+        raise ParameterError(f"line {line.name!r}: the dropper at x = {line.droppers[j].x} m joins wires that clamps "
+                             "already join (a loop: it would hang a wire from itself)")
+    z = line.design_height(np.array([d.x for d in line.droppers], dtype=float))
+    z = np.where(d_low == group[0], z, 0.0)
+    u = np.zeros(K.shape[0])
+    T0 = np.full(nd, np.nan)
+    preload = np.zeros(supports.size)
+    f = f.copy()
+    todo = sorted(set(group))
+    while todo:
+        ready = [g for g in todo if not np.any(np.isnan(T0[d_up == g]))]
+        if not ready:
+            raise ParameterError(f"line {line.name!r}: its droppers form a loop (a wire hangs from a wire that hangs "
+                                 "from it)")
+        g = ready[0]
+        todo.remove(g)
+        ks = [k for k in range(len(line.wires)) if group[k] == g]
+        sl = slot[ks]
+        idx = np.sort(np.concatenate([sl[sl >= 0], sl[sl >= 0] + 1]))
+        pos = -np.ones(K.shape[0], dtype=int)
+        pos[idx] = np.arange(idx.size)
+        mine = np.nonzero(d_low == g)[0]
+        held = _holds(line, x, slot, supports, pinned, pos, low, z, mine, g == group[0])
+        Kg = K[idx][:, idx].tocsr()
+        Kg.eliminate_zeros()
+        fg = f[idx]
+        w = _solve_held(Kg, fg, held)
+        if not np.all(np.isfinite(w)):
+            names = [line.wires[k].name for k in ks]
+            raise ParameterError(f"line {line.name!r}: the static state of wire(s) {names} is singular: a part is held "
+                                 "by nothing (no pinned end, ground spring, clamp or dropper carries it)")
+        r = Kg @ w - fg
+        u[idx] = w
+        T0[mine] = r[pos[low[mine]]]
+        for j in mine:  # the dropper now loads the wire it hangs from
+            f[up[j]] -= T0[j]
+        if g == group[0]:
+            arm = np.array([line.steady_arm(sp_) for sp_ in line.supports], dtype=bool)
+            preload = np.where(arm, r[pos[slot[0, supports]]], 0.0)
+    return u, T0, preload
+
+
+def wire_groups(line: Line) -> list[int]:
+    """The group of each wire: wires joined by clamps share one (its representative wire's index)."""
+    wi = {w.name: k for k, w in enumerate(line.wires)}
+    parent = list(range(len(line.wires)))
+
+    def root(a: int) -> int:
+        while parent[a] != a:
+            a = parent[a]
+        return a
+
+    for c in line.clamps:
+        parent[root(wi[c.a])] = root(wi[c.b])
+    return [root(k) for k in range(len(line.wires))]
+
+
+def _holds(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarray, pinned: list[int], pos: np.ndarray,
+           low: np.ndarray, z: np.ndarray, mine: np.ndarray, contact_group: bool) -> dict[int, float]:
+    """The held DOFs of one group (its local index -> height): pinned ends at 0, the lower end of each of its droppers
+    `mine` at its design height, and (the contact wire's group) the contact wire at each support with a steady arm."""
+    held = {}
+    for p in pinned:
+        if pos[p] >= 0:
+            held[int(pos[p])] = 0.0
+    for j in mine:
+        held[int(pos[low[j]])] = float(z[j])
+    if contact_group:  # the contact wire at each support with a steady arm (a ground spring on it)
+        zs = line.design_height(x[supports])
+        for i, s in enumerate(slot[0, supports]):
+            if line.steady_arm(line.supports[i]):
+                held[int(pos[s])] = float(zs[i])
+    return held
+
+
+def _solve_held(Kg: sp.csr_matrix, fg: np.ndarray, held: dict[int, float]) -> np.ndarray:
+    """The group's static state with the `held` DOFs at their heights (NaN where its matrix is singular)."""
+    hk = np.array(sorted(held), dtype=int)
+    w = np.zeros(fg.size)
+    w[hk] = [held[k] for k in hk]
+    mask = np.ones(fg.size, bool)
+    mask[hk] = False
+    fr = np.nonzero(mask)[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", category=sp.linalg.MatrixRankWarning)
+        try:
+            w[fr] = spsolve(Kg[fr][:, fr].tocsc(), fg[fr] - Kg[fr][:, hk] @ w[hk]) if np.any(w[hk]) else \
+                spsolve(Kg[fr][:, fr].tocsc(), fg[fr])
+        except (sp.linalg.MatrixRankWarning, RuntimeError):
+            w[fr] = np.nan
+    return w

@@ -21,7 +21,10 @@ several keys) and minimises the worst (`aggregate="worst"`) or the mean; the con
 Pareto front (`pareto`): the epsilon-constraint method with scipy — minimise the objective subject to the second
 output >= each level of a list (Haimes, Lasdon and Wismer 1971), every level a `run`; the front is the non-dominated
 set of all evaluations of all levels. A multi-objective library (pymoo) is not used: it would add ten packages to
-the install for a front that a few bounded runs on the same machinery give, with the same executors and store."""
+the install for a front that a few bounded runs on the same machinery give, with the same executors and store.
+
+The module is kept whole (about 600 lines): the bounds, the penalised problem, `run`, `pareto` and their results
+with their reports are one method, read together."""
 
 from __future__ import annotations
 

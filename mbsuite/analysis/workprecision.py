@@ -99,6 +99,51 @@ class Study:
         raise NotImplementedError
 
 
+class LadderStudy(Study):
+    """A study of a model with an event-exact hand path (`reference`, one integrator: its tolerance ladder
+    `HAND_RTOLS`, atol = rtol / 100) and a MuJoCo path (`MJ_INTEGRATORS` x `MJ_STEPS`); the reference is the hand
+    path at rtol 1e-12 (checked against rtol 1e-11). A subclass sets `base` (the scene the settings change) and
+    `signals` (the outputs the state error compares: max_t |y - y_ref| / max_t |y_ref| over them, on the output
+    grid), and writes `physics_error`."""
+
+    HAND_RTOLS: tuple[float, ...] = (1e-4, 1e-6, 1e-8, 1e-10)
+    HAND_METHOD = "event-exact DOP853"
+    MJ_INTEGRATORS: tuple[str, ...] = ("rk4", "euler")
+    MJ_STEPS: tuple[float, ...] = (1e-4, 5e-5, 2e-5)
+    base: Scene
+    signals: list[str]
+
+    def settings(self) -> list[Setting]:
+        """The settings of the study: hand-path tolerances and MuJoCo integrators x timesteps (quick: one each)."""
+        from ..simulate import run
+
+        out = []
+        for r in ((1e-6,) if self.quick else self.HAND_RTOLS):
+            sc = self.base.replace(solver={"engine": "reference", "rtol": r, "atol": r * 1e-2})
+            out.append(Setting("reference", self.HAND_METHOD, r, lambda sc=sc: run(sc)))
+        for i in ("rk4",) if self.quick else self.MJ_INTEGRATORS:
+            for h in ((1e-4,) if self.quick else self.MJ_STEPS):
+                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
+                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
+        return out
+
+    def reference(self) -> tuple[Any, dict]:
+        """The reference run (hand path, rtol 1e-12) and its own accuracy (against rtol 1e-11)."""
+        from ..simulate import run
+
+        ref = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-12, "atol": 1e-14}))
+        chk = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-11, "atol": 1e-13}))
+        err, _ = self.physics_error(chk, ref)
+        return ref, {"reference": f"hand path ({self.HAND_METHOD}) rtol 1e-12, atol 1e-14",
+                     "check": "hand path rtol 1e-11", "check_state_error": self.state_error(chk, ref),
+                     "check_physics_error": err}
+
+    def state_error(self, res: Any, ref: Any) -> float:
+        """Largest difference of the compared signals from the reference, relative to their largest value."""
+        scale = max(float(np.max(np.abs(ref[s]))) for s in self.signals) or 1.0
+        return max(float(np.max(np.abs(np.interp(ref.t, res.t, res[s]) - ref[s]))) for s in self.signals) / scale
+
+
 def available() -> list[str]:
     """Models that declare a work-precision study (`workprecision_study` in their `ModelSpec.cases` module)."""
     from ..registry import models

@@ -105,34 +105,22 @@ def model_of(name: str) -> str | None:
 
 
 def circles() -> list[list[str]]:
-    """The strongly connected components of more than one module (Tarjan)."""
-    g, index, low, stack, on, out = graph(), {}, {}, [], set(), []
+    """The modules that import each other in a loop: the strongly connected components of more than one module
+    (`scipy.sparse.csgraph.connected_components`)."""
+    import numpy as np
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
 
-    def visit(v: str) -> None:
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on.add(v)
-        for w in g.get(v, ()):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                comp.append(w)
-                if w == v:
-                    break
-            if len(comp) > 1:
-                out.append(sorted(comp))
-
-    for v in sorted(modules()):
-        if v not in index:
-            visit(v)
-    return out
+    g, names = graph(), sorted(modules())
+    at = {n: i for i, n in enumerate(names)}
+    rows = [(at[a], at[b]) for a, targets in g.items() for b in targets]
+    r, c = (np.array(x, dtype=int) for x in zip(*rows, strict=True)) if rows else (np.zeros(0, int),) * 2
+    _, label = connected_components(coo_matrix((np.ones(r.size), (r, c)), shape=(len(names),) * 2),
+                                    directed=True, connection="strong")
+    groups: dict[int, list[str]] = defaultdict(list)
+    for name, k in zip(names, label, strict=True):
+        groups[int(k)].append(name)
+    return sorted(sorted(v) for v in groups.values() if len(v) > 1)
 
 
 def test_every_module_is_in_a_layer():

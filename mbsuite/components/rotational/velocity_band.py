@@ -32,7 +32,9 @@ def simulate_velocity_band(
     held (zero relative acceleration) while the torque it must carry is within its capacity; RK23 with the App. J
     settings (tol 1e-3, max step 1.9 ms). The velocity stays wherever it was inside the band, so positions creep.
     Held torques use the same capacity-weighted constraint solution as the event-exact path (the App. D two-body test
-    evaluated jointly rather than clutch by clutch)."""
+    evaluated jointly rather than clutch by clutch).
+    One function (about 110 lines), as the thesis' App. C/D loop it reproduces reads: the band's modes, the
+    controller's samples and the integration step stay in one place."""
     if sys.dampers() or any(f.g is not None or f.one_way_hold is not None for f in sys.frictions):
         raise ParameterError("the velocity-band scheme takes two-rotor friction elements without one-way logic and "
                              "springs without dampers (the thesis' systems); use simulate_reference")

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ... import load_scene, run
-from ...analysis.workprecision import Setting, Study, _rel
+from ...analysis.workprecision import LadderStudy, Study, _rel
 from ...components.rotational.event_exact import simulate_reference
 from ...components.rotational.interfaces import Friction, Part, RotorSystem, Source, Spring
 from ...components.rotational.mujoco_sim import MujocoRotorSim
@@ -171,16 +171,13 @@ HARD_CASES: tuple[HardCase, ...] = (
 
 
 # ================================================================================================ work-precision
-class DrivesStudy(Study):
+class DrivesStudy(LadderStudy):
     """The hand path (event-exact DOP853) x rtol and MuJoCo (rk4, euler) x timestep; reference: the hand path at rtol
     1e-12 (checked against rtol 1e-11; the hand path has one integrator, so the MuJoCo rows are the different-method
     comparison). State error: max |w - w_ref| / max |w_ref| over the rotors. Physics metric: relative errors of the
     cycle-mean load speed and of the efficiency E_out/E_in over [t_settle, T], and the lock-up time error (max over
     matched stick events) over the energy-cycle period."""
 
-    HAND_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
-    MJ_INTEGRATORS = ("rk4", "euler")
-    MJ_STEPS = (1e-4, 5e-5, 2e-5)
     state_doc = "max_t |w_i - w_i,ref| / max_t,i |w_ref| over the rotor speeds, on the output grid"
     physics_doc = ("max(rel. error of cycle-mean load speed and of efficiency E_out/E_in over [t_settle, T]; max "
                    "lock-up time error / energy-cycle period)")
@@ -189,38 +186,11 @@ class DrivesStudy(Study):
         super().__init__(scene, quick)
         T = min(scene.solver.duration, duration or (1.0 if quick else 2.0))
         ts = T / 2
-        self.speeds = ["w_motor", "w_spring", "w_load"]
+        self.signals = ["w_motor", "w_spring", "w_load"]
         # the study measures the error of loose settings: a health figure past its bound is kept, not refused
         self.base = scene.replace(solver={"duration": T, "t_settle": ts, "allow_inaccurate": True},
-                                  outputs=[*self.speeds, "E_in", "E_out"])
+                                  outputs=[*self.signals, "E_in", "E_out"])
         self.ts = ts
-
-    def settings(self) -> list[Setting]:
-        """The settings of the study: hand-path tolerances and MuJoCo integrators x timesteps."""
-        out = []
-        for r in ((1e-6,) if self.quick else self.HAND_RTOLS):
-            sc = self.base.replace(solver={"engine": "reference", "rtol": r, "atol": r * 1e-2})
-            out.append(Setting("reference", "event-exact DOP853", r, lambda sc=sc: run(sc)))
-        integ = ("rk4",) if self.quick else self.MJ_INTEGRATORS
-        for i in integ:
-            for h in ((1e-4,) if self.quick else self.MJ_STEPS):
-                sc = self.base.replace(solver={"engine": "mujoco", "integrator": i, "timestep": h})
-                out.append(Setting("mujoco", i, h, lambda sc=sc: run(sc)))
-        return out
-
-    def reference(self):
-        """The reference run (hand path, rtol 1e-12) and its own accuracy (against rtol 1e-11)."""
-        ref = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-12, "atol": 1e-14}))
-        chk = run(self.base.replace(solver={"engine": "reference", "rtol": 1e-11, "atol": 1e-13}))
-        err, _ = self.physics_error(chk, ref)
-        return ref, {"reference": "hand path (event-exact DOP853) rtol 1e-12, atol 1e-14",
-                     "check": "hand path rtol 1e-11", "check_state_error": self.state_error(chk, ref),
-                     "check_physics_error": err}
-
-    def state_error(self, res, ref) -> float:
-        """Largest speed difference from the reference, relative to the largest reference speed."""
-        scale = max(float(np.max(np.abs(ref[s]))) for s in self.speeds) or 1.0
-        return max(float(np.max(np.abs(np.interp(ref.t, res.t, res[s]) - ref[s]))) for s in self.speeds) / scale
 
     def _locks(self, res) -> list[tuple[str, float]]:
         return [(e.get("element", "?"), float(e["t"])) for e in res.events

@@ -12,6 +12,7 @@ from ... import load_scene, run
 from ...analysis.workprecision import LadderStudy, Study, _rel
 from ...components.rotational.event_exact import simulate_reference
 from ...components.rotational.interfaces import Friction, Part, RotorSystem, Source, Spring
+from ...components.rotational.locks import lock_time_error, lock_ups
 from ...components.rotational.mujoco_sim import MujocoRotorSim
 from ...engines.inputs import Step
 from ...errors import SceneError
@@ -192,10 +193,6 @@ class DrivesStudy(LadderStudy):
                                   outputs=[*self.signals, "E_in", "E_out"])
         self.ts = ts
 
-    def _locks(self, res) -> list[tuple[str, float]]:
-        return [(e.get("element", "?"), float(e["t"])) for e in res.events
-                if e.get("to") == "stuck" and e.get("t") is not None and e["t"] >= self.ts]
-
     def physics_error(self, res, ref):
         """The study's physics error: cycle-mean load speed, efficiency and lock-up times (over the cycle
         period), relative; returns (error, details)."""
@@ -215,20 +212,9 @@ class DrivesStudy(LadderStudy):
         e_ref = eff(ref)
         if math.isfinite(e_ref) and e_ref > 0:  # a scene without an output torque has no efficiency to compare
             det["efficiency_rel"] = _rel(eff(res), e_ref)
-        lr, lf = self._locks(res), self._locks(ref)
-        by_el: dict[str, tuple[list, list]] = {}
-        for el, t in lf:
-            by_el.setdefault(el, ([], []))[1].append(t)
-        for el, t in lr:
-            by_el.setdefault(el, ([], []))[0].append(t)
-        errs = []
-        for a, b in by_el.values():
-            k = min(len(a), len(b))
-            errs += [abs(x - y) for x, y in zip(a[:k], b[:k], strict=True)]
-            if len(a) != len(b):
-                errs.append(period)  # a missing or extra lock-up counts as a whole period
-        if lf:
-            det["lock_time_rel"] = (max(errs) if errs else 0.0) / period
+        lr, lf = lock_ups(res.events, self.ts), lock_ups(ref.events, self.ts)
+        if lf:  # a missing or extra lock-up counts as a whole period
+            det["lock_time_rel"] = lock_time_error(lr, lf, period)
         det["n_locks_ref"] = len(lf)
         vals = [v for k, v in det.items() if k != "n_locks_ref"]
         # nothing to compare (no lock-up and no load speed in the window) is no accuracy: NaN, not 0

@@ -10,6 +10,7 @@ import numpy as np
 
 from ...analysis.workprecision import LadderStudy, Study
 from ...components.rotational.event_exact import simulate_reference
+from ...components.rotational.locks import lock_time_error, lock_ups
 from ...components.rotational.mujoco_sim import MujocoRotorSim
 from ...hardcases import Checker, HardCase
 from ...paths import mjcf_path
@@ -146,28 +147,12 @@ class RotationalStudy(LadderStudy):
         self.base = scene.replace(solver={"duration": T, "t_settle": 0.0, "allow_inaccurate": True},
                                   outputs=[*self.signals, "E_in", "E_out"])
 
-    @staticmethod
-    def _locks(res) -> list[tuple[str, float]]:
-        return [(e.get("element", "?"), float(e["t"])) for e in res.events
-                if e.get("to") == "stuck" and e.get("t") is not None]
-
     def physics_error(self, res, ref):
         """The study's physics error: lock-up times over 0.1 s; returns (error, details)."""
         det = {}
-        lr, lf = self._locks(res), self._locks(ref)
-        by_el: dict[str, tuple[list, list]] = {}
-        for el, t in lf:
-            by_el.setdefault(el, ([], []))[1].append(t)
-        for el, t in lr:
-            by_el.setdefault(el, ([], []))[0].append(t)
-        errs = []
-        for a, b in by_el.values():
-            k = min(len(a), len(b))
-            errs += [abs(x - y) for x, y in zip(a[:k], b[:k], strict=True)]
-            if len(a) != len(b):
-                errs.append(self.PERIOD)  # a missing or extra lock-up counts as a whole period
-        if lf:
-            det["lock_time_rel"] = (max(errs) if errs else 0.0) / self.PERIOD
+        lr, lf = lock_ups(res.events), lock_ups(ref.events)
+        if lf:  # a missing or extra lock-up counts as a whole period
+            det["lock_time_rel"] = lock_time_error(lr, lf, self.PERIOD)
         det["n_locks_ref"] = len(lf)
         vals = [v for k, v in det.items() if k != "n_locks_ref"]
         # nothing to compare (no lock-up in the run) is no accuracy: NaN, not 0

@@ -307,6 +307,13 @@ def scene_attempts() -> Iterator[Attempt]:
                     with_lines(MODEL_SCENES[model], "effects", f"{eff} = {val}"), culprit=eff)
     yield scene("param-drives-set", a, 'drives: [params] set = "table_9_9"',
                 with_lines(MODEL_SCENES["drives"], "params", 'set = "table_9_9"'), culprit="set")
+    rot = 'model = "rotational"\n[effects]\nexample = "coupled_clutches"\n'
+    yield scene("effect-rotational-example", a, 'rotational: example = "clutchless"',
+                rot.replace('"coupled_clutches"', '"clutchless"'), culprit="example")
+    yield scene("param-rotational-any", a, "rotational: a [params] key (the examples carry the MSL's own)",
+                rot + "[params]\nJ1 = 2.0\n", culprit="J1")
+    yield scene("effect-drives-modelica-mechanism", a, 'drives: mechanism = "coupled_clutches" (now its own model)',
+                with_lines(MODEL_SCENES["drives"], "effects", 'mechanism = "coupled_clutches"'), culprit="mechanism")
     yield scene("param-unknown", a, "unknown parameter", PANTO + "[params]\nmass = 3.0\n", culprit="mass")
     for p, v, why in (("l1", "nan", "NaN"), ("l1", "inf", "infinite"), ("l1", "-inf", "minus infinity"),
                       ("l1", "-1.95", "negative length"), ("l1", "0.0", "zero length"), ("m1", '"heavy"', "a string"),
@@ -688,6 +695,14 @@ def cli_attempts() -> Iterator[Attempt]:
         yield cli(f"sweep-vary-{why.replace(' ', '_')}", a, f"sweep --vary {spec} ({why})",
                   (*sw, "--vary", spec), culprit=cul)
     yield cli("sweep-no-vary", a, "sweep without --vary", "sweep pantograph", culprit="--vary")
+    opt = ("optimise", "catenary/en50318", "--vary", "params.F0=100:140", "--maxiter", "1", "--popsize", "2")
+    yield cli("optimise-band-unknown-system", a, "optimise --band XX (not a system of the model's band)",
+              (*opt, "--band", "XX"), culprit="XX")
+    yield cli("optimise-band-on-a-model-without", a, "optimise --band AC on the pantograph (it declares no band)",
+              ("optimise", "pantograph/lab", "--vary", "params.ks=1e4:2e4", "--objective", "F1_amplitude",
+               "--band", "AC"), culprit="band")
+    yield cli("optimise-no-objective", a, "optimise of a model that declares no default objective, none given",
+              ("optimise", "pantograph/lab", "--vary", "params.ks=1e4:2e4"), culprit="objective")
     yield cli("sweep-grid-product-huge", a, "two 2000-value axes (4 million points)",
               (*sw, "--vary", "input.frequency=1:2000:1", "--vary", "input.amplitude=1:2000:1"),
               culprit="points|--vary|max")

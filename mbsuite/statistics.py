@@ -16,7 +16,6 @@ perturbation check read) are statistics or signal features with a tolerance; a s
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -96,16 +95,10 @@ def unit_of(table: Mapping[str, Statistic], name: str) -> str:
 
 
 def describe(table: Mapping[str, Statistic]) -> list[str]:
-    """One line per declared statistic (docs, `mbsuite list --json`)."""
+    """One line per declared statistic (`mbsuite list --json`: each model's `statistics`)."""
     lines = []
     for name, s in table.items():
-        shown = s.per.format(k="<k>", name=name) if s.per else name
+        shown = f"{name} (per member: {s.per.format(k='<k>', name=name)})" if s.per else name
         value = "true/false" if s.kind == "verdict" else f"[{s.unit}]" if s.unit else "[-]"
         lines.append(f"{shown} {value}: {s.definition}; over {s.window}")
     return lines
-
-
-def finite(values: Mapping[str, Any]) -> dict[str, float]:
-    """The finite numbers among statistic values (verdicts and lists left out)."""
-    return {k: float(v) for k, v in values.items()
-            if isinstance(v, float | int) and not isinstance(v, bool) and math.isfinite(float(v))}

@@ -13,6 +13,7 @@ from ..errors import MbsuiteError
 from ..limits import Limit
 from ..results import Report, format_table
 from ..scenes import load_scene
+from ..statistics import describe
 from .options import MAX_REPEATS, load, scene_of
 from .output import emit, wrap
 from .study import apply_sets
@@ -63,6 +64,7 @@ def cmd_list(args: argparse.Namespace) -> None:
                    "band": None if st.band is None else {"name": st.band.name, "output": st.band.output,
                                                          "systems": list(st.band.systems), "doc": st.band.doc}}
         data[name]["studies"] = studies
+        data[name]["statistics"] = describe(spec.statistics)
         if st.objective or st.band:
             band = f"; --band: {st.band.output} in the {st.band.name} ({', '.join(st.band.systems)})" if st.band else ""
             path_lines.append(wrap(f"studies: objective {st.objective}, against {st.against}{band}"))

@@ -133,7 +133,7 @@ def headline(res: Any) -> dict[str, tuple[float, float]]:
         elif isinstance(v, list | tuple):
             out[f"{prefix}.count"] = (float(len(v)), float(len(v)))
 
-    walk("statistics", {k: v for k, v in res.statistics.items() if not isinstance(v, bool)})
+    walk("statistics", res.statistics)
     walk("stats", res.stats)
     groups: dict[str, float] = {}  # "statistics.<key>" / "stats.<key>" -> the largest magnitude under it
     for k, (x, _) in out.items():

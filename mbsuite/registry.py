@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import SceneError
+from .errors import MbsuiteError, SceneError
 from .limits import Limit
 from .settings import SolverSettings
 
@@ -100,8 +100,6 @@ class Band:
 
     def check(self, system: str, output: str, model: str) -> str:
         """The system (the first when `system` is empty), or an MbsuiteError naming the valid ones."""
-        from .errors import MbsuiteError
-
         if output != self.output:
             raise MbsuiteError(f"the {self.name} of model '{model}' bounds {self.output} only, not {output}")
         if not system:

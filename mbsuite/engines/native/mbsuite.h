@@ -140,6 +140,50 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* job);
 /* sizeof(mbs_job): the Python side compares it with its ctypes layout */
 int mbs_job_size(void);
 
+/* ------------------------------------------------------------------------------------------------ one-ports */
+/* A mechanical one-port stepped by a host that owns the force through it (the FE catenary stepping a pantograph in
+ * its compiled loop). Over one host step of length dt the port force f (N; f >= 0 presses the port down) varies
+ * linearly f0 -> f1, and the port answers its displacement y (m, the host's datum) at the step's end. Per step the
+ * host calls `trial` any number of times, each from the committed state, then `commit`, which accepts the last
+ * trial. An affine port (y exactly affine in f1) also gives its map y = P - g f1, so the host needs no iteration.
+ * Implementations fill the struct with an init function of their own (`void mbs_<name>_port(mbs_port*, state*)`);
+ * the state behind `self` belongs to the caller (numpy/ctypes memory). Nothing is global: one port per instance. */
+typedef struct {
+  void* self;                 /* the implementation's state */
+  int affine;                 /* 1: `map` gives y exactly */
+  int nout;                   /* outputs per recorded row (`outputs`), <= MBS_PORT_MAXOUT */
+  /* affine ports: y(t + dt) = P - g f1 under f0 -> f1 */
+  void (*map)(void* self, double t, double dt, double f0, double* P, double* g);
+  /* y(t + dt) under f0 -> f1, the committed state unchanged: 0, or a failure code of the implementation (which keeps
+     what its caller needs to describe the failure) */
+  int (*trial)(void* self, double t, double dt, double f0, double f1, double* y);
+  void (*commit)(void* self); /* accept the last trial */
+  void (*outputs)(const void* self, double* out); /* the committed state's nout outputs (the host records them) */
+} mbs_port;
+#define MBS_PORT_MAXOUT 16
+/* sizeof(mbs_port): the Python mirror (mbsuite.engines.native.oneport.Port) is checked against it */
+int mbs_port_size(void);
+
+/* The MuJoCo one-port: a MuJoCo model driven by one force actuator (gain 1, bias 0: ctrl = force along the actuator)
+ * whose displacement is the height of one site above another. A trial restores the committed integration state
+ * (mj_setState), sets ctrl = sign (f0 + f1) / 2 (the step's mean force) and advances one step through the core
+ * (`mbs_run`, one step, every check: a failure is the job's status), then reads the height after mj_kinematics and
+ * saves the pending state (mj_getState). Outputs: the height, then qpos[0 .. nq_out-1]. */
+typedef struct {
+  const mjModel* m;
+  mjData* d;
+  mbs_job* job;               /* the core's job for one unrecorded step (status on failure) */
+  int actuator, site, origin; /* the force actuator; the site whose height is y, measured from `origin` */
+  int spec;                   /* mjtState of the saved states (the integration state) */
+  double sign, offset;        /* ctrl = sign * mean force; y = z(site) - z(origin) - offset */
+  double* committed;          /* mj_stateSize(m, spec) doubles each */
+  double* pending;
+  int holds;                  /* 1 when d holds the pending state (the last trial) */
+  int nq_out;                 /* qpos entries among the outputs (nout = 1 + nq_out <= MBS_PORT_MAXOUT) */
+} mbs_mj_port;
+void mbs_mj_port_init(mbs_port* port, mbs_mj_port* s);
+int mbs_mj_port_size(void);
+
 /* Version of the job layout; the Python side refuses a library with another. */
 int mbs_abi_version(void);
 #define MBS_ABI_VERSION 2

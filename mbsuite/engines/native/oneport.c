@@ -1,0 +1,70 @@
+/* One-ports (mbsuite.h): the struct's size for the Python mirror, and the MuJoCo one-port, a MuJoCo model driven by
+ * one force actuator stepped by a host that owns the force (the FE catenary's compiled loop stepping the Eppinger
+ * pantograph's MuJoCo model). The twin of `EppingerMujoco.trial / commit` in Python (mbsuite.models.pantograph
+ * .under_wire), call for call: mj_setState, ctrl, the core's one checked step (mbs_run), mj_kinematics, mj_getState. */
+#include "mbsuite.h"
+
+int mbs_port_size(void) { return (int)sizeof(mbs_port); }
+int mbs_mj_port_size(void) { return (int)sizeof(mbs_mj_port); }
+
+static double mj_height(const mbs_mj_port* s) {
+  const mjData* d = s->d;
+  return d->site_xpos[3 * s->site + 2] - d->site_xpos[3 * s->origin + 2] - s->offset;
+}
+
+static int mj_trial(void* self, double t, double dt, double f0, double f1, double* y) {
+  mbs_mj_port* s = (mbs_mj_port*)self;
+  const mjModel* m = s->m;
+  mjData* d = s->d;
+  mj_setState(m, d, s->committed, s->spec);
+  d->ctrl[s->actuator] = s->sign * (0.5 * (f0 + f1));
+  mbs_job* J = s->job;
+  J->nstep = 1;
+  J->k0 = 0;
+  J->final = 0;
+  J->ctrl = NULL;
+  J->ctrl_idx = NULL;
+  J->ctrl_ncol = 0;
+  J->ctrl_rows = 0;
+  J->rec = NULL;
+  J->rec_cap = 0;
+  J->rec_row = 0;
+  const int status = mbs_run(m, d, J);
+  s->holds = 0;
+  if (status) return status;
+  mj_kinematics(m, d);
+  *y = mj_height(s);
+  mj_getState(m, d, s->pending, s->spec);
+  s->holds = 1;
+  return 0;
+}
+
+static void mj_commit(void* self) {
+  mbs_mj_port* s = (mbs_mj_port*)self;
+  double* c = s->committed;
+  s->committed = s->pending;
+  s->pending = c;
+  /* d holds the committed state with its kinematics when it held the last trial; else restore it */
+  if (!s->holds) {
+    mj_setState(s->m, s->d, s->committed, s->spec);
+    mj_kinematics(s->m, s->d);
+  }
+  s->holds = 0;
+}
+
+static void mj_outputs(const void* self, double* out) {
+  const mbs_mj_port* s = (const mbs_mj_port*)self;
+  out[0] = mj_height(s);
+  for (int i = 0; i < s->nq_out; i++) out[1 + i] = s->d->qpos[i];
+}
+
+void mbs_mj_port_init(mbs_port* port, mbs_mj_port* s) {
+  port->self = s;
+  port->affine = 0;
+  port->nout = 1 + s->nq_out;
+  port->map = NULL;
+  port->trial = mj_trial;
+  port->commit = mj_commit;
+  port->outputs = mj_outputs;
+  s->holds = 0;
+}

@@ -55,11 +55,11 @@ def core_loop_cpu(p: CatenaryParams, speed_kmh: float, dt: float, with_pantograp
     core = NativeCore(sim, 1, np.array([p.x_start]), np.array([p.x_end]))
     core.u[:], core.q[:], core.p[:] = ps.u, ps.q, ps.p
     core.place(0, p.x_start)
+    core.attach([sim.panto.native(dt)])
     if with_pantograph:
         core.present[0], core.active[0] = 1, 1
         core.set_force(0, ps.force)
         core.head[0] = ps.head
-        sim.panto.pack(core.pm[0:16], dt)
     c0 = time.process_time()
     code = core.run(0, ps.nsteps, CHECK_EVERY)
     cpu = time.process_time() - c0

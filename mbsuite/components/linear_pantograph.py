@@ -360,6 +360,10 @@ class LinearPantograph:
         """Head displacement (m) of the committed state."""
         return float(self.c @ self.x)
 
+    def native(self, dt: float) -> LinearNativePort:
+        """This pantograph as the linear one-port of a compiled host loop at time step `dt`."""
+        return LinearNativePort(self, dt)
+
     def signals(self) -> dict[str, float]:
         """The named outputs of the committed state (m)."""
         y = self.Cout @ self.x
@@ -432,3 +436,33 @@ def make(kind: str, section: Mapping[str, Any], name: str | None = None) -> Line
     """The linear pantograph `kind` (`LUMPED` or `TRANSFER`) of the scene's `[pantograph]` section."""
     p = params_of(kind, section)
     return lumped(p, name or kind) if isinstance(p, LumpedParams) else transfer(p, name or kind)
+
+
+class LinearNativePort:
+    """A `LinearPantograph` as the linear one-port (`engines/native/oneport.c`) at time step `dt`: the same Phi, G0,
+    Gf and head-map numbers as its `affine_map / trial`, its outputs `Cout` x."""
+
+    def __init__(self, panto: LinearPantograph, dt: float):
+        from ..engines.native.oneport import LinearPort
+
+        if dt != panto._dt:
+            panto._prepare(dt)
+        self.panto = panto
+        self._lp = LinearPort(panto._Phi, panto._G0, panto._Gf, panto.c, panto.Cout, panto.x, panto._cPhi,
+                              panto._cG0, panto._cGf)
+        self.port = self._lp.port
+
+    def load(self) -> None:
+        """The pantograph's committed state into the port."""
+        self._lp.set_state(self.panto.x)
+
+    def pull(self) -> None:
+        """The port's committed state back into the pantograph."""
+        self.panto.x = self._lp.state()
+
+    def signals(self, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Recorded output rows (`Cout` x) under the pantograph's output names."""
+        return {k: rows[:, i].copy() for i, k in enumerate(self.panto.names)}
+
+    def failure(self, code: int) -> str:
+        return f"the {self.panto.name} pantograph's state became non-finite"

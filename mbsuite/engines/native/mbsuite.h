@@ -184,6 +184,18 @@ typedef struct {
 void mbs_mj_port_init(mbs_port* port, mbs_mj_port* s);
 int mbs_mj_port_size(void);
 
+/* The linear one-port: a linear model x' = A x + b0 F0 - B f stepped by the trapezoidal rule, which the caller has
+ * written as x_{n+1} = Phi x_n + G0 - Gf (f0 + f1); its displacement is y = c . x, its map P = cPhi . x + cG0 - cGf
+ * f0, g = cGf (cPhi = c Phi, cG0 = c . G0, cGf = c . Gf); outputs Cout x (nout rows). Affine. */
+typedef struct {
+  int n, nout;
+  const double *Phi, *G0, *Gf, *c, *cPhi, *Cout; /* n*n, n, n, n, n, nout*n */
+  double cG0, cGf;
+  double *x, *pending;                            /* n each: the committed state and the last trial's */
+} mbs_lin_port;
+void mbs_lin_port_init(mbs_port* port, mbs_lin_port* s);
+int mbs_lin_port_size(void);
+
 /* Version of the job layout; the Python side refuses a library with another. */
 int mbs_abi_version(void);
 #define MBS_ABI_VERSION 2

@@ -2,10 +2,13 @@
  * one force actuator stepped by a host that owns the force (the FE catenary's compiled loop stepping the Eppinger
  * pantograph's MuJoCo model). The twin of `EppingerMujoco.trial / commit` in Python (mbsuite.models.pantograph
  * .under_wire), call for call: mj_setState, ctrl, the core's one checked step (mbs_run), mj_kinematics, mj_getState. */
+#include <math.h>
+
 #include "mbsuite.h"
 
 int mbs_port_size(void) { return (int)sizeof(mbs_port); }
 int mbs_mj_port_size(void) { return (int)sizeof(mbs_mj_port); }
+int mbs_lin_port_size(void) { return (int)sizeof(mbs_lin_port); }
 
 static double mj_height(const mbs_mj_port* s) {
   const mjData* d = s->d;
@@ -67,4 +70,49 @@ void mbs_mj_port_init(mbs_port* port, mbs_mj_port* s) {
   port->commit = mj_commit;
   port->outputs = mj_outputs;
   s->holds = 0;
+}
+
+/* ------------------------------------------------------------------------------------------ the linear one-port */
+/* The twin of `components.linear_pantograph.LinearPantograph.affine_map / trial / commit` (sums in index order). */
+static double dot(const double* a, const double* b, int n) {
+  double s = 0.0;
+  for (int i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
+}
+
+static void lin_map(void* self, double t, double dt, double f0, double* P, double* g) {
+  const mbs_lin_port* s = (const mbs_lin_port*)self;
+  *P = dot(s->cPhi, s->x, s->n) + s->cG0 - s->cGf * f0;
+  *g = s->cGf;
+}
+
+static int lin_trial(void* self, double t, double dt, double f0, double f1, double* y) {
+  mbs_lin_port* s = (mbs_lin_port*)self;
+  const int n = s->n;
+  const double f = f0 + f1;
+  for (int i = 0; i < n; i++) s->pending[i] = dot(s->Phi + (long)i * n, s->x, n) + s->G0[i] - s->Gf[i] * f;
+  *y = dot(s->c, s->pending, n);
+  return isfinite(*y) ? 0 : 1;
+}
+
+static void lin_commit(void* self) {
+  mbs_lin_port* s = (mbs_lin_port*)self;
+  double* x = s->x;
+  s->x = s->pending;
+  s->pending = x;
+}
+
+static void lin_outputs(const void* self, double* out) {
+  const mbs_lin_port* s = (const mbs_lin_port*)self;
+  for (int r = 0; r < s->nout; r++) out[r] = dot(s->Cout + (long)r * s->n, s->x, s->n);
+}
+
+void mbs_lin_port_init(mbs_port* port, mbs_lin_port* s) {
+  port->self = s;
+  port->affine = 1;
+  port->nout = s->nout;
+  port->map = lin_map;
+  port->trial = lin_trial;
+  port->commit = lin_commit;
+  port->outputs = lin_outputs;
 }

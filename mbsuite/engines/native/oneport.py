@@ -34,12 +34,58 @@ class _MjPort(ctypes.Structure):
                 ("sign", _D), ("offset", _D), ("committed", _P), ("pending", _P), ("holds", _I), ("nq_out", _I)]
 
 
-#: `oneport.c` as Python binds it (the layouts of `mbs_port` and `mbs_mj_port` checked)
+class _LinPort(ctypes.Structure):
+    _fields_ = [("n", _I), ("nout", _I), ("Phi", _P), ("G0", _P), ("Gf", _P), ("c", _P), ("cPhi", _P), ("Cout", _P),
+                ("cG0", _D), ("cGf", _D), ("x", _P), ("pending", _P)]
+
+
+#: `oneport.c` as Python binds it (the layouts of `mbs_port`, `mbs_mj_port` and `mbs_lin_port` checked)
 DECLARATION = Declaration(
     "engines/native/oneport.c", "mbs_abi_version", ABI_VERSION,
-    functions=(CFunction("mbs_mj_port_init", None, (_P, _P)),),
-    structs=(CStruct(Port, "mbs_port_size"), CStruct(_MjPort, "mbs_mj_port_size")),
+    functions=(CFunction("mbs_mj_port_init", None, (_P, _P)), CFunction("mbs_lin_port_init", None, (_P, _P))),
+    structs=(CStruct(Port, "mbs_port_size"), CStruct(_MjPort, "mbs_mj_port_size"),
+             CStruct(_LinPort, "mbs_lin_port_size")),
 )
+
+
+class LinearPort:
+    """The linear one-port: x_{n+1} = `Phi` x_n + `G0` - `Gf` (f0 + f1), displacement `c` . x, outputs `Cout` x;
+    `x` the committed state (copied in). The head map's row `cPhi` = c Phi and scalars `cG0` = c . G0, `cGf` =
+    c . Gf are the caller's (so that both twins use the same numbers)."""
+
+    def __init__(self, Phi: np.ndarray, G0: np.ndarray, Gf: np.ndarray, c: np.ndarray, Cout: np.ndarray,
+                 x: np.ndarray, cPhi: np.ndarray, cG0: float, cGf: float):
+        lib = bind(DECLARATION)
+        n = int(np.size(x))
+        arr = {"Phi": np.ascontiguousarray(Phi, dtype=float).reshape(n, n),
+               "G0": np.ascontiguousarray(G0, dtype=float).reshape(n),
+               "Gf": np.ascontiguousarray(Gf, dtype=float).reshape(n),
+               "c": np.ascontiguousarray(c, dtype=float).reshape(n),
+               "Cout": np.ascontiguousarray(np.atleast_2d(Cout), dtype=float)}
+        if arr["Cout"].shape[1] != n or not 1 <= arr["Cout"].shape[0] <= MAXOUT:
+            raise ValueError(f"Cout must have 1 .. {MAXOUT} rows of {n} columns, got {arr['Cout'].shape}")
+        arr["cPhi"] = np.ascontiguousarray(cPhi, dtype=float).reshape(n)
+        self._bufs = [np.ascontiguousarray(x, dtype=float).copy(), np.zeros(n)]
+        self._arr = arr
+        s = self._s = _LinPort()
+        s.n, s.nout = n, arr["Cout"].shape[0]
+        for name in ("Phi", "G0", "Gf", "c", "cPhi", "Cout"):
+            setattr(s, name, arr[name].ctypes.data)
+        s.cG0, s.cGf = float(cG0), float(cGf)
+        s.x, s.pending = self._bufs[0].ctypes.data, self._bufs[1].ctypes.data
+        self.port = Port()
+        lib.mbs_lin_port_init(ctypes.byref(self.port), ctypes.byref(s))
+
+    def _committed(self) -> np.ndarray:
+        return self._bufs[0] if self._s.x == self._bufs[0].ctypes.data else self._bufs[1]
+
+    def state(self) -> np.ndarray:
+        """The committed state (a copy; the buffers swap at every commit)."""
+        return self._committed().copy()
+
+    def set_state(self, x: np.ndarray) -> None:
+        """Set the committed state."""
+        self._committed()[:] = x
 
 
 class MujocoPort:
@@ -65,7 +111,14 @@ class MujocoPort:
         self.port = Port()
         lib.mbs_mj_port_init(ctypes.byref(self.port), ctypes.byref(s))
 
+    def _committed(self) -> np.ndarray:
+        return self.committed if self._s.committed == self.committed.ctypes.data else self.pending
+
     def state(self) -> np.ndarray:
-        """The committed integration state (the buffers swap at every commit)."""
-        addr = self._s.committed
-        return self.committed if addr == self.committed.ctypes.data else self.pending
+        """The committed integration state (a copy; the buffers swap at every commit)."""
+        return self._committed().copy()
+
+    def set_state(self, state: np.ndarray) -> None:
+        """Set the committed integration state (the data is restored from it at the next trial)."""
+        self._committed()[:] = state
+        self._s.holds = 0

@@ -2,9 +2,12 @@
 
 `NativeCore(sim, contacts)` mirrors a `CoupledSimulation`: the banded Cholesky factor of the step matrix S (computed in
 C, once), K in CSR, the droppers' influence columns, and the state of a passage (u, q, p, the slack set, per contact
-its element, shape functions and cached influence columns). `run(n0, n1)` steps a passage whose pantographs are all
-2-mass (affine) pantographs entirely in C; the stages `predict`, `local`, `advance` are exposed for pantographs that
-are coupled from Python (secant iteration). The readable twin is `passage.Passage`; a test holds both equal to rounding.
+its element, shape functions and cached influence columns). `run(n0, n1)` steps a passage entirely in C, every
+pantograph through its one-port (`attach`; `engines/native/mbsuite.h`): the 2-mass pantograph's (in the C file), the
+linear pantographs' and a MuJoCo model's (`engines/native/oneport.c`), a registry model's own (the Eppinger
+pantograph's hand-derived ODE), an affine one by its head map, a nonlinear one by a secant iteration in C. The stages
+`predict`, `local`, `advance` are exposed for the Python-driven twin (`train._Secant`, the test oracle). The readable
+twin is `passage.Passage`; tests hold all three equal to rounding.
 `NativeFactor(S, node_offset, free)` is the core's factorisation and sweeps alone, for any SPD matrix.
 
 Why a hand-written banded Cholesky rather than LAPACK: S is factorised once per passage and the per-step solve is the
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import ctypes
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -27,7 +31,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 3
+ABI = 4
 
 
 class _Job(ctypes.Structure):
@@ -44,12 +48,13 @@ class _Job(ctypes.Structure):
         ("present", _P), ("active", _P), ("elem", _P), ("xc", _P), ("xs", _P), ("xend", _P), ("Nl", _P),
         ("dofs", _P), ("w0d", _P), ("cols", _P), ("crng", _P), ("zrng", _P), ("f", _P), ("kce", _P), ("cbc", _P),
         ("rirr", _P), ("gv", _P), ("a", _P), ("Cm", _P), ("bz", _P),
-        ("dstar", _P), ("P", _P), ("gp", _P), ("head", _P), ("work", _P), ("iwork", _P), ("pm", _P),
-        ("rec_t", _P), ("rec_x", _P), ("rec_f", _P), ("rec_head", _P), ("rec_wire", _P), ("rec_frame", _P),
-        ("rec_up", _P), ("rec_ns", _P),
+        ("dstar", _P), ("P", _P), ("gp", _P), ("head", _P), ("work", _P), ("iwork", _P),
+        ("ports", _P), ("gs", _P), ("cw", _P), ("nl", _P),
+        ("rec_t", _P), ("rec_x", _P), ("rec_f", _P), ("rec_head", _P), ("rec_wire", _P), ("rec_out", _P),
+        ("rec_up", _P), ("rec_ns", _P), ("ooff", _P), ("nout", _I),
         ("blocked", _I), ("fidx", _P), ("noff", _P), ("boff", _P), ("blk", _P), ("pw", _P), ("seg", _P),
         ("nseg_f", _I), ("nseg_b", _I),
-        ("n_local", ctypes.c_long), ("err", _I), ("err_con", _I), ("err_value", _D),
+        ("n_local", ctypes.c_long), ("err", _I), ("err_con", _I), ("err_port", _I), ("err_value", _D),
     ]
 
 
@@ -62,6 +67,7 @@ DECLARATION = native.Declaration(
         ("mbs_cat_wire", _D, (_P, _I)), ("mbs_cat_predict", None, (_P, _D)), ("mbs_cat_local", _I, (_P,)),
         ("mbs_cat_advance", None, (_P,)), ("mbs_cat_check", _I, (_P,)), ("mbs_cat_run", _I, (_P, _L, _L, _I)),
         ("mbs_cat_record", None, (_P, _L, _D)), ("mbs_cat_dropper_ranges", None, (_P,)),
+        ("mbs_cat_twomass_port", None, (_P, _P)), ("mbs_cat_twomass_size", _I, ()),
     )),
     structs=(native.CStruct(_Job, "mbs_cat_job_size"),),
 )
@@ -127,8 +133,9 @@ class NativeFactor:
 
 class NativeCore:
     """The C twin of a passage of `sim` with `ncon` contact points (see the module docstring). Arrays are owned here
-    (numpy) and the C job points into them; the state arrays (`u`, `q`, `p`, `f`, `head`, `pm`, ...) are views the
-    Python driver reads and writes between calls."""
+    (numpy) and the C job points into them; the state arrays (`u`, `q`, `p`, `f`, `head`, ...) are views the
+    Python driver reads and writes between calls. Each contact's pantograph is stepped through its one-port
+    (`attach`)."""
 
     def __init__(self, sim, ncon: int, x_start: np.ndarray, x_end: np.ndarray):
         lib = self.lib = library()
@@ -179,8 +186,10 @@ class NativeCore:
             "Cm": np.zeros(nc * nc), "bz": np.zeros(max(nc * nd, 1)), "dstar": np.zeros(max(nd, 1)),
             "P": np.zeros(nc), "gp": np.zeros(nc), "head": np.zeros(nc),
             "work": np.zeros(m * (m + 1) + m + 1), "iwork": np.zeros(2 * m + 2, np.int32),
-            "pm": np.zeros(16 * nc),
+            "ports": np.zeros(nc, np.uintp), "gs": np.full(nc, np.nan), "cw": np.zeros(4 * nc),
+            "nl": np.zeros(nc, np.int32), "ooff": np.zeros(nc, np.int32),
         }
+        self.native_ports: list[Any] = [None] * nc
         self._bind(arrays)
         if lib.mbs_cat_factor(ctypes.byref(j)):
             raise SolverError(f"the step matrix is not positive definite (native Cholesky, row {int(j.err_value)})")
@@ -224,8 +233,23 @@ class NativeCore:
         self.lib.mbs_cat_solve(ctypes.byref(self.job), x.ctypes.data)
         return x
 
+    def attach(self, ports: list[Any]) -> int:
+        """Couple each contact's pantograph through its one-port: `ports[k]` a `NativePort` (`pantographs.py`) whose
+        `.port` is a filled `mbs_port`; returns the width of a row of port outputs (each contact's at its offset)."""
+        if len(ports) != self.job.ncon:
+            raise SolverError(f"{len(ports)} one-ports for {self.job.ncon} contacts")
+        off = 0
+        for k, np_ in enumerate(ports):
+            self.native_ports[k] = np_
+            self.ports[k] = ctypes.addressof(np_.port)
+            self.ooff[k] = off
+            off += int(np_.port.nout)
+        self.job.nout = off
+        return off
+
     def set_records(self, **arrays: np.ndarray | None) -> None:
-        """Record arrays (row = step): t, x, f, head, wire, frame (nrec x ncon), up (nrec x nsup), ns (int32)."""
+        """Record arrays (row = step): t, x, f, head, wire (nrec x ncon), out (nrec x the `attach` width: each
+        pantograph's port outputs), up (nrec x nsup), ns (int32)."""
         for name, arr in arrays.items():
             if arr is not None:
                 self._keep.append(arr)
@@ -254,7 +278,8 @@ class NativeCore:
         return int(self.lib.mbs_cat_check(ctypes.byref(self.job)))
 
     def run(self, n0: int, n1: int, check_every: int) -> int:
-        """Steps n0+1 .. n1, all present pantographs 2-mass (state in `pm`); 0 or an error code (`failure`)."""
+        """Steps n0+1 .. n1, every present pantograph through its one-port (`attach`); 0 or an error code
+        (`failure`)."""
         return int(self.lib.mbs_cat_run(ctypes.byref(self.job), int(n0), int(n1), int(check_every)))
 
     def run_chunks(self, n0: int, n1: int, check_every: int, chunk: int, static_force: float,
@@ -290,9 +315,50 @@ class NativeCore:
                     f"(time step {float(j.dt)} s); reduce solver.timestep")
         if code == 1:
             return f"non-finite state at x = {xp:.2f} m"
+        if code == 6:
+            port = self.native_ports[k]
+            return (f"pantograph {k + 1} failed at t = {float(j.err_value):.6f} s (x = {xp:.2f} m): "
+                    + port.failure(int(j.err_port)))
+        if code == 7:
+            return (f"pantograph-catenary coupling did not converge at t = {float(j.err_value):.6f} s (time step "
+                    f"{float(j.dt)} s); reduce solver.timestep")
+        if code == 8:
+            return f"contact {k + 1} is on the line without a one-port (internal error of the compiled loop)"
         if code == 3:
             return (f"the pantograph lost the wire and moved {yh:+.3g} m away from it (x = {xp:.2f} m; static "
                     f"contact force {static_force:.4g} N): it cannot hold the wire")
         return (f"catenary/pantograph displacement {abs(float(j.err_value)):.3g} m exceeds {float(j.max_disp):g} m "
                 f"at x = {xp:.2f} m: outside the small-displacement model (speed too close to the wave speed, or a "
                 "diverging pantograph)")
+
+
+class TwoMassPort:
+    """The 2-mass pantograph `panto` (`pantographs.TwoMassPantograph`) as the C file's one-port: its state and step
+    constants at time step `dt` packed into `mbs_cat_twomass_size()` doubles (`TwoMassPantograph.pack`)."""
+
+    names = ("head_displacement", "frame_displacement")
+
+    def __init__(self, panto: Any, dt: float):
+        from ...engines.native.oneport import Port
+
+        lib = library()
+        self.panto, self.dt = panto, dt
+        self.state = np.zeros(int(lib.mbs_cat_twomass_size()))
+        self.port = Port()
+        lib.mbs_cat_twomass_port(ctypes.byref(self.port), self.state.ctypes.data)
+        self.load()
+
+    def load(self) -> None:
+        """The pantograph's committed state into the port."""
+        self.panto.pack(self.state, self.dt)
+
+    def pull(self) -> None:
+        """The port's committed state back into the pantograph."""
+        self.panto.unpack(self.state)
+
+    def signals(self, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Recorded output rows (x1, x2) as the pantograph's signals."""
+        return {k: rows[:, i].copy() for i, k in enumerate(self.names)}
+
+    def failure(self, code: int) -> str:
+        return f"the 2-mass pantograph's step failed (code {code})"

@@ -17,6 +17,13 @@ f1. Optional: `engine` (the name of the pantograph's engine path, for reports; d
 `engine_warnings() -> {name: count}` (warnings of its engine, reported with the run), `energy()` (J, for the energy
 diagnostics).
 
+`native(dt) -> NativePort` (optional) gives the pantograph as a one-port in C (`engines/native/mbsuite.h`), which
+the catenary's compiled loop steps without Python: `.port` the filled `mbs_port`, `.load()` / `.pull()` the committed
+state into the port and back into the Python object, `.signals(rows)` the recorded output rows as `signals()`'s
+names, `.failure(code)` the words for a failed trial. Its answers are those of `trial / commit` to rounding (a test
+holds each against the Python twin). Every pantograph the catenary knows has one; without it a passage steps from
+Python (`train._Secant`), which is also the test oracle of the compiled loop.
+
 This protocol (`Pantograph`) and the factory that makes one (`UnderWire`: `ModelSpec.under_wire` of a registry model)
 are the only contract. The scene's `pantograph` effect names a `PantographKind`: its engine paths, the `[pantograph]`
 section it takes and its `UnderWire` factory. `reference2mass` is the catenary's own (`TwoMassPantograph`, its
@@ -24,9 +31,9 @@ parameters m1 ... F0 the catenary's); every other name is a pantograph model of 
 found by `mbsuite.registry.get_model(name).under_wire` with the `[pantograph]` section of the scene (its own `effects`
 and `params`, validated against that model's spec). `lumped` and `transfer` are the catenary's linear pantographs
 (`components/linear_pantograph.py`: an n-stage lumped one and a state-space model of a receptance), their parameters
-in the `[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step, but they run on the
-Python coupling (`trial / commit`), not in the compiled loop, except the 2-stage lumped one, which is a
-`TwoMassPantograph` with its own numbers. The catenary imports no pantograph model.
+in the `[pantograph]` section's `params`; like the 2-mass one they are exactly affine per step and run in the compiled
+loop as the linear one-port (the 2-stage lumped one is a `TwoMassPantograph` with its own numbers). The catenary
+imports no pantograph model.
 """
 
 from __future__ import annotations
@@ -169,8 +176,14 @@ class TwoMassPantograph:
         """Head and frame displacements (m) of the committed state."""
         return {"head_displacement": float(self.x[0]), "frame_displacement": float(self.x[1])}
 
+    def native(self, dt: float):
+        """This pantograph as the compiled loop's one-port at time step `dt` (`native_core.TwoMassPort`)."""
+        from .native_core import TwoMassPort
+
+        return TwoMassPort(self, dt)
+
     def pack(self, out: np.ndarray, dt: float) -> None:
-        """The state and step constants into the native core's 16 doubles (x1 x2 v1 v2, S^-1 row-major, m1 m2,
+        """The state and step constants into the native core's one-port (x1 x2 v1 v2, S^-1 row-major, m1 m2,
         k11 k12 k22, F0): `native/catenary.c` advances this pantograph by the same rule."""
         if dt != self._dt:
             self._prepare(dt)

@@ -232,10 +232,9 @@ class CoupledSimulation:
         return Passage(self, x_start, x_end)
 
     def native_ok(self, record_every: int = 1, record_droppers: bool = False, record_energy: bool = False) -> bool:
-        """Whether `run` can step this passage in the compiled core: an affine 2-mass pantograph, every step
-        recorded, no dropper or energy diagnostics (those stay on the readable Python path)."""
-        return (record_every == 1 and not record_droppers and not record_energy
-                and hasattr(self.panto, "pack") and hasattr(self.panto, "unpack"))
+        """Whether `run` can step this passage in the compiled core: a pantograph with a one-port (`native`), every
+        step recorded, no dropper or energy diagnostics (those stay on the readable Python path)."""
+        return record_every == 1 and not record_droppers and not record_energy and hasattr(self.panto, "native")
 
     def run(self, x_start: float, x_end: float, progress=None, record_every: int = 1,
             record_droppers: bool = False, record_energy: bool = False, native: bool | None = None) -> CoupledResult:
@@ -247,8 +246,8 @@ class CoupledSimulation:
         use_native = self.native_ok(record_every, record_droppers, record_energy) if native is None else native
         if use_native:
             if not self.native_ok(record_every, record_droppers, record_energy):
-                raise SolverError("the native core steps an affine 2-mass pantograph and records every step without "
-                                  "dropper/energy diagnostics; use native=False for this run")
+                raise SolverError("the native core steps a pantograph with a one-port (`native`) and records every "
+                                  "step without dropper/energy diagnostics; use native=False for this run")
             return self._run_native(x_start, x_end, progress)
         passage = self.start(x_start, x_end)
         rec = Recorder(passage, record_every, record_droppers, record_energy)
@@ -274,21 +273,21 @@ class CoupledSimulation:
         core.place(0, x_start)
         core.set_force(0, passage.force)
         core.head[0] = passage.head
-        panto.pack(core.pm[0:16], self.dt)
+        port = panto.native(self.dt)
         nsteps = passage.nsteps
         nrec = nsteps + 1
-        T, X, F, H, W, FR = (np.zeros(nrec) for _ in range(6))
+        T, X, F, H, W = (np.zeros(nrec) for _ in range(5))
+        OUT = np.zeros((nrec, core.attach([port])))
         U = np.zeros((nrec, fe.supports.size))
         NS = np.zeros(nrec, dtype=np.int32)
-        core.set_records(t=T, x=X, f=F, head=H, wire=W, frame=FR, up=U, ns=NS)
+        core.set_records(t=T, x=X, f=F, head=H, wire=W, out=OUT, up=U, ns=NS)
         core.record(0, 0.0)
         t0 = time.perf_counter()
         core.run_chunks(0, nsteps, CHECK_EVERY, CHECK_EVERY * 25, passage.static_force,
                         None if progress is None else lambda n: progress(n, nsteps))
         wall = time.perf_counter() - t0
-        panto.unpack(core.pm[0:16])
-        return CoupledResult(t=T, x=X, force=F, head=H, wire=W, uplift=U, n_slack=NS,
-                             panto={"head_displacement": H.copy(), "frame_displacement": FR},
+        port.pull()
+        return CoupledResult(t=T, x=X, force=F, head=H, wire=W, uplift=U, n_slack=NS, panto=port.signals(OUT),
                              support_x=fe.x[fe.supports],
                              stats={"steps": nsteps, "wall_time_loop_s": wall, "dofs": fe.n,
                                     "half_bandwidth": self.lu.bandwidth, "local_solves": core.n_local,

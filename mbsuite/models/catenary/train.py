@@ -12,11 +12,13 @@ displacement in the window while the pantograph is within `UPLIFT_REACH` (30 m) 
 pantograph is charged with its own.
 
 Stepping (`TrainPassage`, a step object): the catenary in the compiled core (`native_core`), all contact points in one
-local problem per step (the contact forces and the slack droppers solved together, exactly). 2-mass pantographs only:
-the whole passage runs in C between entries; any nonlinear pantograph (Eppinger), or dropper/energy diagnostics: the
-core's stages with a secant iteration on every nonlinear pantograph's force (the single-pantograph scheme,
-Jacobi-style over the pantographs). A single pantograph that the C loop cannot step (a nonlinear one, or `native =
-False`) takes the readable Python `passage.Passage` instead, the twin the core is tested against.
+local problem per step (the contact forces and the slack droppers solved together, exactly). Every pantograph that
+offers a one-port (`native`: the 2-mass, lumped and transfer-function pantographs, the Eppinger pantograph on both
+paths) runs with the catenary in the compiled loop between entries, a nonlinear one coupled by a secant iteration on
+its force in C. With dropper/energy diagnostics, `stepwise`, or a pantograph object without a one-port, the passage
+takes the core's stages with the same coupling from Python (`_Secant`, the compiled loop's test oracle); a single
+pantograph with `native = False` takes the readable Python `passage.Passage`, the twin the core is tested against.
+Both Python loops are test oracles and diagnostics, not the way a shipped scene steps.
 """
 
 from __future__ import annotations
@@ -77,8 +79,9 @@ class TrainRun:
 class TrainPassage(Stepping):
     """A passage of the pantographs `pans` (leading first, `offsets` m behind the leading one) stepped in the compiled
     core (module docstring), a `mbsuite.stepping.StepObject`: `step()` runs one chunk of C steps up to the next entry
-    (`compiled`, every pantograph a 2-mass one) or one coupled step through the core's stages; the records
-    (`T`, `X`, `F`, `H`, `W`, `FR`, `U`, `NS`, one row per step from the start) fill as it goes. The leading
+    (`compiled`: every pantograph through its one-port) or one coupled step through the core's stages; the records
+    (`T`, `X`, `F`, `H`, `W`, `OUT` the one-ports' outputs, `U`, `NS`, one row per step from the start) fill as it
+    goes. The leading
     pantograph starts from `lead`, the static state of the single passage."""
 
     def __init__(self, sim: CoupledSimulation, pans: list[Pantograph], lead: Passage, offsets: list[float],
@@ -99,11 +102,13 @@ class TrainPassage(Stepping):
         self.DE = np.zeros((nrec, nd)) if record_droppers else None
         self.DS = np.zeros((nrec, nd), bool) if record_droppers else None
         self.T = np.zeros(nrec)
-        self.X, self.F, self.H, self.W, self.FR = (np.zeros((nrec, nc)) for _ in range(5))
+        self.X, self.F, self.H, self.W = (np.zeros((nrec, nc)) for _ in range(4))
         self.U = np.zeros((nrec, sim.fe.support_cw.size))
         self.NS = np.zeros(nrec, dtype=np.int32)
         self.psig: list[dict[str, np.ndarray]] = [{} for _ in range(nc)]
         self.static_forces = [0.0] * nc
+        self.ports = [pan.native(dt) for pan in pans] if compiled else []
+        self.OUT = np.zeros((nrec, core.attach(self.ports))) if compiled else None
         self.record_energy = record_energy
         self.energy_rows: list[dict[str, float]] = []
         self.energy_t: list[float] = []
@@ -112,7 +117,7 @@ class TrainPassage(Stepping):
             if self.entries[k] == 0:
                 self._enter(k, 0)
         if compiled:
-            core.set_records(t=self.T, x=self.X, f=self.F, head=self.H, wire=self.W, frame=self.FR, up=self.U,
+            core.set_records(t=self.T, x=self.X, f=self.F, head=self.H, wire=self.W, out=self.OUT, up=self.U,
                              ns=self.NS)
             core.record(0, 0.0)
             self._stops = sorted({e for e in self.entries if e > 0} | {self.nsteps})
@@ -140,7 +145,7 @@ class TrainPassage(Stepping):
         core.head[k] = head
         self.static_forces[k] = float(f)
         if self.compiled:
-            pan.pack(core.pm[16 * k:16 * k + 16], self.dt)
+            self.ports[k].load()
 
     def _one_step(self) -> None:
         """One chunk of C steps up to the next entry (compiled) or one coupled step (stages); SolverError on a
@@ -193,9 +198,10 @@ class TrainPassage(Stepping):
 
     def _finish(self) -> None:
         if self.compiled:
-            for k, pan in enumerate(self.pans):
-                pan.unpack(self.core.pm[16 * k:16 * k + 16])
-                self.psig[k] = {"head_displacement": self.H[:, k].copy(), "frame_displacement": self.FR[:, k].copy()}
+            for k, port in enumerate(self.ports):
+                port.pull()
+                off = int(self.core.ooff[k])
+                self.psig[k] = port.signals(self.OUT[:, off:off + int(port.port.nout)])
 
     def results(self) -> list[CoupledResult]:
         """Each pantograph's record from its entry, on the time since its entry and its own position."""
@@ -228,11 +234,11 @@ def run_passage(cfg: PassageConfig, progress: Callable[[int, int], None] | None 
     sim = CoupledSimulation(fe, pans[0], adm.V, dt, dropper_law=cfg.dropper_law, contact=cfg.contact)
     t1 = time.perf_counter()
     diagnostics = bool(record_energy or record_droppers)
-    packable = all(hasattr(pn, "pack") and hasattr(pn, "unpack") for pn in pans)
-    if native and (not packable or diagnostics or stepwise):
-        raise SolverError("the native core steps affine 2-mass pantographs and records every step without "
-                          "dropper/energy diagnostics; use native=False for this run")
-    compiled = packable and native is not False and not diagnostics and not stepwise
+    portable = all(hasattr(pn, "native") for pn in pans)
+    if native and (not portable or diagnostics or stepwise):
+        raise SolverError("the compiled loop steps pantographs that offer a one-port (`native`) and records every "
+                          "step without dropper/energy diagnostics; use native=False for this run")
+    compiled = portable and native is not False and not diagnostics and not stepwise
     tp = None
     if len(pans) == 1 and not compiled and not diagnostics and not stepwise:
         res = sim.run(p.x_start, p.x_end, progress=progress, native=False)

@@ -253,6 +253,47 @@ class EppingerMujoco:
         """MuJoCo warning counters raised during the run (empty if none)."""
         return warnings_raised(self.d)
 
+    def native(self, dt: float) -> MujocoNativePort:
+        """This pantograph as the MuJoCo one-port of the catenary's compiled loop (`engines/native/oneport.c`)."""
+        if dt != self.timestep:
+            raise SolverError(f"Eppinger pantograph (MuJoCo) built for time step {self.timestep:g} s, asked to step "
+                              f"{dt:g} s: build it with the catenary's time step")
+        return MujocoNativePort(self)
+
+
+class MujocoNativePort:
+    """An `EppingerMujoco` as the MuJoCo one-port: its model and data, the core's job of its stepper (one checked
+    step per trial), the contact point's height above the origin less y_op, ctrl = -(f0 + f1)/2 on the `catenary`
+    actuator (the force input), outputs the height and q1 .. q3 (`signals` turns them into the absolute angles)."""
+
+    names = ("head_displacement", "theta_1", "theta_2", "theta_h")
+
+    def __init__(self, pan: EppingerMujoco):
+        from ...engines.native.oneport import MujocoPort
+
+        self.pan = pan
+        self._mp = MujocoPort(pan.m, pan.d, pan.stepper._job, pan.i_cat, pan.site_c, pan.site_o, -1.0, pan.y_op,
+                              pan._state, nq_out=3)
+        self.port = self._mp.port
+
+    def load(self) -> None:
+        """The pantograph's committed state into the port."""
+        self._mp.set_state(self.pan._state)
+
+    def pull(self) -> None:
+        """The port's committed state back into the pantograph (its data restored at the next read)."""
+        self.pan._state[:] = self._mp.state()
+        self.pan._holds = None
+
+    def signals(self, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Recorded output rows (height, q1, q2, q3) as the pantograph's signals."""
+        th = q_to_theta(rows[:, 1:4].T)
+        return {"head_displacement": rows[:, 0].copy(), "theta_1": th[0], "theta_2": th[1], "theta_h": th[2]}
+
+    def failure(self, code: int) -> str:
+        """The words of the failed MuJoCo step (the core's job holds its status)."""
+        return str(self.pan.stepper._error(self.pan.stepper._job))
+
 
 #: the pantograph under the wire on each engine path, keyed like the model's path table `SPEC.paths`
 PATHS: dict[str, type[EppingerReference] | type[EppingerMujoco]] = {"reference": EppingerReference,

@@ -14,13 +14,16 @@
  *             y_head,k = P_k - gp_k f_k;
  *   advance:  vb = vb* + (sum_k f_k G N_k - sum_j s_j G B_j) / (2h), u += 2h vb, and the momentum recursions
  *             q' = 2(M - h^2 K) vb - p, p' = 2(M + h^2 K) vb - q with M vb from S vb = R (g_{n+1} included).
- * `mbs_cat_run` loops these stages over a range of steps for affine 2-mass pantographs (EN 50318 reference
- * pantograph, trapezoidal rule: its head map is exactly affine), recording every step; a nonlinear pantograph is
- * coupled from Python by calling the stages one by one. No allocation: every array belongs to the caller (numpy). */
+ * `mbs_cat_run` loops these stages over a range of steps, every pantograph coupled through its one-port (mbsuite.h:
+ * the 2-mass pantograph below, the linear and MuJoCo ports of engines/native/oneport.c, a model's own such as the
+ * Eppinger pantograph's hand-derived ODE), an affine one by its exact head map, a nonlinear one by a secant
+ * iteration (`couple`), recording every step; the stages are also exposed one by one for the Python-driven twin. No allocation: every array belongs to the caller (numpy). */
 #include <math.h>
 #include <string.h>
 
-#define CAT_ABI 3
+#include "mbsuite.h"
+
+#define CAT_ABI 4
 /* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
  * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
  * rounding) */
@@ -84,11 +87,16 @@ typedef struct {
   double *head;  /* ncon */
   double *work;  /* (ncon+nd)*(ncon+nd+1) + (ncon+nd) */
   int *iwork;    /* 2*(ncon+nd) */
-  /* 2-mass pantographs: per contact 16 doubles x1 x2 v1 v2 S00 S01 S10 S11 m1 m2 k11 k12 k22 F0 (2 spare) */
-  double *pm;
-  /* records (row = step index), may be NULL */
-  double *rec_t, *rec_x, *rec_f, *rec_head, *rec_wire, *rec_frame, *rec_up; /* nrec, nrec*ncon x4, nrec*nsup */
+  /* the pantographs: per contact its one-port (mbsuite.h; NULL while a contact has none), the secant slope of a
+   * nonlinear one's head map kept between steps (gs, NaN = not yet measured), work (cw: 4*ncon, nl: ncon) */
+  mbs_port **ports;
+  double *gs, *cw;
+  int *nl;
+  /* records (row = step index), may be NULL; rec_out: per row nout doubles, contact k's port outputs at ooff[k] */
+  double *rec_t, *rec_x, *rec_f, *rec_head, *rec_wire, *rec_out, *rec_up; /* nrec, nrec*ncon x4, nrec*nout, nrec*nsup */
   int *rec_ns;
+  int *ooff;
+  int nout;
   /* block form of the factor (see build_blocks) */
   int blocked;   /* 1 when the block form is in use */
   int *fidx;     /* n: padded index of each free DOF (node I's DOFs are noff[I] .. noff[I+1]-1) */
@@ -101,8 +109,11 @@ typedef struct {
   int nseg_f, nseg_b; /* number of stretches of the forward and the backward sweep */
   /* diagnostics */
   long n_local;
-  int err;       /* 0 ok; 1 non-finite; 2 displacement too large; 3 lost the wire; 4 active set; 5 not SPD */
+  int err;       /* 0 ok; 1 non-finite; 2 displacement too large; 3 lost the wire; 4 active set; 5 not SPD;
+                    6 a pantograph's trial failed (its code in err_port); 7 the coupling did not converge;
+                    8 bad arguments (too many contacts, a present contact without a port) */
   int err_con;
+  int err_port;
   double err_value;
 } cat_job;
 
@@ -847,29 +858,56 @@ int mbs_cat_check(cat_job* J) {
 }
 
 /* ---------------------------------------------------------------------------------- 2-mass pantographs */
-/* head map of pantograph k over a step with force f0 -> f1: P - gp f1 (exact: the trapezoidal rule is linear) */
-static void twomass_map(cat_job* J, int k) {
-  const double* s = J->pm + 16 * k;
-  const double h = J->h, f0 = J->f[k];
+/* The EN 50318 2-mass pantograph as a one-port (mbsuite.h), the twin of `pantographs.TwoMassPantograph`: its state in
+ * TM_SIZE doubles, x1 x2 v1 v2, S^-1 (S00 S01 S10 S11, S = M + hC + h^2 K), m1 m2, k11 k12 k22, F0, then the pending
+ * x1 x2 v1 v2 of the last trial. The trapezoidal rule makes its head height exactly affine in the end force. */
+#define TM_SIZE 18
+
+static void twomass_map(void* self, double t, double dt, double f0, double* P, double* g) {
+  const double* s = (const double*)self;
+  const double h = 0.5 * dt;
   const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + 0.0) / 2;
   const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
-  J->P[k] = s[0] + 2 * h * (s[4] * r1 + s[5] * r2);
-  J->gp[k] = h * h * s[4];
+  *P = s[0] + 2 * h * (s[4] * r1 + s[5] * r2);
+  *g = h * h * s[4];
 }
 
-static void twomass_commit(cat_job* J, int k, double f0, double f1) {
-  double* s = J->pm + 16 * k;
-  const double h = J->h;
+static int twomass_trial(void* self, double t, double dt, double f0, double f1, double* y) {
+  double* s = (double*)self;
+  const double h = 0.5 * dt;
   const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + f1) / 2;
   const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
   const double vb1 = s[4] * r1 + s[5] * r2;
   const double vb2 = s[6] * r1 + s[7] * r2;
-  s[0] = s[0] + 2 * h * vb1;
-  s[1] = s[1] + 2 * h * vb2;
-  s[2] = 2 * vb1 - s[2];
-  s[3] = 2 * vb2 - s[3];
-  J->head[k] = s[0];
+  s[14] = s[0] + 2 * h * vb1;
+  s[15] = s[1] + 2 * h * vb2;
+  s[16] = 2 * vb1 - s[2];
+  s[17] = 2 * vb2 - s[3];
+  *y = s[14];
+  return 0;
 }
+
+static void twomass_commit(void* self) {
+  double* s = (double*)self;
+  memcpy(s, s + 14, 4 * sizeof(double));
+}
+
+static void twomass_outputs(const void* self, double* out) {
+  const double* s = (const double*)self;
+  out[0] = s[0];
+  out[1] = s[1];
+}
+
+void mbs_cat_twomass_port(mbs_port* port, double* state) {
+  port->self = state;
+  port->affine = 1;
+  port->nout = 2;
+  port->map = twomass_map;
+  port->trial = twomass_trial;
+  port->commit = twomass_commit;
+  port->outputs = twomass_outputs;
+}
+int mbs_cat_twomass_size(void) { return TM_SIZE; }
 
 static void record(cat_job* J, long row, double t) {
   const int nc = J->ncon;
@@ -879,7 +917,10 @@ static void record(cat_job* J, long row, double t) {
     if (J->rec_f) J->rec_f[row * nc + k] = J->present[k] ? J->f[k] : 0.0;
     if (J->rec_head) J->rec_head[row * nc + k] = J->head[k];
     if (J->rec_wire) J->rec_wire[row * nc + k] = J->present[k] ? mbs_cat_wire(J, k) + J->cbc[k] * J->f[k] : 0.0;
-    if (J->rec_frame) J->rec_frame[row * nc + k] = J->pm ? J->pm[16 * k + 1] : 0.0;
+    if (J->rec_out && J->present[k] && J->ports[k]) {
+      const mbs_port* pt = J->ports[k];
+      pt->outputs(pt->self, J->rec_out + row * J->nout + J->ooff[k]);
+    }
   }
   if (J->rec_up) {
     for (int j = 0; j < J->nsup; j++) {
@@ -890,27 +931,111 @@ static void record(cat_job* J, long row, double t) {
   if (J->rec_ns) J->rec_ns[row] = J->nslack;
 }
 
-/* steps n0+1 .. n1 with every present contact a 2-mass pantograph; records row n after step n; checks every
- * `check_every` steps and at n1. Returns 0 or the error code (J->err; the step in J->err_value for code 4). */
+/* ------------------------------------------------------------------------------------------------ coupling */
+/* The contact forces of the step ending at t + dt and every present pantograph advanced to it, the twin of
+ * `train._Secant.couple`: an affine pantograph gives its exact head map P - g f1; a nonlinear one is iterated by the
+ * secant rule on its force (the slope kept between steps in gs), all of them in one local problem per iteration,
+ * until every nonlinear head map is consistent to 1e-13 + 1e-11 |y|; then each pantograph's last trial (an affine one
+ * steps once with its force) is committed. Returns 0 or the error code (J->err). */
+static int port_failed(cat_job* J, int k, int code, double t_end) {
+  J->err = 6;
+  J->err_con = k;
+  J->err_port = code;
+  J->err_value = t_end;
+  return 6;
+}
+
+static int couple(cat_job* J, double t) {
+  const int nc = J->ncon;
+  const double dt = J->dt;
+  double *fprev = J->cw, *ya = J->cw + nc, *fa = J->cw + 2 * nc, *yh = J->cw + 3 * nc;
+  int* nonlin = J->nl;
+  int nn = 0;
+  for (int k = 0; k < nc; k++) {
+    fprev[k] = J->f[k];
+    if (!J->present[k]) continue;
+    mbs_port* pt = J->ports[k];
+    if (pt->affine) {
+      pt->map(pt->self, t, dt, fprev[k], J->P + k, J->gp + k);
+      continue;
+    }
+    double y0, y1;
+    int code = pt->trial(pt->self, t, dt, fprev[k], fprev[k], &y0);
+    if (!code && isnan(J->gs[k])) {
+      code = pt->trial(pt->self, t, dt, fprev[k], fprev[k] + 1.0, &y1);
+      J->gs[k] = y0 - y1;
+    }
+    if (code) return port_failed(J, k, code, t + dt);
+    J->gp[k] = J->gs[k];
+    J->P[k] = y0 + J->gs[k] * fprev[k];
+    ya[k] = y0;
+    fa[k] = fprev[k];
+    nonlin[nn++] = k;
+  }
+  int done = 0;
+  for (int it = 0; it < 30 && !done; it++) {
+    if (mbs_cat_local(J)) {
+      J->err_value = t + dt;
+      return J->err;
+    }
+    done = 1;
+    for (int i = 0; i < nn; i++) {
+      const int k = nonlin[i];
+      mbs_port* pt = J->ports[k];
+      const double f = J->f[k];
+      const int code = pt->trial(pt->self, t, dt, fprev[k], f, yh + k);
+      if (code) return port_failed(J, k, code, t + dt);
+      if (f == fa[k]) continue;
+      const double y = yh[k];
+      const double err = y - (J->P[k] - J->gp[k] * f);
+      if (fabs(err) < 1e-13 + 1e-11 * fabs(y)) continue;
+      done = 0;
+      if (fabs(f - fa[k]) > 1e-9) {
+        const double g_new = (ya[k] - y) / (f - fa[k]);
+        if (g_new > 0) {
+          J->gs[k] = g_new;
+          J->gp[k] = g_new;
+        }
+      }
+      J->P[k] = y + J->gp[k] * f;
+      fa[k] = f;
+      ya[k] = y;
+    }
+  }
+  if (!done) {
+    J->err = 7;
+    J->err_value = t + dt;
+    return 7;
+  }
+  for (int k = 0; k < nc; k++) {
+    if (!J->present[k]) continue;
+    mbs_port* pt = J->ports[k];
+    if (pt->affine) {
+      const int code = pt->trial(pt->self, t, dt, fprev[k], J->f[k], yh + k);
+      if (code) return port_failed(J, k, code, t + dt);
+    }
+    pt->commit(pt->self);
+    J->head[k] = yh[k];
+  }
+  J->n_local++;
+  return 0;
+}
+
+/* steps n0+1 .. n1, every present contact coupled through its port; records row n after step n; checks every
+ * `check_every` steps and at n1. Returns 0 or the error code (J->err; the time in J->err_value for codes 4, 6, 7). */
 int mbs_cat_run(cat_job* J, long n0, long n1, int check_every) {
   const int nc = J->ncon;
-  double fprev[64];
-  if (nc > 64) return 6;
+  for (int k = 0; k < nc; k++) {
+    if (J->present[k] && !J->ports[k]) {
+      J->err = 8;
+      J->err_con = k;
+      return 8;
+    }
+  }
   for (long n = n0 + 1; n <= n1; n++) {
     const double t_new = (double)n * J->dt;
     mbs_cat_predict(J, t_new);
-    for (int k = 0; k < nc; k++) {
-      fprev[k] = J->f[k];
-      if (J->present[k]) twomass_map(J, k);
-    }
-    if (mbs_cat_local(J)) {
-      J->err_value = t_new;
-      return J->err;
-    }
-    J->n_local++;
-    for (int k = 0; k < nc; k++) {
-      if (J->present[k]) twomass_commit(J, k, fprev[k], J->f[k]);
-    }
+    if (couple(J, t_new - J->dt)) return J->err;
     mbs_cat_advance(J);
     record(J, n, t_new);
     if ((check_every > 0 && n % check_every == 0) || n == n1) {

@@ -12,6 +12,13 @@ passage each, in fresh interpreters, assembly included, alternating, medians and
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --compare [--repeats 7] [--baseline REV]
     taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --lines [--repeats 7]
 
+`--kinds` times whole processes (`mbsuite catenary SCENE --json`, CPU of the child process from the operating
+system's accounting) of one EN 50318 passage per pantograph kind, all at one element length and time step (default
+0.5 m and 1e-4 s, the Eppinger scene's), alternating, medians with min-max and each median's ratio to the 2-mass
+pantograph's; `--error-estimate` adds each kind's run with its error estimate and the ratio to its plain run.
+
+    taskset -c 0 .venv/bin/python scripts/catenary_benchmark.py --kinds [--repeats 3] [--speeds 250] [--error-estimate]
+
 `--lines` times the core's step loop (a whole passage, the 2-mass pantograph, the scene's mesh and step) on the
 simple, stitched and compound lines, alternating, and prints the medians per step and per element-step with their
 ratio to the simple line's (the compiled core's cost on a line with more wires per node).
@@ -165,17 +172,73 @@ def lines(speeds: list[float], repeats: int) -> None:
                         "min-max", "us/step", "ns/element-step", "ratio to simple (per element-step)"], rows))
 
 
+#: pantograph kind -> scene and the settings that select it (`--kinds`)
+KINDS = {
+    "2-mass reference": ("catenary/en50318", ()),
+    "Eppinger, MuJoCo path": ("catenary/en50318_eppinger", ("solver.engine=mujoco",)),
+    "Eppinger, hand-derived path": ("catenary/en50318_eppinger", ("solver.engine=reference",)),
+    "lumped 3-stage": ("catenary/en50318_lumped3", ()),
+    "transfer function": ("catenary/en50318_transfer", ()),
+}
+
+
+def _child_cpu(cmd: list[str]) -> float:
+    """CPU seconds (user + sys) of one whole child process running `cmd` (its output discarded)."""
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def kinds(speeds: list[float], repeats: int, h: float, dt: float, error_estimate: bool) -> None:
+    """Whole-process CPU of one passage per pantograph kind (KINDS), alternating, medians and ratios (module
+    docstring)."""
+    exe = [sys.executable, "-m", "mbsuite", "catenary"]
+    rows = []
+    for v in speeds:
+        cmds = {}
+        for name, (scene, sets) in KINDS.items():
+            base = [*exe, scene, "--json", "--set", f"params.element_length={h}", "--set", f"solver.timestep={dt}",
+                    "--set", f"input.speed={v}"]
+            for kv in sets:
+                base += ["--set", kv]
+            cmds[name] = base
+            if error_estimate:
+                cmds[name + " + error estimate"] = [*base, "--error-estimate", "--allow-inaccurate"]
+        cpu: dict[str, list[float]] = {k: [] for k in cmds}
+        for r in range(repeats):
+            for k in (list(cmds) if r % 2 == 0 else list(reversed(cmds))):
+                cpu[k].append(_child_cpu(cmds[k]))
+        ref = statistics.median(cpu["2-mass reference"])
+        for k, c in cpu.items():
+            med = statistics.median(c)
+            plain = statistics.median(cpu[k.removesuffix(" + error estimate")])
+            rows.append([v, k, f"{med:.2f}", f"{min(c):.2f}-{max(c):.2f}", f"{med / ref:.2f}",
+                         f"{med / plain:.2f}" if k.endswith("estimate") else ""])
+    print(f"element length {h:g} m, time step {dt:g} s, {repeats} runs each (alternating), whole processes")
+    print(format_table(["km/h", "pantograph", "CPU s (median)", "min-max", "ratio to the 2-mass",
+                        "ratio to its plain run"], rows))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--speeds", type=float, nargs="+", default=[250.0, 300.0])
+    ap.add_argument("--speeds", type=float, nargs="+", default=None, help="km/h (default 250 300; --kinds: 250)")
     ap.add_argument("--element-length", type=float, default=0.5)
-    ap.add_argument("--timestep", type=float, default=2e-4)
+    ap.add_argument("--timestep", type=float, default=None, help="s (default 2e-4; --kinds: 1e-4)")
     ap.add_argument("--eppinger", action="store_true", help="also time the Eppinger pantograph on both engine paths")
     ap.add_argument("--compare", action="store_true", help="the shipped method against the plain Hermite wires")
     ap.add_argument("--baseline", default=None, help="with --compare: a git revision whose code runs the plain wires")
     ap.add_argument("--lines", action="store_true", help="the core's step loop on the simple, stitched, compound lines")
+    ap.add_argument("--kinds", action="store_true", help="whole-process CPU of one passage per pantograph kind")
+    ap.add_argument("--error-estimate", action="store_true", help="with --kinds: also each kind with its estimate")
     a = ap.parse_args()
+    if a.kinds:
+        kinds(a.speeds or [250.0], a.repeats, a.element_length, a.timestep or 1e-4, a.error_estimate)
+        return
+    a.speeds, a.timestep = a.speeds or [250.0, 300.0], a.timestep or 2e-4
     if a.lines:
         lines(a.speeds, a.repeats)
         return

@@ -8,9 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mbsuite.errors import SolverError
 from mbsuite.models.catenary import train
 from mbsuite.models.catenary.config import PassageConfig
+from mbsuite.models.catenary.fe import assemble
+from mbsuite.models.catenary.pantographs import build_train
 from mbsuite.models.catenary.params import CatenaryParams
+from mbsuite.models.catenary.sim import CoupledSimulation
 from mbsuite.scenes import load_scene
 
 #: a 3-span line, 300 km/h: the slack droppers go slack, the contact force spans ~50-300 N
@@ -77,3 +81,27 @@ def test_a_single_pantograph_in_the_compiled_loop_equals_the_readable_python_pas
     d = _diff(ra, rb)
     assert d.pop("force") < 3e-8, kind
     assert max(d.values()) < 3e-12, (kind, d)
+
+
+def test_a_pantograph_that_fails_inside_the_compiled_loop_is_named_with_its_engines_words():
+    """A MuJoCo pantograph whose state turns non-finite mid-passage (its committed velocity poisoned between two
+    chunks): the compiled loop stops at that step and the error names the pantograph, the time and MuJoCo's
+    warning, in the words of the Python path's stepper."""
+    name, engine, scene = KINDS["eppinger-mujoco"]
+    cfg = PassageConfig(P3, 300.0, 1e-4, (name,), (), "slack", "unilateral", engine, _section(scene))
+    adm = cfg.check()
+    fe = assemble(P3)
+    pans = build_train([name], P3, engine, 1e-4, _section(scene), "unilateral")
+    sim = CoupledSimulation(fe, pans[0], adm.V, 1e-4, dropper_law="slack", contact="unilateral")
+    tp = train.TrainPassage(sim, pans, sim.start(P3.x_start, P3.x_end), adm.offsets, compiled=True)
+    tp.step()
+    assert tp.status == "running" and tp.n == train.CHUNK
+    port = tp.ports[0]._mp
+    state = port.state()
+    m = pans[0].m
+    nq = m.nq
+    state[1 + nq] = np.nan  # the integration state: time, qpos, qvel, ...: the first joint velocity
+    port.set_state(state)
+    words = r"pantograph 1 failed at t = 0\.500100 s \(x = 41\.67 m\): .*MuJoCo diverged \(warning badqvel"
+    with pytest.raises(SolverError, match=words):
+        tp.step()

@@ -116,7 +116,8 @@ class EppingerReference:
         return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
     def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
-        """Contact force after a trial step of h to wire height y_w, the state left unchanged."""
+        """Contact-point height (m, from the undisturbed wire) after one RK4 step of dt under the force f0 -> f1,
+        pending until `commit`."""
         xn = self._rk4(t, dt, f0, f1)
         self._pending = xn
         return self.ode.contact_height(xn) - self.y_op
@@ -134,6 +135,39 @@ class EppingerReference:
         t = self.ode.theta(self.x[: self.ode.nq])
         return {"head_displacement": self.head(), "theta_1": float(t[0]), "theta_2": float(t[1]),
                 "theta_h": float(t[2])}
+
+    def native(self, dt: float) -> ReferenceNativePort:
+        """This pantograph as a one-port of the catenary's compiled loop: its ODE and RK4 step in C
+        (`native/ode_port.c`)."""
+        return ReferenceNativePort(self)
+
+
+class ReferenceNativePort:
+    """An `EppingerReference` as its C one-port (`ode_port.OdePort`): the same RK4 step of the same ODE, outputs the
+    head height and the three absolute angles."""
+
+    def __init__(self, pan: EppingerReference):
+        from .ode_port import OdePort
+
+        self.pan = pan
+        self._op = OdePort(pan)
+        self.port = self._op.port
+
+    def load(self) -> None:
+        """The pantograph's committed state into the port."""
+        self._op.push(self.pan)
+
+    def pull(self) -> None:
+        """The port's committed state back into the pantograph."""
+        self._op.pull(self.pan)
+
+    def signals(self, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Recorded output rows as the pantograph's signals."""
+        return self._op.signals(rows)
+
+    def failure(self, code: int) -> str:
+        """The words of the failed trial."""
+        return self._op.failure(code)
 
 
 class EppingerMujoco:
@@ -211,7 +245,8 @@ class EppingerMujoco:
         return -f_up
 
     def trial(self, t: float, dt: float, f0: float, f1: float) -> float:
-        """Contact force after a trial step of h to wire height y_w, the state left unchanged."""
+        """Contact-point height (m, from the undisturbed wire) after one MuJoCo step of dt under the mean force
+        (f0 + f1)/2, pending until `commit`."""
         if dt != self.timestep:
             raise SolverError(f"Eppinger pantograph (MuJoCo) built for time step {self.timestep:g} s, asked to step "
                               f"{dt:g} s: build it with the catenary's time step")

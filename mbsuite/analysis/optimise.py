@@ -20,8 +20,10 @@ several keys) and minimises the worst (`aggregate="worst"`) or the mean; the con
 
 Pareto front (`pareto`): the epsilon-constraint method with scipy — minimise the objective subject to the second
 output >= each level of a list (Haimes, Lasdon and Wismer 1971), every level a `run`; the front is the non-dominated
-set of all evaluations of all levels. A multi-objective library (pymoo) is not used: it would add ten packages to
-the install for a front that a few bounded runs on the same machinery give, with the same executors and store.
+set of all evaluations of all levels (over several operating points, of all designs, each with its aggregated
+objective and its least second output: `candidates`). A multi-objective library (pymoo) is not used: it would add
+ten packages to the install for a front that a few bounded runs on the same machinery give, with the same executors
+and store.
 
 The module is kept whole (about 600 lines): the bounds, the penalised problem, `run`, `pareto` and their results
 with their reports are one method, read together."""
@@ -482,7 +484,8 @@ def judge_rerun(result: OptimiseResult, scene: Scene) -> None:
 @dataclass
 class ParetoResult:
     """The epsilon-constraint front: per level the optimum (`runs`), and the non-dominated set of every evaluation
-    (`front`: minimise `objective`, maximise `against`)."""
+    (`front`: minimise `objective`, maximise `against`; over several operating points, of every design with its
+    aggregate, `candidates`)."""
 
     objective: str
     against: str
@@ -499,14 +502,21 @@ class ParetoResult:
         return to_jsonable({"target": self.target, "objective": self.objective, "against": self.against,
                             "levels": self.levels, "front": self.front,
                             "runs": [{k: v for k, v in r.to_dict().items() if k != "evaluations"} for r in self.runs],
-                            "evaluations": [e for r in self.runs for e in r.evaluations]})
+                            "evaluations": self.evaluations()})
+
+    def evaluations(self) -> list[dict[str, Any]]:
+        """Every evaluation of every level, its `violation` that of the run's own constraints (the level's is the
+        last of its `violations`): what `evaluations.csv` and summary.json report, so that both give one number."""
+        return _evaluations(self.runs)
 
     def table(self) -> str:
         """Each level's optimum and the front."""
         from ..results import format_table
 
-        rows = [[lv, r.value, r.best_outputs[0].get(self.against, float("nan")), "yes" if r.feasible else "NO",
-                 *[r.best[f.label] for f in r.factors]] for lv, r in zip(self.levels, self.runs, strict=True)]
+        # the traded output of each level's optimum: the least over the operating points (the level holds at each)
+        rows = [[lv, r.value, min(o.get(self.against, float("nan")) for o in r.best_outputs),
+                 "yes" if r.feasible else "NO", *[r.best[f.label] for f in r.factors]]
+                for lv, r in zip(self.levels, self.runs, strict=True)]
         head = [f"{self.against} >=", self.objective, self.against, "feasible",
                 *[f.label for f in self.runs[0].factors]]
         text = (f"epsilon-constraint front of {self.target}: minimise {self.objective}, {self.against} >= each level "
@@ -522,7 +532,8 @@ class ParetoResult:
         return Report(self.to_dict(), self.table(), self.write)
 
     def write(self, out: str | Path) -> list[Path]:
-        """`pareto.csv` (the front), `evaluations.csv` (every evaluation) and `pareto.png` under `out`."""
+        """`pareto.csv` (the front), `evaluations.csv` (every evaluation, its operating point, the violation of the
+        run's own constraints) and `pareto.png` (the candidates of the front, `candidates`) under `out`."""
         from ..plotting import figure, save
         from ..results import write_csv
 
@@ -532,16 +543,17 @@ class ParetoResult:
                 (self.objective, self.units.get(self.objective, ""),
                  [p["outputs"][self.objective] for p in self.front])]
         cols += [(k, "", [p["design"][k] for p in self.front]) for k in labels]
-        n_base = len(self.runs[0].constraints) - 1  # each run's last constraint is its level
-        ev = [{**e, "violation": float(sum(e["violations"][:n_base]))} for r in self.runs for e in r.evaluations]
+        ev = self.evaluations()
         ecols = [(k, "", [e["design"][k] for e in ev]) for k in labels]
+        ecols += [(k, "", [e["context"].get(k, "") for e in ev]) for k in sorted({k for e in ev for k in e["context"]})]
         ecols += [(k, self.units.get(k, ""), [e["outputs"].get(k, float("nan")) for e in ev])
                   for k in sorted({k for e in ev for k in e["outputs"]})]
         ecols += [("violation", "", [e["violation"] for e in ev])]
         fig, axs = figure(1, 1, size=(6.5, 4.2), squeeze=False)
         ax = axs[0, 0]
-        ok = [e for e in ev if e["violation"] == 0.0]
-        bad = [e for e in ev if e["violation"] > 0.0]
+        cand = candidates(ev, self.runs[0].contexts, self.objective, self.against, self.runs[0].aggregate)
+        ok = [e for e in cand if e["violation"] == 0.0]
+        bad = [e for e in cand if e["violation"] > 0.0]
         ax.plot([e["outputs"][self.against] for e in bad], [e["outputs"][self.objective] for e in bad], "x",
                 color="0.7", ms=3, label="evaluations violating the run's constraints")
         ax.plot([e["outputs"][self.against] for e in ok], [e["outputs"][self.objective] for e in ok], ".",
@@ -576,13 +588,49 @@ def non_dominated(evals: Sequence[Mapping[str, Any]], objective: str, against: s
     return sorted(uniq.values(), key=lambda p: p["outputs"][against])
 
 
+def _evaluations(runs: Sequence[OptimiseResult]) -> list[dict[str, Any]]:
+    """Every evaluation of every level's run, its `violation` that of the run's own constraints only (each run's last
+    constraint is its level, which does not count against a design on the front)."""
+    n_base = len(runs[0].constraints) - 1
+    return [{**e, "violation": float(sum(e["violations"][:n_base]))} for r in runs for e in r.evaluations]
+
+
+def candidates(evals: Sequence[Mapping[str, Any]], contexts: Sequence[Mapping[str, Any]], objective: str,
+               against: str, aggregate: str) -> list[dict[str, Any]]:
+    """What the front is chosen from. At one operating point: the evaluations. Over several: the designs, each with
+    the figures its runs constrain and minimise -- the objective aggregated over the points as the runs minimise it
+    (`worst`: the max, `mean`: the mean), `against` the least over the points (the level it meets at every one), the
+    violation summed over the points, its evaluations in `points`; a design is not compared by one operating point's
+    evaluation."""
+    if len(contexts) <= 1:
+        return [dict(e) for e in evals]
+    by_design: dict[tuple, dict[tuple, Mapping[str, Any]]] = {}
+    for e in evals:  # a design met again (the start design in every run) has the same outputs
+        by_design.setdefault(tuple(e["design"].items()), {})[tuple(e["context"].items())] = e
+    out = []
+    for key, per in by_design.items():
+        pts = [per.get(tuple(c.items())) for c in contexts]
+        if any(p is None for p in pts):
+            continue
+        terms = [float(p["outputs"][objective]) for p in pts]
+        out.append({"design": dict(key), "context": {},
+                    "outputs": {objective: max(terms) if aggregate == "worst" else float(np.mean(terms)),
+                                against: min(float(p["outputs"][against]) for p in pts)},
+                    "violation": float(sum(p["violation"] for p in pts)), "points": [dict(p) for p in pts]})
+    return out
+
+
 def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: Sequence[Factor | str], *,
            objective: str | None = None, against: str | None = None, levels: Sequence[float],
            **kwargs: Any) -> ParetoResult:
     """The trade-off of `objective` (minimised) against `against` (maximised): one `run` per level with the extra
     constraint `against >= level` (epsilon-constraint), the front the non-dominated set of all their evaluations.
-    `objective` / `against` None: the model's declared ones (`SPEC.studies`). `kwargs` go to `run` (constraints,
-    over, maxiter, popsize, seed, workers, options)."""
+    Over several operating points (`over`) the front is of designs (`candidates`): each with its aggregated objective
+    (what the runs minimise) and the least `against` over the points (the level it meets at each). Before, it was the
+    non-dominated set of single evaluations, so a design entered by its best operating point (e.g. sigma at 250 km/h
+    for a worst case set at 300 km/h), below what the runs could reach, and the table gave `against` at the first
+    point only. `objective` / `against` None: the model's declared ones (`SPEC.studies`). `kwargs` go to `run`
+    (constraints, over, aggregate, maxiter, popsize, seed, workers, options)."""
     from ..scenes import Scene
 
     lv = [LIMITS["level"].check("pareto level", x, MbsuiteError) for x in levels]
@@ -594,11 +642,10 @@ def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factor
     runs = [run(target, factors, objective=objective, constraints=[*base, Bound(against, lo=x)], **kwargs)
             for x in lv]
     # a design is on the front if it meets the run's own constraints; the level it was searched under does not count
-    evals = [{**e, "violation": float(sum(e["violations"][:len(base)]))} for r in runs for e in r.evaluations]
-    units = runs[0].units
-    return ParetoResult(objective, against, lv, runs, non_dominated(evals, objective, against), units,
+    cand = candidates(_evaluations(runs), runs[0].contexts, objective, against, runs[0].aggregate)
+    return ParetoResult(objective, against, lv, runs, non_dominated(cand, objective, against), runs[0].units,
                         scene.name if scene is not None else runs[0].target)
 
 
-__all__ = ["AGGREGATES", "Bound", "OptimiseResult", "ParetoResult", "band", "contexts_of", "non_dominated",
-           "judge_rerun", "parse_bound", "pareto", "rerun", "run"]
+__all__ = ["AGGREGATES", "Bound", "OptimiseResult", "ParetoResult", "band", "candidates", "contexts_of",
+           "judge_rerun", "non_dominated", "parse_bound", "pareto", "rerun", "run"]

@@ -797,6 +797,15 @@ def cli_attempts() -> Iterator[Attempt]:
               culprit="pantograph")
     yield cli("catenary-mujoco-2mass", a, "catenary --engine mujoco with the 2-mass pantograph",
               "catenary --engine mujoco --json", culprit="mujoco|eppinger|reference2mass")
+    train = ('model = "catenary"\n[effects]\ndroppers = "slack"\npantograph = "eppinger"\ncontact = "unilateral"\n'
+             '[params]\nn_spans = 8\n[train]\npantographs = ["eppinger", "reference2mass"]\nspacings = [60.0]\n'
+             '[input]\ntype = "passage"\nspeed = 250.0\n[solver]\nengine = "mujoco"\ntimestep = 1e-4\n')
+    yield scene("catenary-train-eppinger-bad-pressure", a, "a train of an Eppinger and a 2-mass pantograph in the "
+                "compiled loop, the Eppinger one's supply pressure negative", train + "[pantograph]\nparams = { Pg = "
+                "-5.0 }\n", culprit="Pg", cmd=("catenary",))
+    yield scene("catenary-train-eppinger-no-hold", a, "the same train, the Eppinger pantograph's supply pressure too "
+                "low to hold the wire", train + "[pantograph]\nparams = { Pg = 1.0e5 }\n",
+                culprit="Pg|hold|press", cmd=("catenary",), timeout=120)
     # Ctrl-C and closed pipes
     for what, argv, files in (
             ("sweep", f'"sweep", "pantograph", "--vary", "input.frequency=1:30:0.5", "--workers", "1", '

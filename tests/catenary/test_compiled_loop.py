@@ -10,7 +10,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from mbsuite.errors import SolverError
+from mbsuite.errors import SceneError, SolverError
 from mbsuite.models.catenary import train
 from mbsuite.models.catenary.config import PassageConfig
 from mbsuite.models.catenary.fe import assemble
@@ -119,3 +119,19 @@ def test_a_pantograph_that_fails_inside_the_compiled_loop_is_named_with_its_engi
     words = r"pantograph 1 failed at t = 0\.500100 s \(x = 41\.67 m\): .*MuJoCo diverged \(warning badqvel"
     with pytest.raises(SolverError, match=words):
         tp.step()
+
+
+def test_a_mixed_train_gives_the_section_to_its_sectioned_pantograph():
+    """An Eppinger pantograph (its [pantograph] section) leading a 2-mass one (its numbers from [params]) in the
+    compiled loop, as in the stage-driven loop (measured bit-equal; bounds as above); a train of two kinds that each
+    read the section is refused, naming them."""
+    sec = _section("en50318_eppinger")
+    runs = [train.run_passage(PassageConfig(P3, 300.0, 1e-4, ("eppinger", "reference2mass"), (30.0,), "slack",
+                                            "unilateral", "mujoco", sec), stepwise=s) for s in (True, False)]
+    assert runs[0].engines == ["mujoco", "reference"] and runs[1].timing["native_loop"]
+    for ra, rb in zip(runs[0].results, runs[1].results, strict=True):
+        d = _diff(ra, rb)
+        assert d.pop("force") < 3e-8 and max(d.values()) < 3e-12
+    with pytest.raises(SceneError, match=r"\['eppinger', 'lumped'\]"):
+        train.run_passage(PassageConfig(P3, 300.0, 1e-4, ("eppinger", "lumped"), (30.0,), "slack", "unilateral",
+                                        "reference", sec))

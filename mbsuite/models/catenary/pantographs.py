@@ -349,13 +349,20 @@ def build_train(pantographs: list, p, engine: str, dt: float, section: Mapping[s
                 contact: str | None = None) -> list[Pantograph]:
     """The pantographs of a passage, leading first: names (`build`) or objects of the protocol (taken as they are).
     A named pantograph runs on `engine`; on a train that also carries one with that path, a pantograph without it
-    (the 2-mass one) runs on its only path."""
+    (the 2-mass one) runs on its only path. The `[pantograph]` section is the sectioned pantograph's (the Eppinger
+    or a linear one; at most one such kind per train); the 2-mass ones of a mixed train take theirs from [params]."""
     carried = any(engine in kind(n, p).engines for n in pantographs if isinstance(n, str))
+    takers = sorted({n for n in pantographs if isinstance(n, str) and n in SECTION_PANTOGRAPHS})
+    if len(takers) > 1 and section:
+        raise SceneError(f"the [pantograph] section describes one kind of pantograph, but the train carries "
+                         f"{takers}: run trains of one kind of sectioned pantograph")
     out = []
     for item in pantographs:
         if not isinstance(item, str):
             out.append(item)
             continue
         engines = kind(item, p).engines
-        out.append(build(item, p, engine if engine in engines or not carried else engines[0], dt, section, contact))
+        # the section is the sectioned pantograph's; a train without one hands it to every member (which refuse it)
+        sec = section if item in SECTION_PANTOGRAPHS or not takers else None
+        out.append(build(item, p, engine if engine in engines or not carried else engines[0], dt, sec, contact))
     return out

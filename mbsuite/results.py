@@ -374,6 +374,18 @@ class Report:
     data: dict[str, Any]
     table: str
     write: Any = None  # Callable[[Path], list[Path]] | None
+    inaccurate: list[str] = field(default_factory=list)  # error estimates above their tolerance, kept (flag_inaccurate)
+
+    def flag_inaccurate(self, messages: Sequence[str]) -> None:
+        """Flag the report as kept although error estimates exceed their tolerances (`messages`, the `INACCURATE:`
+        lines, already in its warnings): `data["inaccurate"]` holds them and the table ends with the verdict; the
+        command line exits with status 3 after printing it and writing its files (`trust.health.InaccurateResult`)."""
+        if self.inaccurate or not messages:
+            return
+        self.inaccurate = list(messages)
+        self.data["inaccurate"] = list(messages)
+        self.table += (f"\nINACCURATE RESULT, kept: {len(messages)} error estimate(s) above their tolerance (above); "
+                       "exit status 3; --allow-inaccurate accepts it")
 
     def save(self, out_dir: str | Path, scene: Mapping[str, Any] | None,
              command: Mapping[str, Any] | None = None) -> list[Path]:

@@ -470,15 +470,18 @@ def rerun(result: OptimiseResult, scene: Scene, workers: int = 0) -> dict[str, A
     return result.rerun
 
 
-def judge_rerun(result: OptimiseResult, scene: Scene) -> None:
-    """The re-run's error estimates against their tolerances: an `AccuracyError` naming the first past its tolerance
-    (warnings with solver.allow_inaccurate / --allow-inaccurate)."""
-    from ..trust.health import judge
+def judge_rerun(result: OptimiseResult, scene: Scene) -> list[str]:
+    """The re-run's error estimates against their tolerances (`trust.health.judge_estimate`): the `INACCURATE:`
+    lines of those past it (emitted as warnings with solver.allow_inaccurate / --allow-inaccurate). The result is
+    kept either way: the command line flags its report with them unless allowed (exit status 3)."""
+    from ..trust.health import judge_estimate
 
+    out = []
     for p in (result.rerun or {}).get("points", []):
         where = ", ".join(f"{k} = {v:g}" for k, v in p["context"].items())
-        judge(p["_figures"], allow_inaccurate=scene.solver.allow_inaccurate,
-              what=f"the optimum of {scene.name}{' at ' + where if where else ''}")
+        out += judge_estimate(p["_figures"], allow_inaccurate=scene.solver.allow_inaccurate,
+                              what=f"the optimum of {scene.name}{' at ' + where if where else ''}")
+    return out
 
 
 @dataclass

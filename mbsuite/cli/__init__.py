@@ -26,8 +26,9 @@ import sys
 from collections.abc import Sequence
 
 from ..errors import MbsuiteError
+from ..trust.health import InaccurateResult
 from .options import overrides
-from .output import check_out, fail, quiet_stdout
+from .output import check_out, fail, inaccurate, quiet_stdout
 from .parser import UsageError, build_parser, parser_for
 
 __all__ = ["build_parser", "main"]
@@ -35,7 +36,9 @@ __all__ = ["build_parser", "main"]
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line. Exit status: 0 success, 2 any error (one line naming the input; under --json also a JSON
-    object `{"error": {...}}` on stdout), 130 interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
+    object `{"error": {...}}` on stdout), 3 a result printed and written although an error estimate exceeds its
+    tolerance (`trust.health.InaccurateResult`: one line on stderr; `--allow-inaccurate` accepts it: 0), 130
+    interrupted (Ctrl-C). A closed output pipe ends the command quietly."""
     argv = list(sys.argv[1:] if argv is None else argv)
     ap = parser_for(argv)
     try:
@@ -50,6 +53,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         check_out(getattr(args, "out", None))
         overrides(args)  # the one rule over every flag that changes the scene, before anything loads or runs
         args.func(args)
+    except InaccurateResult as exc:
+        if not getattr(exc, "shown", False):  # not raised by `emit` after printing the result: nothing was shown
+            return fail(str(exc), as_json, type(exc).__name__)
+        return inaccurate(str(exc))
     except MbsuiteError as exc:
         return fail(str(exc), as_json, type(exc).__name__)
     except KeyboardInterrupt:

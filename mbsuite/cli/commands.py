@@ -14,6 +14,7 @@ from ..limits import Limit
 from ..results import Report, format_table
 from ..scenes import load_scene
 from ..statistics import describe
+from ..trust.health import InaccurateResult
 from .options import MAX_REPEATS, load, scene_of
 from .output import emit, wrap
 from .study import apply_sets
@@ -79,7 +80,11 @@ def cmd_run(args: argparse.Namespace) -> None:
     from .. import run
 
     scene = apply_sets(load(args), args.set_values)
-    emit(run(scene, error_estimate=args.error_estimate).report(), args, scene.to_dict())
+    try:
+        rep = run(scene, error_estimate=args.error_estimate).report()
+    except InaccurateResult as exc:  # an error estimate above its tolerance: the result kept, flagged (exit 3)
+        rep = exc.report()
+    emit(rep, args, scene.to_dict())
 
 
 def cmd_view(args: argparse.Namespace) -> None:

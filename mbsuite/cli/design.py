@@ -93,8 +93,14 @@ def cmd_optimise(args: argparse.Namespace) -> None:
         emit(res.report(), args, scene.to_dict())
         return
     res = optimise.run(scene, args.vary or [], **common)
+    warned = []
     if args.error_estimate:
         optimise.rerun(res, scene, workers=args.workers)
-    emit(res.report(), args, scene.to_dict())
-    if args.error_estimate:
-        optimise.judge_rerun(res, scene)
+        warned = optimise.judge_rerun(res, scene)
+    rep = res.report()
+    if warned:  # the optimum's error estimate above its tolerance: kept, flagged (exit 3) unless allowed
+        rep.data["warnings"] = list(rep.data.get("warnings", [])) + warned
+        rep.table += "\n" + "\n".join(warned)
+        if not scene.solver.allow_inaccurate:
+            rep.flag_inaccurate(warned)
+    emit(rep, args, scene.to_dict())

@@ -82,13 +82,14 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_error_estimate(p: argparse.ArgumentParser) -> None:
-    """`--error-estimate`: run refined copies and report each headline output's estimated error
+    """`--error-estimate`: run the scene's companions and report each headline output's estimated error
     (mbsuite.trust.estimate)."""
     p.add_argument("--error-estimate", action="store_true",
-                   help="also run the scene refined once and twice (the path's step, tolerance or mesh; in parallel "
-                        "on the local cores) and report per headline output the estimated error, the observed order "
-                        "and the declared tolerance; an estimate above its tolerance is an error unless "
-                        "--allow-inaccurate")
+                   help="also run the scene's companions (the path's step, tolerance or mesh refined once and twice; "
+                        "the catenary's coarsened once and twice first; in parallel on the local cores) and report "
+                        "per headline output the estimated error, the observed order and the declared tolerance; an "
+                        "estimate above its tolerance keeps the result, flagged inaccurate, with exit status 3 (0 "
+                        "with --allow-inaccurate)")
 
 
 def load(args: argparse.Namespace) -> Scene:

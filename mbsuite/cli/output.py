@@ -24,7 +24,8 @@ def add_common(p: argparse.ArgumentParser) -> None:
 
 
 def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> None:
-    """Print `report` (its table, or its data as JSON under `--json`) and write its files under `--out`."""
+    """Print `report` (its table, or its data as JSON under `--json`) and write its files under `--out`; then, for a
+    report flagged inaccurate (`Report.flag_inaccurate`), raise `InaccurateResult` (`main`: exit status 3)."""
     from ..results import to_jsonable
 
     files = report.save(args.out, scene_dict, command_record(args)) if getattr(args, "out", None) else []
@@ -37,6 +38,12 @@ def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> N
         print(report.table)
         for f in files:
             print(f"wrote {f}")
+    if report.inaccurate:
+        from ..trust.health import InaccurateResult
+
+        exc = InaccurateResult(report.inaccurate, report)
+        exc.shown = True  # `main`: the result is out, exit 3
+        raise exc
 
 
 def command_record(args: argparse.Namespace) -> dict:
@@ -49,6 +56,16 @@ def command_record(args: argparse.Namespace) -> dict:
 def wrap(text: str, width: int = 100, indent: str = "  ") -> str:
     """`text` filled to `width` columns, later lines indented two more."""
     return textwrap.fill(text, width=width, initial_indent=indent, subsequent_indent=indent + "  ")
+
+
+def inaccurate(message: str) -> int:
+    """The verdict on a result printed although an error estimate exceeds its tolerance: one line on stderr (the
+    result, under --json its JSON with `"inaccurate"`, is on stdout); exit status 3 (`EXIT_INACCURATE`)."""
+    from ..trust.health import EXIT_INACCURATE
+
+    message = " ".join(message.split())
+    print(f"mbsuite: inaccurate: {message}", file=sys.stderr)
+    return EXIT_INACCURATE
 
 
 def fail(message: str, as_json: bool, kind: str) -> int:

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import MbsuiteError
+from ..trust.health import InaccurateResult
 from .options import SCENE_SECTIONS
 
 if TYPE_CHECKING:
@@ -27,6 +28,8 @@ if TYPE_CHECKING:
     from ..scenes import Scene
 
 SECTIONS = SCENE_SECTIONS
+#: the key of a study point's result that holds its `INACCURATE:` lines (an error estimate above its tolerance)
+INACCURATE = "_inaccurate"
 MAX_LIST = 16  # a list of numbers longer than this is a curve or a time series, not a quantity of the study
 
 
@@ -111,8 +114,15 @@ def study_point(target: str, options: dict[str, Any], job: tuple[dict | None, di
     if scene_d is not None:
         scene = scene_from_dict(scene_d)
         scene = scene.replace(origin="on the command line (--vary)", **sections) if sections else scene
-    report = getattr(importlib.import_module(module), name)(scene, argparse.Namespace(**options))
-    return flatten({k: v for k, v in to_jsonable(report.data).items() if k != "scene"})  # the scene: the axes
+    try:
+        report = getattr(importlib.import_module(module), name)(scene, argparse.Namespace(**options))
+    except InaccurateResult as exc:  # an error estimate above its tolerance: the point kept, flagged
+        report = exc.report()
+    out: dict[str, Any] = flatten({k: v for k, v in to_jsonable(report.data).items()
+                                   if k not in ("scene", "inaccurate")})  # the scene: the axes
+    if report.inaccurate:
+        out[INACCURATE] = list(report.inaccurate)
+    return out
 
 
 def point_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -138,7 +148,11 @@ def run_or_study(args: argparse.Namespace, scene: Scene | None, target: str, *, 
     scene_d = scene.to_dict() if scene is not None else None
     if not getattr(args, "vary", None):
         module, _, name = target.partition(":")
-        out(getattr(importlib.import_module(module), name)(scene, args), args, scene_d)
+        try:
+            rep = getattr(importlib.import_module(module), name)(scene, args)
+        except InaccurateResult as exc:  # an error estimate above its tolerance: the result kept, flagged (exit 3)
+            rep = exc.report()
+        out(rep, args, scene_d)
         return
     out(study(args, scene, target, units=units or {}, parallel_inside=parallel_inside), args, scene_d)
 
@@ -202,6 +216,8 @@ def study_report(scene: Scene | None, axes: list[tuple[str, str, list]], combos:
     head = [f"{s}.{n}" for s, n, _ in axes]
     axis_units = {h: axis_unit(scene, s, n) if scene is not None else units.get(n, "")
                   for h, (s, n, _) in zip(head, axes, strict=True)}
+    flagged = [(combo, r[INACCURATE]) for combo, r in zip(combos, results, strict=True) if INACCURATE in r]
+    results = [{q: v for q, v in r.items() if q != INACCURATE} for r in results]
     quantities = list(dict.fromkeys(q for r in results for q in r))
     rows = [[*combo, q, unit_of(q, units), r[q]] for combo, r in zip(combos, results, strict=True)
             for q in quantities if q in r]
@@ -214,7 +230,13 @@ def study_report(scene: Scene | None, axes: list[tuple[str, str, list]], combos:
                        for c, r in zip(combos, results, strict=True)]}
     write = functools.partial(write_study, head=head, axis_units=axis_units, combos=combos, results=results,
                               quantities=quantities, units=units, what=what)
-    return Report(data, table, write)
+    rep = Report(data, table, write)
+    if flagged:  # points whose error estimate exceeds its tolerance: the study kept, flagged (exit 3)
+        lines = [f"at {', '.join(f'{h} = {v}' for h, v in zip(head, combo, strict=True))}: {m}"
+                 for combo, msgs in flagged for m in msgs]
+        rep.table += "\n" + "\n".join(lines)
+        rep.flag_inaccurate(lines)
+    return rep
 
 
 def write_study(out: Path, *, head: list[str], axis_units: dict[str, str], combos: list[tuple], results: list[dict],

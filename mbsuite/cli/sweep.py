@@ -50,47 +50,92 @@ def cmd_sweep(args: argparse.Namespace) -> None:
     # MuJoCo points run in C threads (the native core releases the GIL), the hand-derived paths in processes
     auto = "threads" if engines == {"mujoco"} else "local"
     estimate = getattr(args, "error_estimate", False)
+    levels = LEVELS
     if estimate:
         if scene.spec.accuracy is None:
             raise MbsuiteError(f"model '{scene.model}' declares no headline outputs: no --error-estimate")
-        points = [(*pt, level) for pt in points for level in LEVELS]  # every point at levels 0, 1, 2
+        if scene.spec.accuracy.refinement(scene).companions == "coarse":
+            levels = COARSE_LEVELS
+        points = [(*pt, level) for pt in points for level in levels]  # every point at levels 0, 1, 2 (or -1, -2)
     results = run_sweep(scene_point, points, workers=args.workers, desc="sweep",
                         executor=None if args.executor else auto, options=options)
     if estimate:
-        results = point_estimates(scene, points, results)
-    emit(sweep_report(scene, axes, combos, results, args.signals), args, scene.to_dict())
+        results = point_estimates(scene, points, results, levels, workers=args.workers, options=options)
+    rep = sweep_report(scene, axes, combos, results, args.signals)
     if estimate:
-        judge_points(scene, axes, combos, results)
+        warned = judge_points(scene, axes, combos, results)
+        if warned:  # estimates above their tolerances: the sweep kept, flagged (exit 3) unless allowed
+            rep.data["warnings"] = warned
+            rep.table += "\n" + "\n".join(warned)
+            if not scene.solver.allow_inaccurate:
+                rep.flag_inaccurate(warned)
+    emit(rep, args, scene.to_dict())
 
 
+#: the levels of a point's error estimate: the run and its refined companions, or its coarse ones (the refined ones
+#: then run for the points whose coarse ones fail their check)
 LEVELS = (0, 1, 2)
+COARSE_LEVELS = (0, -1, -2)
 
 
-def point_estimates(scene: Scene, points: list[tuple], results: list[dict]) -> list[dict]:
+def point_estimates(scene: Scene, points: list[tuple], results: list[dict], levels: tuple[int, ...] = LEVELS, *,
+                    workers: int = 0, options=None) -> list[dict]:
     """Fold the three levels of every point into the level-0 result with its `error_estimate`
-    (mbsuite.trust.estimate)."""
+    (mbsuite.trust.estimate). With `COARSE_LEVELS`, a point whose coarse companions fail (or are not in the
+    asymptotic range) gets its refined ones run (all such points in one batch) and their estimate, with the
+    fallback's reason."""
+    from ..analysis.errorestimate import level_settings
+    from ..analysis.sweep.points import FAILED
     from ..trust.estimate import declared, estimate
 
-    out = []
-    n = len(LEVELS)
+    out, redo = [], []
+    n = len(levels)
     for i in range(0, len(points), n):
         sc = scene.replace(**points[i][1]) if points[i][1] else scene
-        est = estimate([r["headlines"] for r in results[i:i + n]], declared(sc), sc.spec.accuracy.refinement(sc))
+        ref = sc.spec.accuracy.refinement(sc)
+        vals = [r["headlines"] for r in results[i:i + n]]
         r0 = dict(results[i])
-        r0["error_estimate"] = est
         out.append(r0)
+        if levels == LEVELS:
+            r0["error_estimate"] = estimate(vals, declared(sc), ref)
+            continue
+        failed = [v[FAILED] for v in vals[1:] if FAILED in v]
+        if failed:
+            redo.append((r0, i, sc, None, f"refined companions run instead of coarse ones: {failed[0]}"))
+            continue
+        est = estimate(vals, declared(sc), ref, level_settings(sc, [ref.refine(sc, k) for k in levels]), "coarse")
+        if est.passed:
+            r0["error_estimate"] = est
+        else:
+            redo.append((r0, i, sc, est, "refined companions run instead of coarse ones: the coarse companions "
+                                         f"({'; '.join(est.settings[1:])}) are not in the asymptotic range for "
+                                         f"{est.failure_text()}"))
+    if redo:
+        jobs = [(*points[i][:2], level) for _, i, _, _, _ in redo for level in LEVELS[1:]]
+        fine = run_sweep(scene_point, jobs, workers=workers, desc="error estimate (refined companions)",
+                         executor="local", options=options)
+        for k, (r0, i, sc, coarse, why) in enumerate(redo):
+            ref = sc.spec.accuracy.refinement(sc)
+            vals = [results[i]["headlines"], *(r["headlines"] for r in fine[2 * k:2 * k + 2])]
+            est = estimate(vals, declared(sc), ref, level_settings(sc, [ref.refine(sc, j) for j in LEVELS]))
+            est.fallback, est.coarse = why, coarse
+            r0["error_estimate"] = est
     return out
 
 
-def judge_points(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict]) -> None:
-    """Every point's estimates against their tolerances: an AccuracyError naming the first point and headline past
-    its tolerance (warnings with solver.allow_inaccurate / --allow-inaccurate)."""
-    from ..trust.health import judge
+def judge_points(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict]
+                 ) -> list[str]:
+    """Every point's estimates against their tolerances (`trust.health.judge_estimate`): the `INACCURATE:` lines
+    naming the point and headline of those past it (emitted as warnings with solver.allow_inaccurate /
+    --allow-inaccurate)."""
+    from ..trust.health import judge_estimate
 
+    out = []
     for combo, r in zip(combos, results, strict=True):
         where = ", ".join(f"{s}.{n} = {v}" for (s, n, _), v in zip(axes, combo, strict=True))
-        judge(r["error_estimate"].figures(), allow_inaccurate=scene.solver.allow_inaccurate,
-              what=f"sweep point {where}")
+        out += judge_estimate(r["error_estimate"].figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                              what=f"sweep point {where}")
+    return out
 
 
 def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[tuple], results: list[dict],
@@ -127,8 +172,15 @@ def sweep_report(scene: Scene, axes: list[tuple[str, str, list]], combos: list[t
                 sig_units.setdefault(e.name, e.unit)
         first = results[0]["error_estimate"]
         est_head = [*heads, "headline", "unit", "value", "est. error", "tol", "observed order", ""]
-        table += (f"\n\nerror estimate per point: {first.setting} refined by {first.factor:g} twice (nominal order "
-                  f"{first.nominal_order:g})\n" + format_table(est_head, est_rows, ".4g"))
+        kinds = sorted({r["error_estimate"].companions for r in results})
+        f = first.factor
+        how = " or ".join(f"{first.setting} " + (f"coarsened by {f:g} and {f * f:g}" if k == "coarse" else
+                                                 f"refined by {f:g} twice") for k in kinds)
+        table += (f"\n\nerror estimate per point: {how} (nominal order {first.nominal_order:g})\n"
+                  + format_table(est_head, est_rows, ".4g"))
+        table += "".join(f"\n{', '.join(f'{h} = {v}' for h, v in zip(head, combo, strict=True))}: "
+                         f"{r['error_estimate'].fallback}" for combo, r in zip(combos, results, strict=True)
+                         if r["error_estimate"].fallback)
         results = [{**r, "error_estimate": r["error_estimate"].to_dict()} for r in results]
     data = {"axes": {h: a[2] for h, a in zip(head, axes, strict=True)}, "units": {**units, **sig_units},
             "points": [{"values": dict(zip(head, c, strict=True)), **r} for c, r in zip(combos, results, strict=True)]}

@@ -6,6 +6,11 @@ past its bound into an `AccuracyError` naming the figure, its value, its bound a
 caller allows inaccurate results (`--allow-inaccurate`, `solver.allow_inaccurate = true`), into a warning carried in
 the result's `warnings`, its summary and its JSON. A result is never quietly wrong.
 
+An error estimate above its tolerance (`judge_estimate`) does not discard the result: it is kept and flagged. Without
+`allow_inaccurate` the analysis raises `InaccurateResult` carrying its result (an `AccuracyError`, so a caller that
+catches those still does); the command line prints that result, writes its files and exits with status 3
+(`EXIT_INACCURATE`) instead of 0; with `allow_inaccurate` the result is accepted with the warnings, as above.
+
 Figures every time-domain model can report (names are shared so tables line up across models):
 - `stability_margin`: h * omega_max, the step times the highest natural frequency of the linearised model; explicit
   RK4 is stable below 2.79, Euler below 2, the implicit integrators are stable but inaccurate above ~0.5;
@@ -32,6 +37,37 @@ class AccuracyError(SolverError):
 
 class InaccurateResultWarning(UserWarning):
     """A health figure past its bound, accepted because the caller allowed inaccurate results."""
+
+
+#: the command line's exit status of a result kept and reported although an error estimate exceeds its tolerance
+#: (0: success, 2: any error, 130: interrupted)
+EXIT_INACCURATE = 3
+
+
+class InaccurateResult(AccuracyError):
+    """An error estimate above its tolerance, the caller not allowing inaccurate results: the result is kept, not
+    discarded. `result` is it (a `SimResult`, a `Report`), `messages` the `INACCURATE: ...` lines (`judge_estimate`)
+    it carries in its warnings. The command line prints it, writes its files and exits `EXIT_INACCURATE`."""
+
+    def __init__(self, messages: Iterable[str], result: Any = None):
+        self.messages = list(messages)
+        self.result = result
+        self.shown = False  # set by the command line once it has printed the result
+        n = len(self.messages)
+        first = self.messages[0].removeprefix("INACCURATE: ") if n else "an error estimate exceeds its tolerance"
+        super().__init__(first + (f" (and {n - 1} more)" if n > 1 else "") + "; the result is kept, flagged "
+                         "inaccurate; rerun with --allow-inaccurate (solver.allow_inaccurate = true) to accept it")
+
+    def __reduce__(self):  # across processes: the messages (a result may hold what does not pickle)
+        return (type(self), (self.messages,))
+
+    def report(self) -> Any:
+        """The kept result as a `Report` flagged inaccurate (`Report.flag_inaccurate`)."""
+        from ..results import Report
+
+        rep = self.result if isinstance(self.result, Report) else self.result.report()
+        rep.flag_inaccurate(self.messages)
+        return rep
 
 
 @dataclass(frozen=True)
@@ -93,3 +129,14 @@ def judge(figures: Iterable[Figure], *, allow_inaccurate: bool = False, what: st
     for m in msgs:
         warnings.warn("INACCURATE: " + m, InaccurateResultWarning, stacklevel=2)
     return ["INACCURATE: " + m for m in msgs]
+
+
+def judge_estimate(figures: Iterable[Figure], *, allow_inaccurate: bool = False, what: str = "") -> list[str]:
+    """The `INACCURATE: ...` lines of an error estimate's figures past their tolerance (`ErrorEstimate.figures`),
+    emitted as warnings when the caller allows inaccurate results. It never raises: the caller keeps its result with
+    these lines in its warnings and, unless allowed and if there are any, raises `InaccurateResult` carrying it."""
+    msgs = ["INACCURATE: " + f.message(what) for f in figures if not f.ok]
+    if allow_inaccurate:
+        for m in msgs:
+            warnings.warn(m, InaccurateResultWarning, stacklevel=2)
+    return msgs

@@ -42,7 +42,7 @@ def register(sub, add_common, emit) -> str:
     p.add_argument("--spacings", type=float, nargs="+", default=None,
                    help="distances (m) between consecutive pantographs of a [train] scene (overrides the scene)")
     p.add_argument("--workers", type=int, default=0,
-                   help="local processes for the refined passages of --error-estimate (0 = all cores)")
+                   help="local processes for the companion passages of --error-estimate (0 = all cores)")
     add_error_estimate(p)
     add_scene_options(p)
     add_study_options(p)
@@ -153,16 +153,20 @@ def catenary_of(scene: Scene, args: argparse.Namespace) -> Report:
 
 def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0) -> None:
     """Estimate the error of every pantograph's statistics of the passage `stats` (the scene's own run, leading
-    pantograph first) from the scene refined once and twice (`accuracy.refine`, run in parallel), judge each estimate
-    against its tolerance (`AccuracyError` naming the statistic and the setting to refine, unless the scene allows
-    inaccurate results: then a warning) and add the table, `error_estimate` and the warnings to the report."""
+    pantograph first) from its companions (`accuracy.refinement`: coarsened once and twice, else refined once and
+    twice; run in parallel), judge each estimate against its tolerance and add the table, `error_estimate` and the
+    warnings to the report. An estimate above its tolerance keeps the report: a warning where the scene allows
+    inaccurate results, else `InaccurateResult` carrying the report (the command prints it, writes its files and
+    exits 3)."""
     from ...analysis.errorestimate import error_estimate
-    from ...trust.health import judge
+    from ...trust.health import InaccurateResult, judge_estimate
     from .accuracy import passage_values, stats_values
 
     est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers)
-    warned = judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
-                   what=f"catenary scene {scene.name or scene.source or ''}".strip())
+    warned = judge_estimate(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                            what=f"catenary scene {scene.name or scene.source or ''}".strip())
     rep.data["error_estimate"] = est.to_dict()
     rep.data["warnings"] = list(rep.data.get("warnings", [])) + warned
     rep.table = "\n".join([rep.table, est.table(), *warned])
+    if warned and not scene.solver.allow_inaccurate:
+        raise InaccurateResult(warned, rep)

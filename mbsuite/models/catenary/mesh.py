@@ -34,10 +34,7 @@ def build_nodes(p: CatenaryParams | Line, element_length: float | None = None
     keys = line.key_points()
     pieces = []
     for a, b in zip(keys[:-1], keys[1:], strict=True):
-        # a whole number of elements stays one under a relative change < 1e-6: the interval between two key points
-        # 600 m out moves by 1e-7 of itself under the stability check's draws of 1e-10
-        r = (b - a) / element_length
-        n = max(1, math.ceil(r - 1e-6 * max(1.0, r)))
+        n = elements_between(a, b, element_length)
         pieces.append(a + (b - a) * np.arange(n) / n)
     pieces.append(keys[-1:])
     x = np.concatenate(pieces)
@@ -45,6 +42,27 @@ def build_nodes(p: CatenaryParams | Line, element_length: float | None = None
     supports = np.array([at(s.x) for s in line.supports], dtype=int)
     droppers = np.array([at(d.x) for d in line.droppers], dtype=int)
     return x, supports, droppers
+
+
+def elements_between(a: float, b: float, element_length: float) -> int:
+    """How many equal elements the interval [a, b] between two key points gets: ceil((b - a) / element_length), at
+    least 1; a whole number of elements stays one under a relative change < 1e-6 (the interval between two key points
+    600 m out moves by 1e-7 of itself under the stability check's draws of 1e-10)."""
+    r = (b - a) / element_length
+    return max(1, math.ceil(r - 1e-6 * max(1.0, r)))
+
+
+def coarsening_misfit(line: Line, element_length: float, factor: int) -> tuple[float, float, int] | None:
+    """Where a mesh `factor` times coarser does not nest in the mesh of `element_length` on `line`: the first
+    interval (a, b) between key points whose elements at `element_length` are not `factor` times those at
+    `factor * element_length`, with its element count at `element_length`; None where every interval nests (each
+    coarse element is exactly `factor` elements of the finer mesh)."""
+    keys = line.key_points()
+    for a, b in zip(keys[:-1], keys[1:], strict=True):
+        n = elements_between(a, b, element_length)
+        if elements_between(a, b, factor * element_length) * factor != n:
+            return float(a), float(b), n
+    return None
 
 
 def node_index(x: np.ndarray) -> Callable[[float], int]:

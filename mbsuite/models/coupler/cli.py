@@ -15,6 +15,7 @@ from ...errors import ParameterError, SceneError
 from ...limits import Limit, limit_of
 from ...results import Report, format_table
 from ...scenes import Scene
+from ...trust.health import InaccurateResult
 from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
 
@@ -187,15 +188,24 @@ def _dynamics_scene(args: argparse.Namespace) -> Scene:
 
 def dynamics_of(scene: Scene, args: argparse.Namespace) -> Report:
     """The double-coupler run of `scene` with its statistics and health (the command's, or a study point's)."""
-    # health figures judged, the error estimate's among them (AccuracyError past a bound unless allowed)
-    res = mbsuite_run(scene, error_estimate=bool(getattr(args, "error_estimate", False)))
+    # health figures judged (AccuracyError past a bound unless allowed); an error estimate above its tolerance keeps
+    # the result, flagged (InaccurateResult carrying the report: the command prints it and exits 3)
+    inaccurate = None
+    try:
+        res = mbsuite_run(scene, error_estimate=bool(getattr(args, "error_estimate", False)))
+    except InaccurateResult as exc:
+        res, inaccurate = exc.result, exc.messages
     inputs = dict(scene.input.items())  # resolved: declared defaults filled in by the scene loader
     table = dynamics_table(inputs, res)
     if res.error_estimate is not None:
         table += "\n" + res.error_estimate.table()
-    return Report({"input": inputs, "scene": scene.to_dict(), "statistics": res.statistics, "stats": res.stats,
-                   "summary": res.summary()}, table,
-                  partial(write_dynamics, res))
+    if inaccurate:
+        table += "".join(f"\n{w}" for w in inaccurate)
+    rep = Report({"input": inputs, "scene": scene.to_dict(), "statistics": res.statistics, "stats": res.stats,
+                  "summary": res.summary()}, table, partial(write_dynamics, res))
+    if inaccurate:
+        raise InaccurateResult(inaccurate, rep)
+    return rep
 
 
 def cmd_dynamics(args: argparse.Namespace, emit) -> None:

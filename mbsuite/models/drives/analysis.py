@@ -14,7 +14,7 @@ from ...components.rotational.interfaces import RefResult, RotorSystem
 from ...errors import SceneError
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
-from ...trust.health import judge
+from ...trust.health import InaccurateResult, judge_estimate
 from . import design as D
 from . import drive, mujoco, reference
 
@@ -124,8 +124,9 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
 
     `error_estimate`: every point also runs refined once and twice (`mbsuite.trust.estimate`; all points' copies in one
     parallel batch) and its efficiency-curve headlines (`EFFICIENCY_HEADLINES`) get an estimated error: a table per
-    point and `data["points"][i]["error_estimate"]`; an estimate past its tolerance is an `AccuracyError` naming the
-    point (a warning in `data["warnings"]` when the scene allows inaccurate results)."""
+    point and `data["points"][i]["error_estimate"]`; an estimate past its tolerance keeps the report with a warning
+    naming the point in `data["warnings"]` and, unless the scene allows inaccurate results, raises `InaccurateResult`
+    carrying it (the command line prints it, writes its files and exits 3)."""
     if scene.effects.get("closed_loop"):
         raise SceneError("efficiency curves are open-loop runs: use a scene with closed_loop = false")
     pts, scenes, bases = [], [], []
@@ -170,13 +171,16 @@ def efficiency(scene: Scene, loads: list[float], engine: str | None = None, *, e
 
     data: dict[str, Any] = {"scene": scene.name, "points": pts}
     warned = []
-    for p, est in zip(pts if error_estimate else [], ests, strict=True):  # past its tolerance: AccuracyError
-        warned += judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
-                        what=f"drives efficiency {scene.name} at tau_l = {p['tau_l']:g} N m")
+    for p, est in zip(pts if error_estimate else [], ests, strict=True):  # past its tolerance: kept, flagged
+        warned += judge_estimate(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                                 what=f"drives efficiency {scene.name} at tau_l = {p['tau_l']:g} N m")
     if warned:
         data["warnings"] = warned
         table += "\n\n" + "\n".join(warned)
-    return Report(data, table, write)
+    rep = Report(data, table, write)
+    if warned and not scene.solver.allow_inaccurate:
+        raise InaccurateResult(warned, rep)
+    return rep
 
 
 def _tidy(v: float, scale: float) -> float:

@@ -17,7 +17,7 @@ from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import scene_from_dict
-from ...trust.health import judge
+from ...trust.health import InaccurateResult, judge, judge_estimate
 from . import accuracy
 from . import design as D
 from .analysis import design_tables, efficiency, simulate_scene
@@ -372,11 +372,15 @@ def run_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive run` on scene `sc` (the command's, or a study point's): health figures judged as by
     `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
     res = sim_result(sc, *simulate_scene(sc))
-    if a.error_estimate:
+    what = f"drives scene {sc.name or sc.source or ''}".strip()
+    res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate, what=what))
+    inaccurate = []
+    if a.error_estimate:  # an estimate above its tolerance keeps the report, flagged (exit 3) unless allowed
         res.error_estimate = error_estimate(sc, base=accuracy.values(sc, res))
         res.health.extend(res.error_estimate.figures())
-    res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate,
-                              what=f"drives scene {sc.name or sc.source or ''}".strip()))
+        inaccurate = judge_estimate(res.error_estimate.figures(), allow_inaccurate=sc.solver.allow_inaccurate,
+                                    what=what)
+        res.warnings.extend(inaccurate)
     eb = res.stats["energy_balance"]
     cyc = res.statistics
     rows = [["engine", "path that ran", res.engine, ""], ["duration", "simulated time", float(res.t[-1]), "s"],
@@ -394,8 +398,11 @@ def run_of(sc, a: argparse.Namespace) -> Report:
     if res.warnings:
         table += "\n\n" + "\n".join(res.warnings)
     summary = {k: v for k, v in res.summary().items() if k not in ("stats", "statistics", "input", "solver")}  # once
-    return Report({"options": _options(a), "summary": summary, "statistics": res.statistics, "stats": res.stats},
-                  table, partial(_write_run, res))
+    rep = Report({"options": _options(a), "summary": summary, "statistics": res.statistics, "stats": res.stats},
+                 table, partial(_write_run, res))
+    if inaccurate and not sc.solver.allow_inaccurate:
+        raise InaccurateResult(inaccurate, rep)
+    return rep
 
 
 def _write_run(res, out: Path) -> list[Path]:
@@ -413,7 +420,11 @@ def efficiency_cmd(emit, a: argparse.Namespace) -> None:
 def efficiency_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive efficiency` on scene `sc` (`analysis.efficiency`)."""
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
-    rep = efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate)
+    try:
+        rep = efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate)
+    except InaccurateResult as exc:  # kept, flagged: the command prints it and exits 3
+        exc.result.data = {"options": _options(a), **exc.result.data}
+        raise
     rep.data = {"options": _options(a), **rep.data}
     return rep
 

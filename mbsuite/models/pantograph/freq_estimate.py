@@ -14,7 +14,7 @@ import numpy as np
 from ...errors import SceneError
 from ...scenes import Scene, scene_from_dict
 from ...trust.estimate import ErrorEstimate, Headline
-from ...trust.health import judge
+from ...trust.health import judge_estimate
 from .freq_grid import FR_SIGNALS, PEAK_SIGNALS, TIME_METHODS, check_grid
 from .freq_peaks import Peak
 from .freq_sweeps import method_curves
@@ -159,8 +159,9 @@ def estimate_method(scene: Scene, method: str, grid: tuple[float, float, float],
                     curves: dict[str, dict[str, np.ndarray]], pks: dict[str, dict[str, list[Peak]]], *,
                     workers: int = 0) -> tuple[ErrorEstimate, list[str]]:
     """The error estimate of one time method's frequency response (the scene's own curves and peaks are level 0;
-    the scene refined once and twice runs in parallel) and the warnings of the estimates past their tolerances (an
-    `AccuracyError` instead unless the scene allows inaccurate results)."""
+    the scene refined once and twice runs in parallel) and the `INACCURATE:` lines of the estimates past their
+    tolerances (`trust.health.judge_estimate`; the caller keeps its report and flags it unless the scene allows
+    inaccurate results)."""
     from ...analysis.errorestimate import error_estimate
 
     names = _curve_names(scene, method)
@@ -176,7 +177,7 @@ def estimate_method(scene: Scene, method: str, grid: tuple[float, float, float],
     # a scene's [accuracy] names the time run's headlines: these tolerances are FR_TOL's
     figs = [replace(f, fix=f.fix.split(" (or set accuracy.")[0] + " (the frequency response's tolerances are "
                     "mbsuite.models.pantograph.freqresp.FR_TOL)") for f in est.figures()]
-    warned = judge(figs, allow_inaccurate=scene.solver.allow_inaccurate,
+    warned = judge_estimate(figs, allow_inaccurate=scene.solver.allow_inaccurate,
                    what=f"pantograph frequency response ({method}) of {scene.name or scene.source or 'the scene'}")
     return est, warned
 
@@ -206,8 +207,7 @@ def estimate_summary(est: ErrorEstimate, method: str) -> str:
              "not declared" if r.tol is None else ("ok" if r.ok else "EXCEEDED")] for r in show]
     free = (f" ({n_free} not declared: contact lost at the scene's settings, the estimate reported, not judged)"
             if n_free else "")
-    head = (f"error estimate of the {method} frequency response: {est.setting} refined by {est.factor:g} twice "
-            f"(nominal order {est.nominal_order:g}; levels: {'; '.join(est.settings)}); {len(est.rows)} headlines, "
+    head = (f"error estimate of the {method} frequency response: {est.describe()}; {len(est.rows)} headlines, "
             f"{len(est.rows) - n_bad - n_free} of {len(est.rows) - n_free} declared within tolerance{free}. Shown: "
             "the peaks and, per curve, signal and quantity, the grid point nearest its tolerance")
     return head + "\n" + fmt(["headline", "unit", "value", "est. error", "tol", "observed order", ""], rows, ".4g")

@@ -31,6 +31,7 @@ from ...analysis.sweep import SweepOptions
 from ...results import Report, SimResult, format_table, write_csv
 from ...scenes import Scene
 from ...trust.estimate import ErrorEstimate
+from ...trust.health import InaccurateResult
 from .freq_estimate import (
     FR_TOL,
     SECTION_KEYS,
@@ -91,8 +92,9 @@ def freqresp(scene: Scene, f_min: float | None = None, f_max: float | None = Non
     of them is written). Arguments left None take `DEFAULTS` (the command line's defaults too). `options`
     (`SweepOptions`): where and how the sweeps run (executor, store, size guard). `error_estimate`: every time method
     also runs refined copies and each headline (amplitude and phase of F1, HD at every grid frequency, every peak
-    frequency) gets its estimated error; an estimate above its tolerance is an `AccuracyError` unless the scene
-    allows inaccurate results (then a warning in the report)."""
+    frequency) gets its estimated error; an estimate above its tolerance keeps the report, with a warning in it, and
+    unless the scene allows inaccurate results raises `InaccurateResult` carrying it (the command line prints it,
+    writes its files and exits 3)."""
     f_min, f_max, df, peak_tol = (DEFAULTS[k] if v is None else float(v) for k, v in
                                   (("f_min", f_min), ("f_max", f_max), ("df", df), ("peak_tol", peak_tol)))
     freqs, methods = check_grid(f_min, f_max, df, peak_tol, DEFAULTS["methods"] if methods is None else methods)
@@ -109,7 +111,11 @@ def freqresp(scene: Scene, f_min: float | None = None, f_max: float | None = Non
     if error_estimate:
         estimates = _estimates(scene, methods, (f_min, f_max, df), peak_tol, curves, pks, data, lines, workers)
     histories = time_history_runs(scene) if time_histories else None  # the thesis' Figs 5-1..5-6 for the writer
-    return Report(data, "\n".join(lines), _writer(freqs, curves, pks, estimates, histories))
+    rep = Report(data, "\n".join(lines), _writer(freqs, curves, pks, estimates, histories))
+    warned = [w for w in data.get("warnings", []) if w.startswith("INACCURATE: ")]
+    if warned and not scene.solver.allow_inaccurate:
+        raise InaccurateResult(warned, rep)
+    return rep
 
 
 def _curves(scene: Scene, freqs: np.ndarray, methods: tuple[str, ...], peak_tol: float,

@@ -13,7 +13,7 @@ row: head_displacement, theta_1, theta_2, theta_h (`EppingerReference.signals`).
 from __future__ import annotations
 
 import ctypes
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
@@ -21,8 +21,9 @@ from ...engines import native
 from ...engines.native.oneport import Port
 from ...errors import SceneError
 
-if TYPE_CHECKING:
-    from .under_wire import EppingerReference
+#: an `under_wire.EppingerReference` (its params, cfg, ode and state x; not imported: it imports this module)
+Reference = Any
+
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int
@@ -84,7 +85,7 @@ class OdePort:
     """The C one-port of `ref` (an `EppingerReference`): its parameters, effects and committed state `ref.x` copied
     into the C state. `port` is the filled `oneport.Port` (its `self` points into this object, kept alive by it)."""
 
-    def __init__(self, ref: EppingerReference):
+    def __init__(self, ref: Reference):
         ode = ref.ode
         p = ode.p
         cfg = ode.cfg
@@ -114,7 +115,7 @@ class OdePort:
         self.lib.mbs_panto_ode_port(ctypes.byref(self.port), ctypes.byref(s))
         self.push(ref)
 
-    def push(self, ref: EppingerReference) -> None:
+    def push(self, ref: Reference) -> None:
         """Take `ref.x` as the committed state (e.g. after `ref.static`)."""
         x = np.asarray(ref.x, dtype=float)
         if x.shape != (self.n,):
@@ -126,12 +127,12 @@ class OdePort:
         """The committed state x (a copy)."""
         return np.array(self._s.x[: self.n])
 
-    def pull(self, ref: EppingerReference) -> None:
+    def pull(self, ref: Reference) -> None:
         """Write the committed state back into `ref.x`."""
         ref.x = self.state()
 
     def signals(self, rows: np.ndarray) -> dict[str, np.ndarray]:
-        """The signals of recorded output rows (shape (n, 4)), keyed like `EppingerReference.signals`."""
+        """The signals of recorded output rows (shape (n, 4)), keyed like `Reference.signals`."""
         rows = np.asarray(rows, dtype=float).reshape(-1, len(OUTPUTS))
         return {name: rows[:, i].copy() for i, name in enumerate(OUTPUTS)}
 

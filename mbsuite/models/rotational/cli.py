@@ -17,7 +17,7 @@ from ...limits import Limit
 from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene
-from ...trust.health import judge
+from ...trust.health import judge_estimate
 from . import coupled_clutches as cc
 from .analysis import coupled_clutches_table
 from .plots import coupled_clutches_figure
@@ -85,13 +85,15 @@ def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
     scene = _solver_options(load_scene("rotational/coupled_clutches"), a)
     d = coupled_clutches_table(timestep=a.timestep, error_estimate=a.error_estimate, scene=scene)
     estimates = ""
-    for eng in ("reference", "mujoco"):  # each path's estimate against its tolerances (AccuracyError naming it)
+    inaccurate = []
+    for eng in ("reference", "mujoco"):  # each path's estimate against its tolerances (kept, flagged: exit 3)
         est = d[eng].pop("error_estimate", None)
         if est is None:
             continue
         d[eng]["error_estimate"] = est.to_dict()
-        warned = judge(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
-                       what=f"rotational coupled-clutches, path {eng}")
+        warned = judge_estimate(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
+                                what=f"rotational coupled-clutches, path {eng}")
+        inaccurate += warned
         estimates += f"\n\n{eng} path: " + est.table() + "".join("\n" + w for w in warned)
     mode = {v: k for k, v in cc.MODE_CODE.items()}
     rows = []
@@ -118,7 +120,10 @@ def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
     ref = cc.load_reference()
     write = partial(_write_coupled_clutches, d, ref["t"], ref["w"], ev_cols, w_cols)
     text = "clutch mode changes:\n" + t1 + "\n\nspeeds every 0.1 s:\n" + t2 + estimates
-    emit(Report({"options": _options(a), **d}, text, write), a, scene.to_dict())
+    rep = Report({"options": _options(a), **d, **({"warnings": inaccurate} if inaccurate else {})}, text, write)
+    if inaccurate and not scene.solver.allow_inaccurate:
+        rep.flag_inaccurate(inaccurate)
+    emit(rep, a, scene.to_dict())
 
 
 def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,

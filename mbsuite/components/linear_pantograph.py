@@ -465,4 +465,5 @@ class LinearNativePort:
         return {k: rows[:, i].copy() for i, k in enumerate(self.panto.names)}
 
     def failure(self, code: int) -> str:
+        """The words of a failed trial (code `code` of the C step)."""
         return f"the {self.panto.name} pantograph's state became non-finite"

@@ -141,8 +141,8 @@ int mbs_run(const mjModel* m, mjData* d, mbs_job* job);
 int mbs_job_size(void);
 
 /* ------------------------------------------------------------------------------------------------ one-ports */
-/* A mechanical one-port stepped by a host that owns the force through it (the FE catenary stepping a pantograph in
- * its compiled loop). Over one host step of length dt the port force f (N; f >= 0 presses the port down) varies
+/* A mechanical one-port stepped by a host that owns the force through it (a compiled loop of a model that couples a
+ * body to it through one contact). Over one host step of length dt the port force f (N; f >= 0 presses the port down) varies
  * linearly f0 -> f1, and the port answers its displacement y (m, the host's datum) at the step's end. Per step the
  * host calls `trial` any number of times, each from the committed state, then `commit`, which accepts the last
  * trial. An affine port (y exactly affine in f1) also gives its map y = P - g f1, so the host needs no iteration.

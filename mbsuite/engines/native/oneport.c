@@ -1,7 +1,6 @@
-/* One-ports (mbsuite.h): the struct's size for the Python mirror, and the MuJoCo one-port, a MuJoCo model driven by
- * one force actuator stepped by a host that owns the force (the FE catenary's compiled loop stepping the Eppinger
- * pantograph's MuJoCo model). The twin of `EppingerMujoco.trial / commit` in Python (mbsuite.models.pantograph
- * .under_wire), call for call: mj_setState, ctrl, the core's one checked step (mbs_run), mj_kinematics, mj_getState. */
+/* One-ports (mbsuite.h): the struct's size for the Python mirror; the MuJoCo one-port, a MuJoCo model driven by one
+ * force actuator stepped by a host that owns the force, call for call what a Python adapter does with the same model:
+ * mj_setState, ctrl, the core's one checked step (mbs_run), mj_kinematics, mj_getState; the linear one-port. */
 #include <math.h>
 
 #include "mbsuite.h"
@@ -73,7 +72,8 @@ void mbs_mj_port_init(mbs_port* port, mbs_mj_port* s) {
 }
 
 /* ------------------------------------------------------------------------------------------ the linear one-port */
-/* The twin of `components.linear_pantograph.LinearPantograph.affine_map / trial / commit` (sums in index order). */
+/* A linear model's trapezoidal step as written by its Python twin: x = Phi x + G0 - Gf (f0 + f1) (sums in index
+ * order). */
 static double dot(const double* a, const double* b, int n) {
   double s = 0.0;
   for (int i = 0; i < n; i++) s += a[i] * b[i];

@@ -1,5 +1,5 @@
 """One-ports in C (`mbsuite.h`, `oneport.c`): the ctypes mirror of `mbs_port`, the protocol by which a compiled host
-loop (the FE catenary's) steps a body that it couples through one force, and the MuJoCo one-port (`MujocoPort`), a
+loop (a model's) steps a body that it couples through one force, and the MuJoCo one-port (`MujocoPort`), a
 MuJoCo model driven by one force actuator.
 
 A Python object that a compiled host can step offers `port(dt) -> Port` (a filled `mbs_port`, kept alive by the

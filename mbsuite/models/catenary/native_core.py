@@ -361,4 +361,5 @@ class TwoMassPort:
         return {k: rows[:, i].copy() for i, k in enumerate(self.names)}
 
     def failure(self, code: int) -> str:
+        """The words of a failed trial (code `code` of the C step)."""
         return f"the 2-mass pantograph's step failed (code {code})"

@@ -8,7 +8,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
 import platform
 import sys
 from collections.abc import Mapping, Sequence
@@ -149,7 +148,12 @@ class SimResult:
             kinds: dict[str, int] = {}
             for e in self.events:
                 kinds[e.get("kind", "event")] = kinds.get(e.get("kind", "event"), 0) + 1
-            table += "\nevents: " + ", ".join(f"{k} x{n}" for k, n in sorted(kinds.items()))
+            table += (f"\nrecorded events (one per element and change): {len(self.events)}" if
+                      set(kinds) == {"event"} else "\nrecorded events: " + ", ".join(
+                          f"{k} x{n}" for k, n in sorted(kinds.items())))
+            if isinstance(self.stats.get("events"), int | np.integer):  # the engine's own count differs in kind
+                table += (f"; the engine's events = {self.stats['events']} below counts the instants its event "
+                          "location stopped at (one instant may change several elements)")
         if self.statistics:
             table += "\n" + textwrap.fill("statistics: " + ", ".join(
                 f"{k} = {_plain(v)}" + (f" {self.statistic_units[k]}" if self.statistic_units.get(k, "-") != "-"
@@ -333,37 +337,6 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence[Any]], floatfmt
     lines.append("  ".join("-" * w for w in widths))
     lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in body]
     return "\n".join(lines)
-
-
-class Progress:
-    """A progress bar on stderr (tqdm): shown when stderr is a terminal, when `MBSUITE_PROGRESS=1`, or with
-    `enabled=True`; on a non-terminal it prints a line at most every 5 s instead of redrawing."""
-
-    def __init__(self, total: int, desc: str = "", enabled: bool | None = None):
-        from tqdm import tqdm
-
-        tty = sys.stderr.isatty()
-        if enabled is None:
-            enabled = tty or os.environ.get("MBSUITE_PROGRESS", "") not in ("", "0")
-        self.enabled = bool(enabled)
-        self.total = max(int(total), 1)
-        self._bar = tqdm(total=self.total, desc=desc, disable=not self.enabled, file=sys.stderr, ncols=100,
-                         mininterval=0.2 if tty else 5.0, leave=True)
-
-    @property
-    def n(self) -> int:
-        """How many units are done."""
-        return int(self._bar.n)
-
-    def update(self, k: int = 1) -> None:
-        """Advance by `k` units."""
-        self._bar.update(k)
-
-    def __enter__(self) -> Progress:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._bar.close()
 
 
 @dataclass

@@ -39,8 +39,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..engines.core import n_workers
 from ..errors import MbsuiteError
 from ..limits import Limit, real
+from ..progress import planned
 from .designspace import Factor, evaluate, factors_for, headline_units, point_scene, scene_evaluator
 
 if TYPE_CHECKING:
@@ -339,8 +341,6 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
     `maxiter`: generations. `objective` None: the model's declared one (`SPEC.studies.objective`).
     `start`: a design evaluated first and reported beside the optimum (default: the scene's own values of the
     factors, when they lie in the ranges)."""
-    from scipy.optimize import differential_evolution
-
     from ..scenes import Scene
 
     scene = target if isinstance(target, Scene) else None
@@ -364,6 +364,39 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
             point_scene(scene, ctx, origin="at an operating point of the study")
     prob = _Problem(fn, scene, facs, objective, cons, ctxs, aggregate, float(penalty), workers, options, progress)
     x0 = _start(scene, facs, start)
+    with planned(*plan(len(facs), len(ctxs), maxiter, popsize, x0 is not None, workers), upto=True,
+                 cheaper=cheaper(len(facs), len(ctxs), popsize, x0 is not None)):
+        return _minimise(prob, facs, cons, ctxs, objective, aggregate, maxiter, popsize, seed, tol, penalty, x0,
+                         scene, fn, units)
+
+
+def plan(n_factors: int, n_contexts: int, maxiter: int, popsize: int, start: bool, workers: int, levels: int = 1
+         ) -> tuple[str, int, int]:
+    """(what, runs at most, in parallel) of an optimisation (`levels` of them: a Pareto front), for
+    `mbsuite.progress.planned`: scipy's population max(5, popsize x factors), maxiter + 1 generations, each design
+    at every operating point, plus the start design."""
+    npop = max(5, popsize * n_factors)
+    runs = levels * ((maxiter + 1) * npop + int(start)) * n_contexts
+    return ("optimise" if levels == 1 else f"pareto front ({levels} optimisations)"), runs, min(
+        n_workers(workers), npop * n_contexts)
+
+
+def cheaper(n_factors: int, n_contexts: int, popsize: int, start: bool, levels: int = 1) -> Callable[[int], str | None]:
+    """The `--maxiter` of an optimisation that fits in a number of runs (None if not even one generation fits)."""
+    def fit(runs: int) -> str | None:
+        npop = max(5, popsize * n_factors)
+        k = runs // (levels * n_contexts) - int(start)
+        return f"--maxiter {k // npop - 1}" if k // npop - 1 >= 1 else None
+
+    return fit
+
+
+def _minimise(prob: _Problem, facs: list[Factor], cons: list[Bound], ctxs: list[dict[str, Any]], objective: str,
+              aggregate: str, maxiter: int, popsize: int, seed: int, tol: float, penalty: float,
+              x0: np.ndarray | None, scene: Scene | None, fn: Callable, units: dict[str, str]) -> OptimiseResult:
+    """Differential evolution on `prob` (`run`)."""
+    from scipy.optimize import differential_evolution
+
     start_rec = None
     if x0 is not None:
         agg, viol, outs = prob.evaluate([x0])[0]
@@ -642,13 +675,18 @@ def pareto(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factor
     scene = target if isinstance(target, Scene) else None
     objective, against = _default(scene, "objective", objective), _default(scene, "against", against)
     base = [parse_bound(c) if isinstance(c, str) else c for c in kwargs.pop("constraints", ())]
-    runs = [run(target, factors, objective=objective, constraints=[*base, Bound(against, lo=x)], **kwargs)
-            for x in lv]
+    nf, nc = len(factors), len(contexts_of(kwargs.get("over")))
+    start = kwargs.get("start") is not None or scene is not None
+    popsize, workers = kwargs.get("popsize", 5), kwargs.get("workers", 0)
+    with planned(*plan(nf, nc, kwargs.get("maxiter", 20), popsize, start, workers, len(lv)), upto=True,
+                 cheaper=cheaper(nf, nc, popsize, start, len(lv))):
+        runs = [run(target, factors, objective=objective, constraints=[*base, Bound(against, lo=x)], **kwargs)
+                for x in lv]
     # a design is on the front if it meets the run's own constraints; the level it was searched under does not count
     cand = candidates(_evaluations(runs), runs[0].contexts, objective, against, runs[0].aggregate)
     return ParetoResult(objective, against, lv, runs, non_dominated(cand, objective, against), runs[0].units,
                         scene.name if scene is not None else runs[0].target)
 
 
-__all__ = ["AGGREGATES", "Bound", "OptimiseResult", "ParetoResult", "band", "candidates", "contexts_of",
-           "judge_rerun", "non_dominated", "parse_bound", "pareto", "rerun", "run"]
+__all__ = ["AGGREGATES", "Bound", "OptimiseResult", "ParetoResult", "band", "candidates", "cheaper", "contexts_of",
+           "judge_rerun", "non_dominated", "parse_bound", "pareto", "plan", "rerun", "run"]

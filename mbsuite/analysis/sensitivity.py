@@ -26,8 +26,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..engines.core import n_workers
 from ..errors import MbsuiteError
 from ..limits import Limit
+from ..progress import planned
 from .designspace import Factor, evaluate, factors_for, headline_units, output_names, scene_evaluator
 
 if TYPE_CHECKING:
@@ -260,8 +262,18 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
         raise MbsuiteError(f"sensitivity target {target!r} is neither a scene nor a function")
     x = sample(method, facs, n, seed, levels)
     points = [dict(zip([f.label for f in facs], map(float, row), strict=True)) for row in x]
-    results = evaluate(fn, points, scene=scene, workers=workers, options=options, progress=progress,
-                       desc=f"{method} sensitivity")
+    per = len(facs) + (1 if method == "morris" else 2)  # runs per trajectory / base sample
+
+    def fit(runs: int) -> str | None:
+        k = runs // per
+        if method == "sobol":
+            k = 2 ** int(math.log2(k)) if k >= 1 else 0
+        return f"--n {k}" if 1 <= k < n else None
+
+    with planned(f"{method} sensitivity", len(points), min(n_workers(workers), len(points)),
+                 detail=f"n = {n} x {per}", cheaper=fit):
+        results = evaluate(fn, points, scene=scene, workers=workers, options=options, progress=progress,
+                           desc=f"{method} sensitivity")
     names = output_names(results, outputs, "sensitivity")
     indices = {}
     for o in names:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MbsuiteError
+from ..progress import planned
 from ..results import Report, format_table, write_csv
 from ..scenes import Scene
 
@@ -187,19 +188,25 @@ def workprecision(scene: Scene, repeats: int = 5, quick: bool = False, progress:
                   ) -> Report:
     """Run the scene's study (module docstring) and return a Report (table, data, CSV/JSON/PNG writer)."""
     study = study_for(scene, quick)
-    ref, ref_info = study.reference()
+    settings = study.settings()
     rows: list[Row] = []
-    for s in study.settings():
-        row = Row(s.engine, s.method, s.setting)
-        try:
-            res, row.time_s, row.time_min, row.time_max = timed(s.run, repeats)
-            row.state_error = study.state_error(res, ref)
-            row.physics_error, row.details = study.physics_error(res, ref)
-        except MbsuiteError as exc:  # a diverging setting is a data point, not a crash
-            row.error = str(exc)
-        rows.append(row)
-        if progress:
-            progress(f"{row.engine} {row.method} {row.setting}: {row.time_s:.3g} s, physics {row.physics_error:.2e}")
+    ref, ref_info = study.reference()
+    with planned("work-precision", len(settings) * repeats, 1,
+                 detail=f"{len(settings)} settings x {repeats} timed repeats, after the reference run") as plan:
+        for s in settings:
+            row = Row(s.engine, s.method, s.setting)
+            try:
+                res, row.time_s, row.time_min, row.time_max = timed(s.run, repeats)
+                row.state_error = study.state_error(res, ref)
+                row.physics_error, row.details = study.physics_error(res, ref)
+            except MbsuiteError as exc:  # a diverging setting is a data point, not a crash
+                row.error = str(exc)
+            rows.append(row)
+            if plan is not None:
+                plan.update(repeats)
+            if progress:
+                progress(f"{row.engine} {row.method} {row.setting}: {row.time_s:.3g} s, physics "
+                         f"{row.physics_error:.2e}")
     best = cheapest(rows)
     data = {"scene": scene.name or scene.model, "model": scene.model, "repeats": repeats, "quick": quick,
             "state_error": study.state_doc, "physics_error": study.physics_doc, **ref_info,

@@ -25,10 +25,11 @@ import os
 import sys
 from collections.abc import Sequence
 
+from .. import progress
 from ..errors import MbsuiteError
 from ..trust.health import InaccurateResult
 from .options import overrides
-from .output import check_out, fail, inaccurate, quiet_stdout
+from .output import check_out, fail, inaccurate, one_line_warnings, quiet_stdout
 from .parser import UsageError, build_parser, parser_for
 
 __all__ = ["build_parser", "main"]
@@ -52,7 +53,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         check_out(getattr(args, "out", None))
         overrides(args)  # the one rule over every flag that changes the scene, before anything loads or runs
-        args.func(args)
+        with one_line_warnings(), progress.study(
+                " ".join(argv[:1]) or "mbsuite", quiet=bool(getattr(args, "quiet", False)), budget=_budget(args),
+                confirmed=bool(getattr(args, "yes", False)), out=getattr(args, "out", None),
+                store=getattr(args, "store", None)):
+            args.func(args)
     except InaccurateResult as exc:
         if not getattr(exc, "shown", False):  # not raised by `emit` after printing the result: nothing was shown
             return fail(str(exc), as_json, type(exc).__name__)
@@ -60,8 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MbsuiteError as exc:
         return fail(str(exc), as_json, type(exc).__name__)
     except KeyboardInterrupt:
-        store = getattr(args, "store", None)
-        saved = f"finished points are kept in {store} (rerun the command to resume)" if store else "nothing was saved"
+        st = progress.last_study()
+        saved = st.keep_partial() if st is not None else "nothing was saved"
         print(f"mbsuite: interrupted; {saved}", file=sys.stderr)
         return 130
     except BrokenPipeError:
@@ -83,3 +88,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         quiet_stdout()
     return 0
+
+
+def _budget(args: object) -> float | None:
+    """The command's budget (s): `--budget`, else `progress.BUDGET` where the command takes one; None otherwise."""
+    if not hasattr(args, "yes"):
+        return None
+    from ..limits import Limit
+
+    b = getattr(args, "budget", None)
+    return progress.BUDGET if b is None else Limit(lo=0, lo_open=True, unit="s", doc="wall time of a study").check(
+        "--budget", b, MbsuiteError)

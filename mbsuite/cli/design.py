@@ -27,6 +27,8 @@ def cmd_sensitivity(args: argparse.Namespace) -> None:
     from ..analysis import sensitivity
 
     scene = apply_sets(load(args), args.set_values)
+    if args.speed is not None:  # one speed, as optimise's single --speed (composed with --set by the one rule)
+        scene = apply_sets(scene, [f"input.speed={args.speed!r}"])
     check_workers(args.workers)
     outputs = [x.strip() for x in args.outputs.split(",") if x.strip()] if args.outputs else None
     res = sensitivity.run(scene, args.vary or [], method=args.method, n=args.n, seed=args.seed, outputs=outputs,

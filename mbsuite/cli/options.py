@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ..analysis.sweep.options import EXECUTORS, MAX_POINTS
 from ..errors import MbsuiteError
 from ..overrides import SCENE_SECTIONS, Override, compose, parse_override, section_of  # noqa: F401 (the rule's names)
+from ..progress import BUDGET
 
 if TYPE_CHECKING:
     from ..analysis.sweep import SweepOptions
@@ -90,6 +91,18 @@ def add_error_estimate(p: argparse.ArgumentParser) -> None:
                         "per headline output the estimated error, the observed order and the declared tolerance; an "
                         "estimate above its tolerance keeps the result, flagged inaccurate, with exit status 3 (0 "
                         "with --allow-inaccurate)")
+    add_progress_options(p)
+
+
+def add_progress_options(p: argparse.ArgumentParser) -> None:
+    """`--yes` and `--budget`: the cost check of a command that may run many simulations (`mbsuite.progress`);
+    `--quiet` comes with every command (`output.add_common`)."""
+    if "--yes" in p._option_string_actions:
+        return
+    p.add_argument("--budget", type=float, metavar="SECONDS",
+                   help=f"wall time a study may take without asking: above it (estimated from the first finished "
+                        f"run) it stops, naming --yes and a cheaper setting (default {BUDGET:g} s)")
+    p.add_argument("--yes", action="store_true", help="run a study whose estimated time exceeds --budget")
 
 
 def load(args: argparse.Namespace) -> Scene:

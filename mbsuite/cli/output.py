@@ -8,8 +8,11 @@ import json
 import os
 import sys
 import textwrap
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..errors import MbsuiteError
 
@@ -18,9 +21,11 @@ if TYPE_CHECKING:
 
 
 def add_common(p: argparse.ArgumentParser) -> None:
-    """`--json` and `--out DIR`, which every command that reports takes."""
+    """`--json`, `--out DIR` and `--quiet`, which every command that reports takes."""
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.add_argument("--out", metavar="DIR", help="write CSV/PNG/summary.json into DIR")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress: neither the plan of a long study, its time estimate nor the bar (stderr)")
 
 
 def emit(report: Report, args: argparse.Namespace, scene_dict: dict | None) -> None:
@@ -100,3 +105,24 @@ def quiet_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
     except (OSError, ValueError):
         pass
+
+
+@contextmanager
+def one_line_warnings() -> Iterator[None]:
+    """Warnings as one line each on stderr, `mbsuite: <Category>: <message>`, without the package's source line, and
+    each text once per command."""
+    seen: set[str] = set()
+    before = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
+             line: str | None = None) -> None:
+        text = f"mbsuite: {category.__name__}: {' '.join(str(message).split())}"
+        if text not in seen:
+            seen.add(text)
+            print(text, file=sys.stderr, flush=True)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = before

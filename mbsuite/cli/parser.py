@@ -14,7 +14,7 @@ import importlib
 from collections.abc import Callable
 from pathlib import Path
 
-from .options import SCENE_HELP, add_error_estimate, add_scene_options, add_sweep_options
+from .options import SCENE_HELP, add_error_estimate, add_progress_options, add_scene_options, add_sweep_options
 from .output import add_common, emit
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -180,6 +180,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--repeats", type=int, default=5, help="runs per setting; wall time = median (default 5)")
     p.add_argument("--quick", action="store_true", help="a few settings and short runs (smoke test)")
     p.add_argument("--verbose", action="store_true", help="print each setting as it finishes (stderr)")
+    add_progress_options(p)
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_workprecision"))
 
@@ -221,9 +222,12 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--levels", type=int, default=4, help="morris grid levels, even (default 4)")
     p.add_argument("--outputs", help="comma list of headline outputs to analyse (default: all)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sample and the bootstrap (default 0)")
+    p.add_argument("--speed", metavar="KMH", type=float,
+                   help="train speed, km/h (sets input.speed of every point; a scene with a speed)")
     p.add_argument("--workers", type=int, default=0, help="local processes or threads (0 = all cores)")
     add_sweep_options(p)
     add_scene_options(p)
+    add_progress_options(p)
     add_common(p)
     p.set_defaults(func=deferred(".design", "cmd_sensitivity"))
 
@@ -268,6 +272,7 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=0, help="local processes or threads (0 = all cores)")
     add_sweep_options(p)
     add_scene_options(p)
+    add_progress_options(p)
     add_common(p)
     p.set_defaults(func=deferred(".design", "cmd_optimise"))
 

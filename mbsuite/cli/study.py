@@ -37,8 +37,9 @@ def add_study_options(p: argparse.ArgumentParser, scene: bool = True) -> None:
     """`--set` and `--vary` (`scene=False`: a command without a scene varies its options: `--vary option.NAME=...`),
     plus the sweep's `--executor/--scheduler/--store/--max-points` and `--workers` where the command does not have
     them yet."""
-    from .options import add_sweep_options
+    from .options import add_progress_options, add_sweep_options
 
+    add_progress_options(p)
     if scene:
         p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
                        help="change one value of the scene (SECTION: input, params, solver, effects or a model's own "

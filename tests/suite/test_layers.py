@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[2] / "mbsuite"
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("foundation", ("mbsuite.errors", "mbsuite.version", "mbsuite.limits", "mbsuite.schema", "mbsuite.deferred",
                     "mbsuite.paths", "mbsuite.overrides", "mbsuite.plotting", "mbsuite.modeltext",
-                    "mbsuite.stepping", "mbsuite.results", "mbsuite.settings", "mbsuite.statistics",
+                    "mbsuite.stepping", "mbsuite.results", "mbsuite.progress", "mbsuite.settings", "mbsuite.statistics",
                     "mbsuite.trust.health", "mbsuite.trust.perturbation", "mbsuite.trust.estimate", "mbsuite.trust")),
     ("engines and components", ("mbsuite.engines", "mbsuite.components", "mbsuite.native")),
     ("registry and scenes", ("mbsuite.registry", "mbsuite.scenes", "mbsuite.scene_schema", "mbsuite.modelfiles",

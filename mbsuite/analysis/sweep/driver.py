@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from ...results import Progress
+from ...progress import sweep_progress
 from .encoding import StoreError, encode_value, fn_id, record_key
 from .executors import Runner
 from .grid import take
@@ -43,8 +43,8 @@ def run_sweep(fn: Callable[[Any], Any], points: Iterable[Any], *, workers: int =
     results: list[Any] = [None] * len(points)
     if not store:
         groups: dict[Any, list[int]] = {i: [i] for i in range(len(points))}
-        with Progress(len(points), desc, enabled=progress) as bar:
-            _drive(fn, points, groups, results, bar, None, None, executor, workers, scheduler, desc)
+        with sweep_progress(desc, len(points), _parallel(executor, workers, len(points)), progress) as report:
+            _drive(fn, points, groups, results, report, None, None, executor, workers, scheduler, desc)
         return results
     db = SweepStore(store)
     fid = fn_id(fn)
@@ -58,20 +58,29 @@ def run_sweep(fn: Callable[[Any], Any], points: Iterable[Any], *, workers: int =
         k = record_key(fid, enc)
         encoded.setdefault(k, enc)
         groups.setdefault(k, []).append(i)
-    with Progress(len(points), desc, enabled=progress) as bar, db.session() as owner_fd:
-        _drive(fn, points, groups, results, bar, db, (fid, encoded, owner_fd), executor, workers, scheduler,
+    with sweep_progress(desc, len(points), _parallel(executor, workers, len(groups)), progress) as report, \
+            db.session() as owner_fd:
+        _drive(fn, points, groups, results, report, db, (fid, encoded, owner_fd), executor, workers, scheduler,
                desc)
     return results
 
 
-def _drive(fn: Callable, points: list[Any], groups: dict[Any, list[int]], results: list[Any], bar: Progress,
+def _parallel(executor: str, workers: int, n: int) -> int:
+    """How many points run at a time (a Dask cluster: its own count, said as 'many')."""
+    from ...engines.core import n_workers
+
+    return n if executor == "dask" else max(1, min(n_workers(workers), n))
+
+
+def _drive(fn: Callable, points: list[Any], groups: dict[Any, list[int]], results: list[Any],
+           report: Callable[..., None],
            db: SweepStore | None, meta: tuple[str, dict[str, Any], int] | None, executor: str, workers: int,
            scheduler: Any, desc: str) -> None:
     """The loop of `run_sweep`: claim, submit, collect; with a store, wait for points other live writers compute."""
     def deliver(gid: Any, res: Any) -> None:
         for i in groups[gid]:
             results[i] = res
-        bar.update(len(groups[gid]))
+        report(len(groups[gid]), [(points[i], res) for i in groups[gid]])
 
     queue: deque[Any] = deque(groups)
     waiting: list[Any] = []  # claimed by another live writer

@@ -10,7 +10,8 @@ from pathlib import Path
 from ...cli.options import add_error_estimate, add_scene_options, check_workers, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import SceneError
-from ...results import Progress, Report
+from ...progress import Progress
+from ...results import Report
 from ...scenes import Scene, load_scene, scene_from_dict
 from .linefile import is_line_file
 

@@ -1,0 +1,140 @@
+"""Progress and cost of long work (`mbsuite.progress`): the plan said before the work with its run count counted by
+hand, the estimate after the first run, the budget, the partial summary on an interrupt, --quiet, and the command
+line's one-line warnings."""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import warnings
+
+import pytest
+
+from mbsuite import progress
+from mbsuite.analysis import optimise, sensitivity
+from mbsuite.analysis.sweep import run_sweep
+from mbsuite.cli import main
+
+
+def _square(p: dict) -> dict:
+    return {"y": (p["x.a"] - 0.3) ** 2 + 0.1 * p["x.b"]}
+
+
+def _twice(x: float) -> float:
+    return 2 * x
+
+
+def _lines(stream: io.StringIO) -> list[str]:
+    return [ln for ln in stream.getvalue().splitlines() if ln.strip()]
+
+
+def test_sweep_states_its_runs_and_counts_each_once():
+    out = io.StringIO()
+    with progress.study("sweep", stream=out, bar=False) as st:
+        res = run_sweep(_twice, [1.0, 2.0, 3.0, 4.0, 5.0], workers=1)
+    assert res == [2.0, 4.0, 6.0, 8.0, 10.0]
+    lines = _lines(out)
+    assert lines[0] == "mbsuite sweep: 5 runs, one at a time; time estimate after the first"
+    assert lines[1].startswith("mbsuite sweep: first run finished after ") and lines[1].endswith("for 5 runs")
+    assert len(lines) == 2
+    assert st.last is not None and st.last.done == 5 and len(st.last.finished) == 5
+
+
+def test_optimise_plan_counts_scipy_generations_and_reports_every_evaluation():
+    out = io.StringIO()
+    k, maxiter, popsize = 2, 3, 4  # scipy's population: max(5, popsize x factors) = 8 designs a generation
+    with progress.study("optimise", stream=out, bar=False) as st:
+        res = optimise.run(_square, ["x.a=0:1", "x.b=0:1"], objective="y", maxiter=maxiter, popsize=popsize, tol=1e-12,
+                           workers=1)
+    runs = (maxiter + 1) * max(5, popsize * k)
+    assert _lines(out)[0] == f"mbsuite optimise: up to {runs} runs, one at a time; time estimate after the first"
+    assert st.last.done == len(res.evaluations)  # every evaluation the study logs reached the plan, once
+    assert len(res.evaluations) <= runs
+
+
+def test_sensitivity_plan_is_the_sample_size():
+    out = io.StringIO()
+    with progress.study("sensitivity", stream=out, bar=False) as st:
+        res = sensitivity.run(_square, ["x.a=0:1", "x.b=0:1"], method="sobol", n=8, workers=1)
+    assert len(res.samples) == 8 * (2 + 2)  # Saltelli without second order: n (k + 2)
+    assert _lines(out)[0].startswith("mbsuite sensitivity: sobol sensitivity: 32 runs (n = 8 x 4), one at a time")
+    assert st.last.done == 32
+
+
+def test_over_budget_stops_with_yes_and_a_cheaper_setting_that_fits():
+    plan = progress.Plan("optimise", 210, 2, upto=True, cheaper=optimise.cheaper(2, 1, 5, False))
+    st = progress.Study("optimise", budget=60.0, stream=io.StringIO(), bar=False)
+    st.start(plan)
+    plan.started -= 3.9  # the first run took 3.9 s
+    with pytest.raises(progress.OverBudget) as exc:
+        st.update(1)
+    text = str(exc.value)
+    # 3.9 s x ceil(210 / 2) = 409.5 s; 60 s fit 15 rounds x 2 = 30 runs = 3 generations of 10: --maxiter 2
+    assert "about 6.8 min for up to 210 runs" in text and "--yes" in text and "--maxiter 2" in text
+    st.confirmed = True  # --yes: no stop
+    plan.done = 0
+    st.update(1)
+
+
+def test_interrupt_keeps_the_finished_runs_in_a_partial_summary(tmp_path):
+    def stop_at_third(x: float) -> float:
+        if x == 3.0:
+            raise KeyboardInterrupt
+        return 2 * x
+
+    with pytest.raises(KeyboardInterrupt), progress.study("sweep", out=str(tmp_path), stream=io.StringIO(),
+                                                          bar=False) as st:
+        run_sweep(stop_at_third, [1.0, 2.0, 3.0, 4.0], workers=1)
+    said = st.keep_partial()
+    data = json.loads((tmp_path / "partial_summary.json").read_text())
+    assert data["finished_runs"] == 2 and data["planned_runs"] == 4
+    assert [r["result"] for r in data["runs"]] == [2.0, 4.0]
+    assert str(tmp_path / "partial_summary.json") in said
+
+
+def test_nested_sweeps_are_not_runs_of_the_plan():
+    def inner(x: float) -> float:
+        return sum(run_sweep(_twice, [x, x], workers=1))
+
+    out = io.StringIO()
+    with progress.study("study", stream=out, bar=False) as st:
+        assert run_sweep(inner, [1.0, 2.0, 3.0], workers=1) == [4.0, 8.0, 12.0]
+    assert st.last.runs == 3 and st.last.done == 3
+    assert _lines(out)[0].startswith("mbsuite study: sweep: 3 runs, one at a time")
+
+
+def test_estimate_is_first_run_times_rounds():
+    plan = progress.Plan("x", 7, 2)
+    assert plan.estimate(3.0) == 3.0 * math.ceil(7 / 2)
+
+
+def test_quiet_and_cli_lines(capsys):
+    assert main(["sweep", "pantograph", "--vary", "input.frequency=2,4", "--workers", "1", "--quiet"]) == 0
+    assert "runs" not in capsys.readouterr().err
+    assert main(["sweep", "pantograph", "--vary", "input.frequency=2,4", "--workers", "1"]) == 0
+    err = capsys.readouterr().err
+    assert "mbsuite sweep: 2 runs, one at a time" in err
+
+
+def test_budget_is_a_checked_input(capsys):
+    assert main(["sweep", "pantograph", "--vary", "input.frequency=2,4", "--budget", "-1"]) == 2
+    assert "--budget" in capsys.readouterr().err
+
+
+def test_sensitivity_speed_conflicts_with_set_of_the_same_key(capsys):
+    code = main(["sensitivity", "catenary/en50318", "--vary", "params.F0=100:140", "--speed", "250", "--set",
+                 "input.speed=200"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "--speed" in err and "--set" in err
+
+
+def test_warnings_are_one_line_each_once(capsys):
+    from mbsuite.cli.output import one_line_warnings
+
+    with one_line_warnings():
+        for _ in range(3):
+            warnings.warn("a   warning\n  over two lines", UserWarning, stacklevel=1)
+    err = capsys.readouterr().err
+    assert err == "mbsuite: UserWarning: a warning over two lines\n"

@@ -31,7 +31,11 @@ def _write(tmp_path, *extra: str):
 
 def test_scene_holds_the_design(tmp_path, capsys):
     path = _write(tmp_path)
-    assert max(len(line) for line in capsys.readouterr().out.splitlines()) <= 100
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines()) <= 100
+    # the command it prints is the README's (`mbsuite drive run FILE`) and runs the scene it wrote
+    said = " ".join(out.split()).split("run it: ")[1].split()
+    assert said[:3] == ["mbsuite", "drive", "run"] and said[3] == str(path)
     sc = load_scene(path)
     p = sc.params
     P, Sr_min, w_max, V_m, tau_c, w_op = 200.0, 15.0, 400.0, 100.0, 8.0, 300.0

@@ -180,7 +180,7 @@ def register(sub, add_common, emit) -> str:
                    help=_help("--tau-c", "read the family at this clutch torque (as Tables 5.2, 6.2)"))
     g = q.add_argument_group("design -> scene (with --scene-out; one --srmin and --tau-c or one --js)")
     g.add_argument("--scene-out", metavar="FILE", default=None,
-                   help="write the design point as a step-up/step-down scene TOML (mbsuite run FILE runs it)")
+                   help="write the design point as a step-up/step-down scene TOML (mbsuite drive run FILE runs it)")
     g.add_argument("--wop", type=float, default=None,
                    help=_help("--wop", "speed the scene's PI tracks, in [--wmin, --wmax]; default their middle"))
     g.add_argument("--Jl", type=float, default=None, help=_help("--Jl", "default: the base set's"))
@@ -290,8 +290,8 @@ def cadjs_cmd(emit, a: argparse.Namespace) -> None:
         d = scene["design"]["derived"]
         msg = (f"wrote {a.scene_out}: the design at J_s = {d['J_s']:.4g} kg m^2 as a step-up/step-down scene, "
                f"closed loop at {d['w_op']:g} rad/s against tau_l = {d['tau_l']:.4g} N m (Sr = {d['Sr_op']:.4g} /s "
-               f"there: K_p = {d['Kp']:.4g}, K_I = {d['Ki']:.4g}); run it: mbsuite run {a.scene_out}")
-        table += "\n\n" + textwrap.fill(msg, 100)
+               f"there: K_p = {d['Kp']:.4g}, K_I = {d['Ki']:.4g}); run it: mbsuite drive run {a.scene_out}")
+        table += "\n\n" + textwrap.fill(msg, 100, break_on_hyphens=False, break_long_words=False)
     emit(Report({"inputs": inputs, "designs": data, **({"scene_file": a.scene_out} if scene else {})}, table,
                 _csv_writer("cadjs", cols, fig)), a, scene)
 

@@ -90,7 +90,8 @@ def duration(seconds: float) -> str:
 class Plan:
     """What a piece of long work will run: `runs` (an upper bound when `upto`: an optimiser may stop early),
     `parallel` at a time, `detail` in words; `cheaper(runs)` names a setting of the analysis that fits in `runs`
-    runs (None: the analysis knows none)."""
+    runs (None: the analysis knows none); `weights`: the runs' relative costs where they differ (an error estimate's
+    companions), in the order of the sweep that runs them."""
 
     what: str
     runs: int
@@ -98,6 +99,7 @@ class Plan:
     upto: bool = False
     detail: str = ""
     cheaper: Callable[[int], str | None] | None = None
+    weights: tuple[float, ...] = ()
     done: int = 0
     started: float = field(default_factory=time.perf_counter)
     finished: list[Any] = field(default_factory=list)
@@ -109,8 +111,12 @@ class Plan:
         par = "one at a time" if self.parallel <= 1 else f"{self.parallel} in parallel"
         return f"{self.what}: {n} run{'s' if self.runs != 1 else ''}{detail}, {par}; time estimate after the first"
 
-    def estimate(self, first: float) -> float:
-        """The wall time of all runs from the first finished run's (s)."""
+    def estimate(self, first: float, index: int | None = None) -> float:
+        """The wall time of all runs from the first finished run's (s; `index`: which run it was, with `weights`:
+        the work of all over the parallel runs, at least the largest run's)."""
+        if self.weights and index is not None and 0 <= index < len(self.weights) and self.weights[index] > 0:
+            unit = first / self.weights[index]
+            return unit * max(sum(self.weights) / max(self.parallel, 1), max(self.weights))
         return first * math.ceil(self.runs / max(self.parallel, 1))
 
 
@@ -154,9 +160,10 @@ class Study:
             self._bar = None
         self.plan = None
 
-    def update(self, k: int = 1, results: list[Any] | None = None) -> None:
-        """`k` more runs of the plan finished (`results`: their (point, result) pairs, kept for a partial summary);
-        after the first, the estimate, checked against the budget."""
+    def update(self, k: int = 1, results: list[Any] | None = None, indices: list[int] | None = None) -> None:
+        """`k` more runs of the plan finished (`results`: their (point, result) pairs, kept for a partial summary;
+        `indices`: their places in the sweep, for the plan's weights); after the first, the estimate, checked
+        against the budget."""
         plan = self.plan
         if plan is None:
             return
@@ -166,11 +173,11 @@ class Study:
             plan.finished.extend(results)
         if self._bar is not None:
             self._bar.update(k)
-        if first and plan.runs > plan.parallel:
+        if first and (plan.runs > plan.parallel or len(set(plan.weights)) > 1):
             took = time.perf_counter() - plan.started
             if plan.parallel == 1:  # one at a time: k runs took that long together
                 took /= k
-            total = plan.estimate(took)
+            total = plan.estimate(took, indices[0] if indices else None)
             self.say(f"{plan.what}: first run finished after {duration(took)}: about {duration(total)} for "
                      f"{'up to ' if plan.upto else ''}{plan.runs} runs")
             if self.budget is not None and total > self.budget and not self.confirmed:
@@ -237,14 +244,15 @@ def study(command: str, **kw: Any) -> Iterator[Study]:
 
 @contextmanager
 def planned(what: str, runs: int, parallel: int, *, upto: bool = False, detail: str = "",
-            cheaper: Callable[[int], str | None] | None = None) -> Iterator[Study | None]:
+            cheaper: Callable[[int], str | None] | None = None, weights: tuple[float, ...] = ()
+            ) -> Iterator[Study | None]:
     """Declare the plan of an analysis that knows its whole size (module docstring); the sweeps it runs report into
     it. Yields the study, or None outside a command line or inside another plan."""
     s = active()
     if s is None or s.plan is not None:
         yield None
         return
-    s.start(Plan(what, max(int(runs), 1), max(int(parallel), 1), upto, detail, cheaper))
+    s.start(Plan(what, max(int(runs), 1), max(int(parallel), 1), upto, detail, cheaper, tuple(weights)))
     try:
         yield s
     finally:
@@ -259,10 +267,10 @@ def sweep_progress(desc: str, n: int, parallel: int, enabled: bool | None) -> It
     s = active()
     if s is None:
         with Progress(n, desc, enabled=enabled) as bar:
-            yield lambda k, results=None: bar.update(k)
+            yield lambda k, results=None, indices=None: bar.update(k)
         return
     if s.depth > 0:
-        yield lambda k, results=None: None
+        yield lambda k, results=None, indices=None: None
         return
     own = s.plan is None
     if own:

@@ -24,7 +24,9 @@ import functools
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from ..engines.core import n_workers
 from ..errors import MbsuiteError
+from ..progress import planned
 from ..scenes import Scene
 from ..trust.estimate import ErrorEstimate, Refinement, declared, estimate
 from .sweep import run_sweep
@@ -51,6 +53,19 @@ def level_settings(scene: Scene, levels: list[Scene]) -> list[str]:
             parts.append(f"{name.strip()} = {v:g}" if isinstance(v, float) else f"{name.strip()} = {v}")
         out.append(", ".join(parts))
     return out
+
+
+def cost(ref: Refinement, level: int) -> float:
+    """The work of the scene refined `level` times (coarsened for a negative level) relative to the run's: the
+    factor to the power of the level times the number of settings it scales together (the catenary's mesh and
+    step: 4 per level)."""
+    return float(ref.factor) ** (level * len(ref.setting.split("+")))
+
+
+def _work(weights: list[float]) -> str:
+    """The runs' work in words, e.g. `about 1, 1/4 and 1/16 of the run's work`."""
+    words = [f"{w:g}" if w >= 1 else f"1/{1 / w:g}" for w in weights]
+    return f"about {', '.join(words[:-1])} and {words[-1]} x the run's work" if len(words) > 1 else ""
 
 
 def coarse_companions(scene: Scene, ref: Refinement) -> list[Scene]:
@@ -87,7 +102,10 @@ def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
     levels = [ref.refine(scene, k) for k in (0, 1, 2)]
     jobs = [sc.to_dict() for sc in levels[1:]] if base is not None else [sc.to_dict() for sc in levels]
     # the most refined copy is the longest: submit it first, so the others share the remaining cores
-    results = run_sweep(evaluate, jobs[::-1], workers=workers, desc="error estimate", executor="local")[::-1]
+    w = [cost(ref, k) for k in (range(1, 3) if base is not None else range(3))][::-1]
+    with planned("error estimate (refined companions)", len(jobs), min(n_workers(workers), len(jobs)),
+                 detail=_work(w) + (", after the coarse ones" if fallback else ""), weights=tuple(w)):
+        results = run_sweep(evaluate, jobs[::-1], workers=workers, desc="error estimate", executor="local")[::-1]
     vals: list[Any] = ([dict(base)] if base is not None else []) + [dict(r) for r in results]
     est = estimate(vals, heads, ref, settings=level_settings(scene, levels))
     est.fallback, est.coarse = fallback, coarse
@@ -106,7 +124,10 @@ def _coarse_estimate(scene: Scene, ref: Refinement, heads, base: Mapping[str, fl
     # the run first (when it is not given: the longest job), then the companion coarsened once
     jobs = ([] if base is not None else [(evaluate, scene.to_dict())]) + [
         (functools.partial(companion_values, evaluate), sc.to_dict()) for sc in comps]
-    results = run_sweep(_call, jobs, workers=workers, desc="error estimate", executor="local")
+    w = [cost(ref, k) for k in ((-1, -2) if base is not None else (0, -1, -2))]
+    with planned("error estimate (coarse companions)", len(jobs), min(n_workers(workers), len(jobs)),
+                 detail=_work(w), weights=tuple(w)):
+        results = run_sweep(_call, jobs, workers=workers, desc="error estimate", executor="local")
     run = dict(results[0]) if base is None else None
     failed = [(k, r[FAILED]) for k, r in enumerate(results[-2:], start=1) if FAILED in r]
     if failed:

@@ -12,7 +12,7 @@ import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..errors import MbsuiteError
 
@@ -110,19 +110,20 @@ def quiet_stdout() -> None:
 @contextmanager
 def one_line_warnings() -> Iterator[None]:
     """Warnings as one line each on stderr, `mbsuite: <Category>: <message>`, without the package's source line, and
-    each text once per command."""
+    each text once per command (the format of Python's own display: a caller recording warnings still gets them)."""
     seen: set[str] = set()
-    before = warnings.showwarning
+    before = warnings.formatwarning
 
-    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
-             line: str | None = None) -> None:
+    def fmt(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+            line: str | None = None) -> str:
         text = f"mbsuite: {category.__name__}: {' '.join(str(message).split())}"
-        if text not in seen:
-            seen.add(text)
-            print(text, file=sys.stderr, flush=True)
+        if text in seen:
+            return ""
+        seen.add(text)
+        return text + "\n"
 
-    warnings.showwarning = show
+    warnings.formatwarning = fmt
     try:
         yield
     finally:
-        warnings.showwarning = before
+        warnings.formatwarning = before

@@ -7,7 +7,8 @@ from __future__ import annotations
 import io
 import json
 import math
-import warnings
+import subprocess
+import sys
 
 import pytest
 
@@ -130,11 +131,25 @@ def test_sensitivity_speed_conflicts_with_set_of_the_same_key(capsys):
     assert "--speed" in err and "--set" in err
 
 
-def test_warnings_are_one_line_each_once(capsys):
-    from mbsuite.cli.output import one_line_warnings
+def test_warnings_are_one_line_each_once():
+    code = ("import warnings\nfrom mbsuite.cli.output import one_line_warnings\nwith one_line_warnings():\n"
+            "    for _ in range(3):\n        warnings.warn('a   warning\\n  over two lines', UserWarning)\n"
+            "warnings.warn('after', UserWarning)\n")
+    r = subprocess.run([sys.executable, "-W", "always", "-c", code], capture_output=True, text=True, check=True)
+    lines = r.stderr.splitlines()
+    assert lines[0] == "mbsuite: UserWarning: a warning over two lines"  # no source line, once
+    assert "mbsuite" not in "".join(lines[1:]) and "after" in lines[1]  # Python's own format again afterwards
 
-    with one_line_warnings():
-        for _ in range(3):
-            warnings.warn("a   warning\n  over two lines", UserWarning, stacklevel=1)
-    err = capsys.readouterr().err
-    assert err == "mbsuite: UserWarning: a warning over two lines\n"
+
+def test_weighted_estimate_scales_the_first_run_by_its_share_of_the_work():
+    from mbsuite.analysis.errorestimate import cost
+    from mbsuite.trust.estimate import Refinement
+
+    ref = Refinement("params.element_length + solver.timestep", 2.0, 2.0, lambda sc, k: sc, "halved")
+    w = tuple(cost(ref, k) for k in (0, -1, -2))
+    assert w == (1.0, 0.25, 0.0625)  # mesh and step doubled: a quarter of the work per level
+    plan = progress.Plan("error estimate", 3, 2, weights=w)
+    # the 1/16 companion finished first after 1 s: the run is 16 s, the three on two workers at least 16 s
+    assert plan.estimate(1.0, index=2) == 16.0
+    plan = progress.Plan("error estimate", 3, 1, weights=w)
+    assert plan.estimate(1.0, index=2) == pytest.approx(16.0 * (1 + 0.25 + 0.0625))

@@ -80,7 +80,7 @@ def _drive(fn: Callable, points: list[Any], groups: dict[Any, list[int]], result
     def deliver(gid: Any, res: Any) -> None:
         for i in groups[gid]:
             results[i] = res
-        report(len(groups[gid]), [(points[i], res) for i in groups[gid]])
+        report(len(groups[gid]), [(points[i], res) for i in groups[gid]], groups[gid])
 
     queue: deque[Any] = deque(groups)
     waiting: list[Any] = []  # claimed by another live writer

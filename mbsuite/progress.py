@@ -13,7 +13,8 @@ Stated before the work starts (stderr, one line): how many runs, how many in par
 its time and the estimated time of all (`first run x ceil(runs / parallel)`, wall clock). With a budget (the command
 line's `--budget`, default `BUDGET` s) an estimate above it stops the study there with an `OverBudget` error naming
 `--yes` and, where the analysis knows one, a cheaper setting that fits; the finished runs are kept as on Ctrl-C.
-The bar (tqdm) is drawn on a terminal only; `--quiet` silences the lines and the bar. Outside a command line (the
+The lines and the bar (tqdm) are shown on a terminal only (the lines also with `MBSUITE_PROGRESS=1`, e.g. in a
+log); `--quiet` silences both. Outside a command line (the
 API) there is no study: sweeps draw their own bar as before (`Progress`).
 
 Ctrl-C: a sweep with a store has its finished points in the store (a rerun resumes); otherwise the finished runs of
@@ -129,7 +130,9 @@ class Study:
         self.command, self.quiet, self.budget, self.confirmed = command, quiet, budget, confirmed
         self.out, self.store = out, store
         self.stream = stream if stream is not None else sys.stderr
-        self.bar_wanted = (not quiet and self.stream.isatty()) if bar is None else bar
+        shown = stream is not None or self.stream.isatty() or os.environ.get("MBSUITE_PROGRESS", "") not in ("", "0")
+        self.quiet = quiet or not shown  # on a terminal (or MBSUITE_PROGRESS=1, or a given stream) unless --quiet
+        self.bar_wanted = (not self.quiet and self.stream.isatty()) if bar is None else bar
         self.plan: Plan | None = None
         self.last: Plan | None = None  # the latest plan, kept for the partial summary
         self.depth = 0  # sweeps running inside the plan (a nested one is silent)

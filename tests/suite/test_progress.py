@@ -110,7 +110,8 @@ def test_estimate_is_first_run_times_rounds():
     assert plan.estimate(3.0) == 3.0 * math.ceil(7 / 2)
 
 
-def test_quiet_and_cli_lines(capsys):
+def test_quiet_and_cli_lines(capsys, monkeypatch):
+    monkeypatch.setenv("MBSUITE_PROGRESS", "1")  # the lines as on a terminal
     assert main(["sweep", "pantograph", "--vary", "input.frequency=2,4", "--workers", "1", "--quiet"]) == 0
     assert "runs" not in capsys.readouterr().err
     assert main(["sweep", "pantograph", "--vary", "input.frequency=2,4", "--workers", "1"]) == 0

@@ -229,25 +229,27 @@ def test_the_elbow_without_a_tangent_fails_as_the_python_raises():
         x[:nq] = [-0.54, 0.5, 0.0][:nq] if nq == 3 else [-0.54, 0.0]
         x[-1] = ref.ode.cylinder_lever(-0.54)[0]
         ref.x = x
-        with pytest.raises(GeometryError, match="no tangent line"):
-            ref.trial(0.0, 1e-4, 100.0, 100.0)
-        op = OdePort(ref)
-        code, _ = op.trial(0.0, 1e-4, 100.0, 100.0)
-        assert code == ode_port.FAIL_ELBOW
-        msg = op.failure(code)
-        assert "no tangent line at theta_1 = -0.54" in msg and "RK4 stage 1" in msg, msg
+        _fails_alike(ref, GeometryError, "no tangent line", ode_port.FAIL_ELBOW, "no tangent line at theta_1 = -0.54",
+                     "RK4 stage 1")
 
 
 def test_a_non_positive_cylinder_volume_fails_as_the_python_raises():
     ref, _ = _reference({"cylinder": "nonlinear"})
     ref.x[0] = -0.3  # x_p = lb cos(alpha + 0.3) < -V0 / Ap
-    with pytest.raises(SolverError, match="volume became non-positive"):
+    _fails_alike(ref, SolverError, "volume became non-positive", ode_port.FAIL_VOLUME,
+                 "volume became non-positive (V = -", "theta_1 = -0.3")
+
+
+def _fails_alike(ref, error: type, match: str, code: int, *said: str) -> None:
+    """The Python trial raises `error` (matching `match`); the C trial from the same state returns `code`, and its
+    failure text holds every piece of `said`."""
+    with pytest.raises(error, match=match):
         ref.trial(0.0, 1e-4, 100.0, 100.0)
     op = OdePort(ref)
-    code, _ = op.trial(0.0, 1e-4, 100.0, 100.0)
-    assert code == ode_port.FAIL_VOLUME
-    msg = op.failure(code)
-    assert "volume became non-positive (V = -" in msg and "theta_1 = -0.3" in msg, msg
+    got, _ = op.trial(0.0, 1e-4, 100.0, 100.0)
+    assert got == code
+    msg = op.failure(got)
+    assert all(s in msg for s in said), msg
 
 
 def test_the_port_is_filled_and_event_exact_coulomb_is_refused():

@@ -15,7 +15,7 @@ from ..results import Report, format_table
 from ..scenes import load_scene
 from ..statistics import describe
 from ..trust.health import InaccurateResult
-from .options import MAX_REPEATS, load, scene_of
+from .options import MAX_REPEATS, apply_speed, load, scene_of
 from .output import emit, wrap
 from .study import apply_sets
 
@@ -79,7 +79,7 @@ def cmd_run(args: argparse.Namespace) -> None:
     """`mbsuite run SCENE`: the scene's time simulation on its path (health judged by `mbsuite.run`)."""
     from .. import run
 
-    scene = apply_sets(load(args), args.set_values)
+    scene = apply_speed(apply_sets(load(args), args.set_values), args)
     try:
         rep = run(scene, error_estimate=args.error_estimate).report()
     except InaccurateResult as exc:  # an error estimate above its tolerance: the result kept, flagged (exit 3)

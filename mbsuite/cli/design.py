@@ -11,7 +11,7 @@ from typing import Any
 from ..errors import MbsuiteError
 from ..limits import Limit
 from ..schema import Items, check_value
-from .options import check_workers, load, sweep_options
+from .options import apply_speed, check_workers, load, sweep_options
 from .output import emit
 from .study import apply_sets
 
@@ -26,9 +26,7 @@ def cmd_sensitivity(args: argparse.Namespace) -> None:
     """Run the study and emit its ranked table (files under --out)."""
     from ..analysis import sensitivity
 
-    scene = apply_sets(load(args), args.set_values)
-    if args.speed is not None:  # one speed, as optimise's single --speed (composed with --set by the one rule)
-        scene = apply_sets(scene, [f"input.speed={args.speed!r}"])
+    scene = apply_speed(apply_sets(load(args), args.set_values), args)
     check_workers(args.workers)
     outputs = [x.strip() for x in args.outputs.split(",") if x.strip()] if args.outputs else None
     res = sensitivity.run(scene, args.vary or [], method=args.method, n=args.n, seed=args.seed, outputs=outputs,

@@ -105,6 +105,22 @@ def add_progress_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--yes", action="store_true", help="run a study whose estimated time exceeds --budget")
 
 
+def add_speed_option(p: argparse.ArgumentParser) -> None:
+    """`--speed KMH`: the train speed of a scene that has one (sets input.speed, as on `catenary` and `optimise`)."""
+    p.add_argument("--speed", metavar="KMH", type=float,
+                   help="train speed, km/h: sets input.speed (a scene whose model has a speed: catenary)")
+
+
+def apply_speed(scene: Scene, args: argparse.Namespace) -> Scene:
+    """The scene at `--speed` (input.speed; unchanged without it), resolved by the one rule (`resolve`); the rule has
+    already checked it against every other flag (`overrides`)."""
+    v = getattr(args, "speed", None)
+    if v is None:
+        return scene
+    o = Override("--speed", "input.speed", v, f"--speed {v:g}")
+    return scene.replace(origin=f"on the command line (--speed {v:g})", **resolve(scene, {o: float(v)}))
+
+
 def load(args: argparse.Namespace) -> Scene:
     """The command's scene with the command-line solver overrides applied (and validated); `--engine` may name a
     path by its key or its label (`mbsuite list`). The command line's overrides are composed first (`overrides`)."""

@@ -14,7 +14,14 @@ import importlib
 from collections.abc import Callable
 from pathlib import Path
 
-from .options import SCENE_HELP, add_error_estimate, add_progress_options, add_scene_options, add_sweep_options
+from .options import (
+    SCENE_HELP,
+    add_error_estimate,
+    add_progress_options,
+    add_scene_options,
+    add_speed_option,
+    add_sweep_options,
+)
 from .output import add_common, emit
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -141,6 +148,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
                    help="override the scene's path: a key or label of the model's path table (mbsuite list)")
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
                    help="change one value of the scene, e.g. params.mh=14 (repeatable; a comma list sets a list)")
+    add_speed_option(p)
     add_error_estimate(p)
     p.set_defaults(func=deferred(".commands", "cmd_run"))
 
@@ -166,6 +174,7 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", dest="set_values",
                    help="change one value of the scene at every point, e.g. params.mh=14 (repeatable)")
     p.add_argument("--signals", help="comma list of output signals to tabulate (default: all)")
+    add_speed_option(p)
     p.add_argument("--workers", type=int, default=0, help="local processes (0 = all cores)")
     add_error_estimate(p)
     add_sweep_options(p)
@@ -222,8 +231,7 @@ def add_design_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--levels", type=int, default=4, help="morris grid levels, even (default 4)")
     p.add_argument("--outputs", help="comma list of headline outputs to analyse (default: all)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sample and the bootstrap (default 0)")
-    p.add_argument("--speed", metavar="KMH", type=float,
-                   help="train speed, km/h (sets input.speed of every point; a scene with a speed)")
+    add_speed_option(p)
     p.add_argument("--workers", type=int, default=0, help="local processes or threads (0 = all cores)")
     add_sweep_options(p)
     add_scene_options(p)

@@ -14,7 +14,7 @@ from ..analysis.sweep import check_grid, parse_values, run_sweep, scene_point
 from ..errors import MbsuiteError
 from ..results import Report, format_table, write_csv
 from ..scenes import Scene
-from .options import check_workers, load, sweep_options
+from .options import apply_speed, check_workers, load, sweep_options
 from .output import emit
 
 
@@ -36,7 +36,7 @@ def cmd_sweep(args: argparse.Namespace) -> None:
     report."""
     from .study import apply_sets
 
-    scene = apply_sets(load(args), getattr(args, "set_values", None))
+    scene = apply_speed(apply_sets(load(args), getattr(args, "set_values", None)), args)
     check_workers(args.workers)
     options = sweep_options(args)
     axes = grid_axes(args, scene, options.max_points)

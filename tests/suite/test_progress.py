@@ -154,3 +154,28 @@ def test_weighted_estimate_scales_the_first_run_by_its_share_of_the_work():
     assert plan.estimate(1.0, index=2) == 16.0
     plan = progress.Plan("error estimate", 3, 1, weights=w)
     assert plan.estimate(1.0, index=2) == pytest.approx(16.0 * (1 + 0.25 + 0.0625))
+
+
+@pytest.mark.parametrize("command", [["run"], ["sweep", "--vary", "params.F0=110,120"],
+                                     ["sensitivity", "--vary", "params.F0=100:140"]])
+def test_speed_means_input_speed_on_every_command(command, monkeypatch):
+    """`--speed` sets input.speed wherever a scene has a speed (as on `catenary` and `optimise`); the command is
+    stopped where its work starts, so nothing runs here."""
+    from mbsuite.cli import sweep
+
+    seen = {}
+
+    def stop_at_run(scene, *a, **k):
+        seen["speed"] = scene.to_dict()["input"]["speed"]
+        raise KeyboardInterrupt
+
+    def stop_at_points(fn, points, **k):
+        seen["speed"] = points[0][0]["input"]["speed"]  # (the scene as a dict, the point's sections)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("mbsuite.run", stop_at_run)
+    monkeypatch.setattr("mbsuite.analysis.sensitivity.run", stop_at_run)
+    monkeypatch.setattr(sweep, "run_sweep", stop_at_points)
+    name, *rest = command
+    assert main([name, "catenary/en50318", *rest, "--speed", "212.5"]) == 130
+    assert seen["speed"] == 212.5

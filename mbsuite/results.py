@@ -229,6 +229,39 @@ def write_csv(path: str | Path, columns: Sequence[tuple[str, str, Any]]) -> Path
     return path
 
 
+#: the unit a name's ending spells (`peaks_hz` -> Hz, `uplift_mm` -> mm), for reported numbers no table names
+SUFFIX_UNITS = {"_hz": "Hz", "_m": "m", "_mm": "mm", "_s": "s", "_deg": "deg", "_rad": "rad", "_kmh": "km/h",
+                "_pct": "%", "_rel": "1", "_ratio": "1", "_kg": "kg", "_count": "1", "_counts": "1"}
+#: names that are counts (dimensionless) whatever reports them
+COUNT_NAMES = {"evaluations": "1", "steps": "1", "dofs": "1", "n_samples": "1", "count": "1", "n": "1"}
+
+
+def names_of(path: str) -> list[str]:
+    """The names of a reported number's path, indices dropped (`peaks_hz.linear.F1[0]` -> peaks_hz, linear, F1)."""
+    return [n.split("[")[0] for n in path.split(".") if n.split("[")[0]]
+
+
+def spelled_unit(name: str) -> str:
+    """The unit a name's ending spells (`SUFFIX_UNITS`; the longest ending wins), else ""."""
+    low = name.lower()
+    return next((u for suffix, u in sorted(SUFFIX_UNITS.items(), key=lambda kv: -len(kv[0])) if low.endswith(suffix)),
+                "")
+
+
+def unit_source(path: str, units: Mapping[str, str]) -> tuple[str, str]:
+    """(the name that gives a reported number its unit, the unit), the number named by its dotted `path`: its last
+    name in `units` (or a count's, `COUNT_NAMES`), else the unit its last name's ending spells, else the nearest name
+    of its path that spells one (`peaks_hz.linear.F1[0]` -> peaks_hz, Hz); (its last name, "") when none does."""
+    names = names_of(path) or [path]
+    last = names[-1]
+    if last in units or last in COUNT_NAMES:
+        return last, units.get(last, COUNT_NAMES.get(last, ""))
+    for name in reversed(names):
+        if spelled_unit(name):
+            return name, spelled_unit(name)
+    return last, ""
+
+
 def _fmt(x: Any) -> str:
     if isinstance(x, float | np.floating):
         return repr(float(x))

@@ -80,6 +80,10 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
      "The epsilon-constraint front of sigma against Fm at 250 km/h."),
     ("Lumped pantographs fitted to the multibody one", "mbsuite pantograph fit-lumped --stages 3", ["lumped_fit.png"],
      "The Eppinger pantograph's driving-point receptance against its 3-stage lumped and transfer-function fits."),
+    ("Two runs compared", "mbsuite compare out/docs-figures/gallery_2 out/docs-figures/gallery_15",
+     ["compare_signals.png"], "The 2-mass pantograph at 250 km/h under the EN 50318 line (A: the passage above) and "
+     "under the line of your own (B): the statistics side by side with their differences (table, compare.csv), the "
+     "signals overlaid along the line; it reads the summary.json files the two gallery commands above wrote."),
 ]
 
 

@@ -1,2 +1,3 @@
-"""Model-agnostic analyses: sweeps, fundamental projection, work-precision, error estimates, and the design
-studies (`designspace`, `sensitivity`: Morris and Sobol; `optimise`: constrained, robust, Pareto)."""
+"""Model-agnostic analyses: sweeps, fundamental projection, work-precision, error estimates, the design
+studies (`designspace`, `sensitivity`: Morris and Sobol; `optimise`: constrained, robust, Pareto) and the comparison
+of earlier runs' summaries (`compare`)."""

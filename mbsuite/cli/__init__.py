@@ -1,5 +1,5 @@
 """Command line: `mbsuite list | run | view | render | sweep | workprecision | perturb | hardcases | sensitivity |
-optimise` plus each model's
+optimise | compare` plus each model's
 command group (`mbsuite pantograph ...`, `mbsuite coupler ...`, ...; `mbsuite list` names them).
 
 Each analysis prints a human table by default, JSON with `--json`, and with `--out DIR` writes CSV (SI units in the
@@ -15,8 +15,9 @@ Every flag that changes the scene is composed by one rule before the command run
 twice, or a key and a key inside it, is an error naming both flags.
 
 The package: `parser.py` (the parser, the model groups), `commands.py` (the generic commands), `sweep.py` (`mbsuite
-sweep`), `study.py` (`--set`/`--vary` on the analyses), `options.py` (options several commands share), `output.py`
-(tables, JSON, files, one-line errors).
+sweep`), `study.py` (`--set`/`--vary` on the analyses), `compare.py` (`mbsuite compare`), `options.py` (options several
+commands share), `output.py` (tables, JSON, files, one-line errors and warnings). Long work reports its plan, time and
+progress through `mbsuite.progress` (`main` opens the command's study).
 """
 
 from __future__ import annotations

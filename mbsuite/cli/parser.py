@@ -26,7 +26,7 @@ from .output import add_common, emit
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
 GENERIC = ("list", "run", "view", "render", "sweep", "sensitivity", "optimise", "workprecision", "perturb",
-           "hardcases")
+           "hardcases", "compare")
 
 
 def deferred(module: str, name: str) -> Callable:
@@ -134,8 +134,9 @@ def parser_for(argv: list[str]) -> argparse.ArgumentParser:
 
 
 def add_generic_commands(sub: argparse._SubParsersAction) -> None:
-    """`list`, `run`, `view`, `render`, `sweep`, `sensitivity`, `optimise`, `workprecision`, `perturb`, `hardcases`:
-    commands every model's scenes take (the design studies: those declaring headline outputs)."""
+    """`list`, `run`, `view`, `render`, `sweep`, `sensitivity`, `optimise`, `workprecision`, `perturb`, `hardcases`,
+    `compare`: commands every model's scenes take (the design studies: those declaring headline outputs; `compare`:
+    the summaries any of them wrote)."""
     p = sub.add_parser("list", help="models, their paths and their shipped scenes")
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_list"))
@@ -215,6 +216,14 @@ def add_generic_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-slow", action="store_true", help="leave out the slow cases")
     add_common(p)
     p.set_defaults(func=deferred(".commands", "cmd_hardcases"))
+
+    p = sub.add_parser("compare", help="earlier runs side by side: the headline outputs of their summary.json, the "
+                                       "differences to the first, their signals overlaid (--out)")
+    p.add_argument("summaries", nargs="+", metavar="SUMMARY",
+                   help="a summary.json an earlier command wrote with --out, or its directory (two or more; the "
+                        "first is the one the others are compared to)")
+    add_common(p)
+    p.set_defaults(func=deferred(".compare", "cmd_compare"))
 
 
 def add_design_commands(sub: argparse._SubParsersAction) -> None:

@@ -143,9 +143,17 @@ def _scene(args: argparse.Namespace, hook: str) -> Scene:
 
 
 # the units of the numbers the analyses report, by their names (a --vary study's table, CSV and figure)
+# (names ending in _hz, _m, _deg, _rel, ... take the unit they spell: `mbsuite.cli.study.unit_source`)
 UNITS = {"f_n": "Hz", "f_d": "Hz", "tau": "s", "zeta": "1", "linearised_at_height_m": "m", "theta1": "rad",
          "theta2": "rad", "thetah": "rad", "theta_e": "rad", "elbow_windup": "rad", "y_d": "m", "contact_force": "N",
-         "dtheta_e_dtheta1": "1", "mujoco": "rad", "pinocchio": "rad"}
+         "dtheta_e_dtheta1": "1", "mujoco": "rad", "pinocchio": "rad",
+         # freqresp: amplitude ratios of the response (a height, m) to the ram input (m)
+         "amplitude": "m/m", "with": "m/m", "without": "m/m", "at_f_amp": "Hz", "at_f_phase": "Hz"}
+#: the quantities in words (the axes of a study's figure)
+WORDS = {"f_n": "natural frequency", "f_d": "damped natural frequency", "zeta": "damping ratio",
+         "tau": "time constant", "peaks_hz": "peak (resonance) frequency of the response"}
+#: the headline quantities a study of each analysis prints wide and draws (by a name of their path)
+WIDE = {"modes": ("f_n", "zeta"), "freqresp": ("peaks_hz", "f_n", "zeta")}
 
 
 def equilibrium_of(scene: Scene, args: argparse.Namespace):
@@ -166,7 +174,7 @@ def cmd_equilibrium(args: argparse.Namespace) -> None:
 
 def cmd_modes(args: argparse.Namespace) -> None:
     """The linearised modes, at `--height` or at the mean of the scene's input (or a --vary study of them)."""
-    run_or_study(args, _scene(args, "modes"), f"{__name__}:modes_of", units=UNITS)
+    run_or_study(args, _scene(args, "modes"), f"{__name__}:modes_of", units=UNITS, wide=WIDE["modes"], words=WORDS)
 
 
 def freq_args(args: argparse.Namespace) -> dict:
@@ -189,8 +197,10 @@ def freqresp_of(scene: Scene, args: argparse.Namespace):
 
 
 def cmd_freqresp(args: argparse.Namespace) -> None:
-    """The frequency response (or a --vary study of it: its points one after another, each on all workers)."""
-    run_or_study(args, _scene(args, "freqresp"), f"{__name__}:freqresp_of", units=UNITS, parallel_inside=True)
+    """The frequency response (or a --vary study of it: its points one after another, each on all workers; every
+    point's curves kept, `freqresp.study_curves`)."""
+    run_or_study(args, _scene(args, "freqresp"), f"{__name__}:freqresp_of", units=UNITS, parallel_inside=True,
+                 wide=WIDE["freqresp"], words=WORDS, curves="mbsuite.models.pantograph.freqresp:study_curves")
 
 
 COMMAND_FUNCS = {"equilibrium": cmd_equilibrium, "modes": cmd_modes, "freqresp": cmd_freqresp,

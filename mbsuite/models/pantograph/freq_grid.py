@@ -13,6 +13,10 @@ from ...errors import SceneError
 from ...limits import Limit
 
 FR_SIGNALS = ("F1", "F2", "HD", "y_d")
+#: each response signal in words (axes of the figures, a study's curves); every one is a height in m, as is the
+#: ram input: its amplitude ratio is in m/m
+SIGNAL_WORDS = {"F1": "lower-arm height F1 = l1 sin(theta_1)", "F2": "upper-arm height F2 = l2 sin(theta_2)",
+                "HD": "head height HD = lh sin(theta_h)", "y_d": "contact-point height y_d = F1 + F2 + HD"}
 #: the signals whose peaks are searched and whose response is estimated (the report's table columns)
 PEAK_SIGNALS = ("F1", "HD")
 THESIS_RESONANCES_SIM = (4.25, 8.75, 19.5)

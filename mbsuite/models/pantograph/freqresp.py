@@ -49,6 +49,7 @@ from .freq_grid import (
     MAX_FREQUENCIES,
     METHODS,
     PEAK_SIGNALS,
+    SIGNAL_WORDS,
     THESIS_FREQS,
     THESIS_RESONANCES_MEAS,
     THESIS_RESONANCES_SIM,
@@ -74,8 +75,8 @@ __all__ = [
     "PEAK_SIGNALS", "SECTION_KEYS", "STENCIL_SHRINK", "THESIS_FREQS", "THESIS_RESONANCES_MEAS",
     "THESIS_RESONANCES_SIM", "TIME_METHODS", "Peak", "_point", "check_grid", "estimate_headlines", "estimate_method",
     "estimate_summary", "estimate_values", "freqresp", "grid_maxima", "headline_values", "linear_peaks",
-    "method_curves", "mujoco_sweep", "refine_peaks", "sweep_method", "time_history_runs", "time_peaks",
-    "validate_section", "vertex",
+    "method_curves", "mujoco_sweep", "refine_peaks", "study_curves", "sweep_method", "time_history_runs",
+    "time_peaks", "validate_section", "vertex",
 ]
 
 Curves = dict[str, dict[str, np.ndarray]]
@@ -116,6 +117,29 @@ def freqresp(scene: Scene, f_min: float | None = None, f_max: float | None = Non
     if warned and not scene.solver.allow_inaccurate:
         raise InaccurateResult(warned, rep)
     return rep
+
+
+def study_curves(data: dict[str, Any]) -> tuple[list[dict[str, Any]], tuple[str, ...]]:
+    """The curves of a `freqresp` report's data, for a `--vary` study (`mbsuite.cli.study`): one per method and
+    signal, the amplitude ratio of the signal's fundamental to the ram's (m/m) and its phase relative to the ram's
+    (deg, negative = lag; the report's own values, unchanged) against the forcing frequency (Hz); and the data keys
+    that hold them (`frequencies_hz`, `response`)."""
+    from .outputs import UNITS
+
+    freqs = data["frequencies_hz"]
+    curves = []
+    for method, signals in data["response"].items():
+        for s in FR_SIGNALS:
+            words = SIGNAL_WORDS[s]
+            curves.append({
+                "output": s, "title": f"{words}: response to the ram input", "method": method,
+                "x": {"name": "frequency", "unit": "Hz", "label": "forcing frequency", "values": freqs},
+                "y": [{"name": "amplitude", "unit": f"{UNITS[s]}/{UNITS['y_w']}", "scale": "log",
+                       "label": f"{words.split(' = ')[0]} per unit ram amplitude",
+                       "values": signals[s]["amplitude"]},
+                      {"name": "phase", "unit": "deg", "period": 360.0,
+                       "label": f"phase of {s} relative to the ram input", "values": signals[s]["phase_deg"]}]})
+    return curves, ("frequencies_hz", "response")
 
 
 def _curves(scene: Scene, freqs: np.ndarray, methods: tuple[str, ...], peak_tol: float,

@@ -89,9 +89,18 @@ MUTATIONS: tuple[Mutation, ...] = (
              "the command line keeps the last of two overrides of one key (--set and --vary, or --vary twice): one "
              "is dropped silently", "tests/suite/test_overrides.py"),
     Mutation("statistics_undeclared_accepted", "mbsuite/statistics.py",
-             "    missing = sorted(k for k in values if lookup(table, k) is None)",
-             "    missing = sorted(k for k in values if k not in values)",
-             "a statistic without a declaration accepted silently (a number without unit, definition or window)",
+             "    missing = sorted(k for k in values if lookup(table, k) is None)\n"
+             "    if missing:\n"
+             "        raise KeyError(f\"model '{model}' declares no statistic {missing}; add them to its "
+             "statistics\")\n"
+             "    out: dict[str, float | bool] = {}\n"
+             "    for k, v in values.items():\n"
+             "        stat = lookup(table, k)\n",
+             "    out: dict[str, float | bool] = {}\n"
+             "    for k, v in values.items():\n"
+             "        stat = lookup(table, k) or next(iter(table.values()))\n",
+             "a statistic without a declaration accepted silently, under the first declared statistic's unit, "
+             "definition and window",
              "tests/suite/test_statistics.py"),
     Mutation("band_system_not_checked", "mbsuite/registry.py",
              "        if system not in self.systems:",

@@ -1,8 +1,8 @@
-"""How long the command line takes to answer: `mbsuite --version`, `--help`, `list` and an argument error, each
-against a bare `python -c pass` measured in the same run (median of 7 wall-clock runs each), printed side by side with
-their ratio. A benchmark, not a test: run it on a quiet machine.
+"""How long the command line takes to answer: `mbsuite --version`, `--help`, `list`, an argument error and the
+subcommands' help, each against a bare `python -c pass` measured in the same run (median of 7 wall-clock runs each),
+printed side by side with their ratio. A benchmark, not a test: run it on a quiet machine.
 
-    python scripts/cli_startup.py            # the four commands
+    python scripts/cli_startup.py            # every command above
     python scripts/cli_startup.py --repeats 11
 """
 
@@ -19,6 +19,13 @@ COMMANDS = {
     "mbsuite --help": ["--help"],
     "mbsuite list": ["list"],
     "mbsuite run (argument error)": ["run", "--no-such-option"],
+    "mbsuite catenary --help": ["catenary", "--help"],
+    "mbsuite pantograph --help": ["pantograph", "--help"],
+    "mbsuite modes --help": ["modes", "--help"],
+    "mbsuite coupler criteria --help": ["coupler", "criteria", "--help"],
+    "mbsuite drive run --help": ["drive", "run", "--help"],
+    "mbsuite rotational --help": ["rotational", "--help"],
+    "mbsuite optimise --help": ["optimise", "--help"],
 }
 
 

@@ -95,10 +95,11 @@ class Parser(argparse.ArgumentParser):
         return super().parse_known_args(args, namespace)
 
 
-def build_parser(models: bool = True) -> argparse.ArgumentParser:
+def build_parser(models: bool = True, only: str | None = None) -> argparse.ArgumentParser:
     """The `mbsuite` argument parser: the generic commands plus each model's own command group (`models=False`: the
-    light parser, whose model commands are declared stubs that parse nothing). The groups, model -> command name, are
-    the parser's default `cli_groups` (what `mbsuite list` shows)."""
+    light parser, whose model commands are declared stubs that parse nothing; `only`: that model's group in full, the
+    others' declared stubs). The groups, model -> command name, are the parser's default `cli_groups` (what `mbsuite
+    list` shows)."""
     from ..version import __version__
 
     ap = Parser(
@@ -108,11 +109,14 @@ def build_parser(models: bool = True) -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"mbsuite {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
     add_generic_commands(sub)
-    declared = None if models else (declared_commands() or {})
+    declared = None if models and only is None else (declared_commands() or {})
     if declared is None:
         ap.set_defaults(cli_groups=add_model_groups(sub))
     else:
-        for commands in declared.values():
+        full = add_model_groups(sub, only) if only is not None else {}
+        for model, commands in declared.items():
+            if model in full:
+                continue
             for name, helptext in commands.items():
                 sub.add_parser(name, help=helptext, add_help=False)
         ap.set_defaults(cli_groups={model: next(iter(commands)) for model, commands in declared.items()})
@@ -129,8 +133,8 @@ def parser_for(argv: list[str]) -> argparse.ArgumentParser:
         light = command in GENERIC and command != "list" or (command is None and "--version" in argv
                                                                  and not {"-h", "--help"} & set(argv))
         return build_parser(models=not light)
-    model_commands = {c for commands in declared.values() for c in commands}
-    return build_parser(models=command in model_commands)
+    owner = next((model for model, commands in declared.items() if command in commands), None)
+    return build_parser(models=owner is not None, only=owner)  # a model's command: only its module is imported
 
 
 def add_generic_commands(sub: argparse._SubParsersAction) -> None:
@@ -302,14 +306,14 @@ def _design_ranges(p: argparse.ArgumentParser) -> None:
                    help="change one value of the scene at every point, e.g. params.n_spans=4 (repeatable)")
 
 
-def add_model_groups(sub: argparse._SubParsersAction) -> dict[str, str]:
-    """Let each model that declares a command module (`SPEC.commands`) add its command group; returns model -> the
-    group's command name."""
+def add_model_groups(sub: argparse._SubParsersAction, only: str | None = None) -> dict[str, str]:
+    """Let each model that declares a command module (`SPEC.commands`; `only`: that model alone) add its command
+    group; returns model -> the group's command name."""
     from .. import registry
 
     groups: dict[str, str] = {}
     for name, spec in sorted(registry.models().items()):
-        if spec.commands is None:
+        if spec.commands is None or only is not None and name != only:
             continue
         group = importlib.import_module(spec.commands).register(sub, add_common, emit)
         if group not in sub.choices:

@@ -70,3 +70,37 @@ def test_light_and_whole_parser_read_a_generic_command_alike():
     assert light.pop("func").__name__ == whole.pop("func").__name__ == "cmd_sweep"
     light.pop("cli_groups"), whole.pop("cli_groups")
     assert light == whole
+
+
+ENGINES = ("scipy", "matplotlib", "mujoco", "pinocchio", "mbsuite.engines.core", "mbsuite.engines.mujoco_engine",
+           "mbsuite.engines.pinocchio_engine", "mbsuite.engines.native")
+
+
+@pytest.mark.parametrize("argv", [["catenary", "--help"], ["pantograph", "--help"], ["pantograph", "fit-lumped",
+                                                                                    "--help"],
+                                  ["modes", "--help"], ["coupler", "criteria", "--help"], ["optimise", "--help"],
+                                  ["compare", "--help"]])
+def test_a_commands_help_loads_its_own_model_only_and_no_engine(argv):
+    """A model command's --help builds that model's command group alone (no other model's cli module) and imports
+    no engine, scipy or matplotlib."""
+    out = subprocess.run([sys.executable, "-c", PROBE, *argv], capture_output=True, text=True, check=True).stdout
+    data = json.loads(out)
+    assert data["code"] == 0
+    clis = [m for m in data["modules"] if m.startswith("mbsuite.models.") and m.endswith(".cli")]
+    declared = declared_commands() or {}
+    owner = [f"mbsuite.models.{model}.cli" for model, commands in declared.items() if argv[0] in commands]
+    assert clis == owner, clis
+    heavy = [m for m in data["modules"] if m.startswith(ENGINES)]
+    assert heavy == [], f"mbsuite {' '.join(argv)} imports {heavy[:8]}"
+
+
+def test_fit_defaults_reach_the_command_line_and_the_api():
+    """The transfer-function fit's default order is a number on both routes (the command line's default and the
+    study's keyword), the one the fit declares."""
+    import inspect
+
+    from mbsuite.models.pantograph import lumped_study
+    from mbsuite.models.pantograph.fit_defaults import DEFAULT_ORDER
+
+    args = build_parser().parse_args(["pantograph", "fit-lumped"])
+    assert args.order == DEFAULT_ORDER == inspect.signature(lumped_study.fit_report).parameters["order"].default == 7

@@ -18,7 +18,7 @@ from ...cli.options import (
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError
 from ...scenes import Scene
-from .freqresp import DEFAULTS, LIMITS, METHODS, check_grid
+from .freq_grid import DEFAULTS, LIMITS, METHODS, check_grid
 
 MODEL = "pantograph"
 COMMANDS = {
@@ -80,7 +80,7 @@ def _add_options(p: argparse.ArgumentParser, name: str, add_common, emit) -> Non
 
 
 def _add_fit_options(p: argparse.ArgumentParser) -> None:
-    from .lumped_fit import BAND, DF, ORDER, STARTS
+    from .fit_defaults import BAND, DEFAULT_ORDER, DF, STARTS
 
     p.add_argument("--stages", type=int, default=2, help="stages of the lumped pantograph (1 to 6; default 2)")
     p.add_argument("--band", default=f"{BAND[0]:g}:{BAND[1]:g}", metavar="LO:HI",
@@ -88,8 +88,8 @@ def _add_fit_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--df", type=float, default=DF, help=f"frequency spacing of the band (Hz; default {DF:g})")
     p.add_argument("--height", type=float, default=None,
                    help="working (ram/wire) height above the base pivot (m) to linearise at (default: params.y_op)")
-    p.add_argument("--order", type=int, default=ORDER,
-                   help=f"order of the transfer function (denominator degree, 2 to 16; default {ORDER})")
+    p.add_argument("--order", type=int, default=DEFAULT_ORDER,
+                   help=f"order of the transfer function (denominator degree, 2 to 16; default {DEFAULT_ORDER})")
     p.add_argument("--starts", type=int, default=STARTS,
                    help=f"starts of the lumped fit's multi-start (default {STARTS})")
     p.add_argument("--seed", type=int, default=0, help="seed of the starts (default 0)")

@@ -40,16 +40,11 @@ from ...components.linear_pantograph import LumpedParams, TransferParams, chain_
 from ...errors import ParameterError
 from ...limits import Limit
 from .equations import PantographConfig, PantographODE
+from .fit_defaults import BAND, DEFAULT_ORDER, DF, POLISH_NFEV, POLISHED, START_NFEV, START_POINTS, STARTS  # noqa: F401
 from .params import PantographParams
 
-#: the multi-start of the lumped fit: this many log-uniform starts inside `START_BOX`, each at most `START_NFEV`
-#: evaluations on at most about `START_POINTS` of the frequencies, the best `POLISHED` polished on all of them (at
-#: most `POLISH_NFEV` evaluations each)
-STARTS, START_NFEV, START_POINTS, POLISHED, POLISH_NFEV = 32, 100, 80, 3, 2000
 #: the log-uniform box of the starts: masses (kg), springs (N/m), dampers (N s/m)
 START_BOX = {"m": (1.0, 100.0), "k": (10.0, 1e6), "c": (1.0, 1e4)}
-#: the default band (Hz), its spacing (Hz), the transfer function's default order
-BAND, DF, ORDER = (0.0, 20.0), 0.05, 7
 
 
 @dataclass(frozen=True)

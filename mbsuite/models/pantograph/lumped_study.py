@@ -15,8 +15,9 @@ import numpy as np
 from ...errors import ParameterError
 from ...results import Report, format_table, write_csv
 from ...scenes import Scene
+from .fit_defaults import BAND, DEFAULT_ORDER, DF, STARTS
 from .inputs import config_of
-from .lumped_fit import BAND, DF, ORDER, STARTS, band_freqs, driving_point, fit_error, fit_lumped, fit_transfer
+from .lumped_fit import band_freqs, driving_point, fit_error, fit_lumped, fit_transfer
 
 #: the fit error is also reported above this frequency (Hz): below it the model's receptance is set by its negative
 #: static stiffness and the cylinder, which no positive chain has
@@ -48,7 +49,7 @@ BASE_SPRINGS = ("static", "fitted")
 
 
 def fit_report(scene: Scene, stages: int = 2, band: tuple[float, float] = BAND, df: float = DF,
-               height: float | None = None, order: int = ORDER, starts: int = STARTS, seed: int = 0,
+               height: float | None = None, order: int = DEFAULT_ORDER, starts: int = STARTS, seed: int = 0,
                base_spring: str = "static") -> Report:
     """Fit an n-stage lumped and an order-`order` transfer-function pantograph to the driving-point receptance of the
     pantograph `scene` (its parameters and effects) at ram height `height` (m; default its y_op) over `band` (Hz,

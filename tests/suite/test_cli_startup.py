@@ -79,7 +79,7 @@ ENGINES = ("scipy", "matplotlib", "mujoco", "pinocchio", "mbsuite.engines.core",
 @pytest.mark.parametrize("argv", [["catenary", "--help"], ["pantograph", "--help"], ["pantograph", "fit-lumped",
                                                                                     "--help"],
                                   ["modes", "--help"], ["coupler", "criteria", "--help"], ["optimise", "--help"],
-                                  ["compare", "--help"]])
+                                  ["compare", "--help"], ["drive", "run", "--help"], ["rotational", "--help"]])
 def test_a_commands_help_loads_its_own_model_only_and_no_engine(argv):
     """A model command's --help builds that model's command group alone (no other model's cli module) and imports
     no engine, scipy or matplotlib."""

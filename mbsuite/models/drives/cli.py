@@ -9,21 +9,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ...analysis.errorestimate import error_estimate
 from ...cli.options import SCENE_HELP, add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError, SceneError
 from ...limits import Limit
-from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import scene_from_dict
 from ...trust.health import InaccurateResult, judge, judge_estimate
-from . import accuracy
 from . import design as D
-from .analysis import design_tables, efficiency, simulate_scene
 from .design_scene import BASE_SETS, DesignInputs, design_scene, scene_toml
-from .plots import cadjs_figure, loss_label, run_figure
-from .scene_run import sim_result
 
 #: the commands `register` adds (read by the command line's light parser without importing the model)
 CLI_COMMANDS = {"drive": "switched-mode drives: design tools, runs, efficiency",
@@ -132,6 +126,8 @@ def _csv_writer(name: str, columns: list[tuple[str, str, list]], figure=None):
 
 def _write_csv(name: str, columns: list[tuple[str, str, list]], figure, out: Path) -> list[Path]:
     """The files of a design command's `--out`: `name`.csv and, with a figure, `name`.png."""
+    from ...plotting import save
+
     files = [write_csv(Path(out) / f"{name}.csv", columns)]
     if figure is not None:
         files.append(save(figure(), Path(out) / f"{name}.png"))
@@ -240,6 +236,8 @@ def register(sub, add_common, emit) -> str:
 # ---- the commands (each takes the top-level `emit` and the parsed arguments) -----------------------------------------
 def design_tables_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design tables`: Tables 5.2 and 6.2 and the controller gains (`analysis.design_tables`)."""
+    from .analysis import design_tables
+
     emit(design_tables(), a, None)
 
 
@@ -263,6 +261,8 @@ def srmin_cmd(emit, a: argparse.Namespace) -> None:
 
 def cadjs_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design cadjs`: the CADJS families (Eqs 5.9-5.13 corrected), or one read at --tau-c."""
+    from .plots import cadjs_figure
+
     flags = ("--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c", "--wop", "--Jl", "--taul", "--pmotor",
              "--scene-duration")
     _check_options(a, *flags)
@@ -371,6 +371,12 @@ def run_cmd(emit, a: argparse.Namespace) -> None:
 def run_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive run` on scene `sc` (the command's, or a study point's): health figures judged as by
     `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
+    from ...analysis.errorestimate import error_estimate
+    from . import accuracy
+    from .analysis import simulate_scene
+    from .plots import loss_label
+    from .scene_run import sim_result
+
     res = sim_result(sc, *simulate_scene(sc))
     what = f"drives scene {sc.name or sc.source or ''}".strip()
     res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate, what=what))
@@ -407,6 +413,9 @@ def run_of(sc, a: argparse.Namespace) -> Report:
 
 def _write_run(res, out: Path) -> list[Path]:
     """The files of `drive run --out`: the time series (run.csv, as `mbsuite run --out`) and the run figure."""
+    from ...plotting import save
+    from .plots import run_figure
+
     return [res.write_csv(Path(out) / "run.csv"), save(run_figure(res), Path(out) / "run.png")]
 
 
@@ -419,6 +428,8 @@ def efficiency_cmd(emit, a: argparse.Namespace) -> None:
 
 def efficiency_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive efficiency` on scene `sc` (`analysis.efficiency`)."""
+    from .analysis import efficiency
+
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))
     try:
         rep = efficiency(sc, loads, engine=a.engine, error_estimate=a.error_estimate)

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ...errors import ParameterError
 from ...limits import Limit, positive
@@ -180,6 +179,8 @@ def at_clutch_torque(P: float, Sr_min: float, w_min: float, w_max: float, V_m: f
     lo, hi = 1e-8, 1e-1
     if f(lo) > 0 or f(hi) < 0:
         raise ParameterError(f"clutch torque {tau_c} N m is outside the family for Sr_min = {Sr_min}")
+    from scipy.optimize import brentq  # here: the design module is read by the command line's help
+
     js = brentq(f, lo, hi, xtol=1e-14, rtol=1e-12)
     return design_point(P, Sr_min, w_min, w_max, V_m, js)
 

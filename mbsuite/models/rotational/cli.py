@@ -14,13 +14,9 @@ import numpy as np
 from ...cli.options import add_error_estimate, add_scene_options
 from ...errors import MbsuiteError
 from ...limits import Limit
-from ...plotting import save
 from ...results import Report, format_table, write_csv
 from ...scenes import DEFAULT_MAX_STEPS, load_scene
 from ...trust.health import judge_estimate
-from . import coupled_clutches as cc
-from .analysis import coupled_clutches_table
-from .plots import coupled_clutches_figure
 
 #: the commands `register` adds (read by the command line's light parser without importing the model)
 CLI_COMMANDS = {"rotational": "Modelica Rotational examples: CoupledClutches on both paths vs the Dymola reference"}
@@ -80,6 +76,9 @@ def _nan(x: float | None) -> float:
 
 def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
     """`rotational coupled-clutches`: both paths against the Dymola reference (`analysis.coupled_clutches_table`)."""
+    from . import coupled_clutches as cc  # here, not at parse time (the command's help imports no engine)
+    from .analysis import coupled_clutches_table
+
     TIMESTEP.check("--timestep", a.timestep, MbsuiteError)
     _check_steps("--timestep", cc.T_END, a.timestep)
     scene = _solver_options(load_scene("rotational/coupled_clutches"), a)
@@ -129,6 +128,9 @@ def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
 def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_cols: list, w_cols: list,
                             out: Path) -> list[Path]:
     """The files of `rotational coupled-clutches --out`: events and speeds as CSV, the comparison figure."""
+    from ...plotting import save
+    from .plots import coupled_clutches_figure
+
     fig = coupled_clutches_figure(d, ref_t, ref_w)
     return [write_csv(Path(out) / "coupled_clutches_events.csv", ev_cols),
             write_csv(Path(out) / "coupled_clutches_w.csv", w_cols),

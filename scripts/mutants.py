@@ -81,6 +81,7 @@ NON_PHYSICS: tuple[tuple[str, str], ...] = (
     ("tests/suite/test_cli.py::test_list_shows_each_models_paths_and_groups", "listing of models and paths"),
     ("tests/suite/test_cli.py::test_engine_override_takes_a_path_key_or_label_and_names_the_flag", "CLI error text"),
     ("tests/suite/test_docs.py", "documentation examples run and parse"),
+    ("tests/catenary/test_readme_numbers.py", "README tables equal the run they quote"),
     ("tests/suite/test_api_docs.py", "docstrings"),
     ("tests/suite/test_render.py", "rendered images"),
 )

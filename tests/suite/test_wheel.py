@@ -96,6 +96,9 @@ COMMANDS = [
     (["equilibrium", "pantograph", "--json"], 0),
     (["modes", "pantograph", "--json"], 0),
     (["freqresp", "pantograph", "--methods", "linear", "--f-min", "1", "--f-max", "3", "--df", "1", "--json"], 0),
+    (["run", "iftomm/fourbar", "--out", "fourbar_a"], 0),
+    (["run", "iftomm/fourbar", "--set", "input.rate=5", "--out", "fourbar_b"], 0),
+    (["compare", "fourbar_a", "fourbar_b", "--json"], 0),
 ]
 
 PROBE_CLI = r"""

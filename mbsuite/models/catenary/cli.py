@@ -48,8 +48,24 @@ def register(sub, add_common, emit) -> str:
     add_scene_options(p)
     add_study_options(p)
     add_common(p)
-    p.set_defaults(func=cmd_catenary, emit=emit)
+    p.set_defaults(func=cmd_catenary, emit=_without_unread_solver(emit))
     return COMMAND
+
+
+#: the solver settings a catenary passage reads (the rest, MuJoCo's integrator and the equations path's, it does not)
+SOLVER_READ = ("engine", "timestep", "duration", "allow_inaccurate", "max_steps")
+
+
+def _without_unread_solver(emit):
+    """The CLI's `emit` with the scene it records (summary.json) holding only the solver settings a catenary passage
+    reads (`SOLVER_READ`); a rerun of the summary fills the others with their defaults, which it does not read."""
+
+    def out(report, args, scene_dict):
+        if scene_dict is not None and isinstance(scene_dict.get("solver"), dict):
+            scene_dict = {**scene_dict, "solver": {k: v for k, v in scene_dict["solver"].items() if k in SOLVER_READ}}
+        return emit(report, args, scene_dict)
+
+    return out
 
 
 class _Percent:
@@ -135,7 +151,7 @@ def catenary_of(scene: Scene, args: argparse.Namespace) -> Report:
     if "train" in scene.sections:
         with Progress(100, desc="catenary train") as bar:
             run = run_train_scene(scene, progress=_Percent(bar))
-        rep = train_report(run, quality=criteria)
+        rep = train_report(run, quality=criteria, scene_dict=scene.to_dict())
         if args.error_estimate:
             add_estimate(rep, scene, run.stats, workers)
         return rep

@@ -26,6 +26,7 @@ import csv
 import dataclasses
 import re
 import tomllib
+import warnings
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ from .irregularity import SECTION as IRREGULARITY
 from .irregularity import check_irregularity
 from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, Support, Wire
 from .lines import CompoundParams, StitchParams
+from .mesh import line_of
 
 TABLES = ("supports", "droppers", "clamps", "masses")
 #: most rows of one table (a tension section of 1 600 m has ~30 supports and ~250 droppers)
@@ -330,8 +332,27 @@ def scene_params(scene) -> Any:
     from .params import CatenaryParams
 
     section = scene.sections.get("line")
+    given = dict(scene.params)
     if section is not None and section["kind"] == "file":
-        return CatenaryParams(**dict(scene.params), line=build_line(section, None, scene.params))
-    p = CatenaryParams(**dict(scene.params))
-    line = build_line(section, p, scene.params)
-    return p if line is None else dataclasses.replace(p, line=line)
+        line = build_line(section, None, scene.params)
+        return _windowed(line, given, lambda **w: CatenaryParams(**{**given, **w}, line=line))
+    p = CatenaryParams(**given)
+    line = build_line(section, p, scene.params) or line_of(p)
+    return _windowed(line, given, lambda **w: dataclasses.replace(
+        p, **w, **({} if section is None else {"line": line})))
+
+
+def _windowed(line: Line, given: Mapping[str, Any], make: Any) -> Any:
+    """The parameters `make(**window)` with the statistics window: the scene's (a `WindowOffSupportWarning` where an
+    edge is off the supports of `line`), else `marks.default_window(line)` (on the EN 50318 line the parameters'
+    own default, [240, 360] m)."""
+    from .marks import WindowOffSupportWarning, default_window, window_off_supports
+
+    if "window_start" in given or "window_end" in given:
+        p = make()
+        msg = window_off_supports(line, p.window_start, p.window_end)
+        if msg is not None:
+            warnings.warn(msg, WindowOffSupportWarning, stacklevel=4)
+        return p
+    a, b = default_window(line)
+    return make(window_start=a, window_end=b)

@@ -13,6 +13,7 @@ from ...results import Report, SimResult, format_table, write_csv
 from ...results import assemble as assemble_result
 from .analysis import CatenaryRun, scene_config, single
 from .config import health_of_regime
+from .marks import line_identity, line_label
 from .plots import force_uplift_figure, train_figure
 from .quality import QualityCriteria, assess, criteria_from
 from .quality import plot as quality_plot
@@ -59,6 +60,13 @@ def _scalar_stats(run: CatenaryRun) -> dict:
     return {k: run.stats[k] for k in STAT_NAMES}
 
 
+def rerun_record(p, scene_dict: dict | None) -> dict[str, Any]:
+    """What a rerun needs besides the scene (summary.json's results): the statistics `window` actually used
+    ([start, end] m) and the `line`'s identity (`marks.line_identity`: its name; a line file's path and SHA-256)."""
+    file = ((scene_dict or {}).get("line") or {}).get("file")
+    return {"window": [p.window_start, p.window_end], "line": line_identity(p, file)}
+
+
 def window_time(stats: dict, dt: float) -> float:
     """Time (s) the pantograph spent in the statistics window (its window samples times dt)."""
     return float(stats["n_samples_window"]) * dt
@@ -89,8 +97,9 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
         rows.append(row)
     what = "EN 50318 reference scene" if run.is_reference else "catenary passage (EN 50318 statistics)"
     path = "" if run.engine == "reference" else f" ({run.engine} path)"
-    lines = [f"{what}, {run.pantograph} pantograph{path}, {run.speed_kmh:g} km/h "
-             f"(element {run.params.element_length:g} m, dt {run.dt:g} s)", format_table(headers, rows)]
+    lines = [f"{what} on the {line_label(run.params)}, {run.pantograph} pantograph{path}, {run.speed_kmh:g} km/h "
+             f"(element {run.params.element_length:g} m, dt {run.dt:g} s, window [{run.params.window_start:g}, "
+             f"{run.params.window_end:g}] m)", format_table(headers, rows)]
     for r in runs:
         c = r.stats["loss_counts"]
         lines.append(f"[{r.dropper_law}] contact losses in window: {len(r.stats['loss_events'])} "
@@ -107,7 +116,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
         lines.append(textwrap.fill(f"WARNING: {w}", 100, subsequent_indent="  "))
     data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "engine": run.engine,
             "element_length": run.params.element_length,
-            "timestep": run.dt, "regime": {k: v for k, v in run.regime.items() if k != "warnings"},
+            "timestep": run.dt, **rerun_record(run.params, scene_dict),
+            "regime": {k: v for k, v in run.regime.items() if k != "warnings"},
             "warnings": run.warnings,
             "runs": {r.dropper_law: {"statistics": _scalar_stats(r), "ranges": r.ranges,
                                      "uplift_at_supports_mm": r.stats["uplift_at_supports_mm"],
@@ -171,14 +181,15 @@ def train_assessments(run: TrainRun, criteria: QualityCriteria) -> list[dict]:
     return [assess(s, run.speed_kmh, criteria, float(s["n_samples_window"]) * run.dt) for s in run.stats]
 
 
-def train_report(run: TrainRun, quality: QualityCriteria | None = None) -> Report:
+def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_dict: dict | None = None) -> Report:
     """Table (one column per pantograph), JSON data and writer (per-pantograph CSV, force/uplift plot, quality plot)
     of a train passage; `quality` (QualityCriteria) adds the quality report of every pantograph."""
     from ...plotting import save
 
     labels = [_label(run, k) for k in range(len(run.names))]
     rows = [[STAT_NAMES[key]] + [f"{s[key]:.2f}" for s in run.stats] for key in STAT_KEYS]
-    lines = [f"train of {len(run.names)} pantographs, {run.speed_kmh:g} km/h (element {run.params.element_length:g} m, "
+    lines = [f"train of {len(run.names)} pantographs on the {line_label(run.params)}, {run.speed_kmh:g} km/h "
+             f"(element {run.params.element_length:g} m, "
              f"dt {run.dt:g} s, {run.timing['steps']} steps, {run.timing['cpu_s']:.2f} s CPU); window "
              f"[{run.params.window_start:g}, {run.params.window_end:g}] m on each pantograph's own position",
              format_table(["statistic", *labels], rows)]
@@ -190,6 +201,7 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None) -> Repor
     for w in run.warnings:
         lines.append(f"WARNING: {w}")
     data = {"speed_kmh": run.speed_kmh, "element_length": run.params.element_length, "timestep": run.dt,
+            **rerun_record(run.params, scene_dict),
             "timing": run.timing,
             "pantographs": [{"name": run.names[k], "engine": run.engines[k], "offset_m": run.offsets[k],
                              "static_contact_force": run.static_forces[k],

@@ -71,6 +71,10 @@ class Progress:
         """Advance by `k` units."""
         self._bar.update(k)
 
+    def write(self, text: str, stream: TextIO) -> None:
+        """A line on `stream` above the bar (the bar redrawn below it)."""
+        self._bar.write(text, file=stream)
+
     def __enter__(self) -> Progress:
         return self
 
@@ -145,7 +149,7 @@ class Study:
         text = f"mbsuite {self.command}: {text.removeprefix(self.command + ': ')}"
         if not self.quiet:
             if self._bar is not None:
-                self._bar._bar.write(text, file=self.stream)
+                self._bar.write(text, self.stream)
             else:
                 print(text, file=self.stream, flush=True)
 

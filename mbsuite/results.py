@@ -236,6 +236,32 @@ SUFFIX_UNITS = {"_hz": "Hz", "_m": "m", "_mm": "mm", "_s": "s", "_deg": "deg", "
 COUNT_NAMES = {"evaluations": "1", "steps": "1", "dofs": "1", "n_samples": "1", "count": "1", "n": "1"}
 
 
+#: a list of numbers longer than this is a curve or a time series, not a quantity of a report
+MAX_LIST = 16
+
+
+def numbers_in(data: Any, prefix: str = "", unit: str = "", skip: frozenset[str] = frozenset()
+               ) -> list[tuple[str, float, str]]:
+    """Every number of a report's data as (dotted path `reference[1].f_n`, value, the unit recorded beside it: a
+    mapping's "unit" holds for its numbers); keys in `skip` (at any depth), booleans, strings and lists longer than
+    `MAX_LIST` (curves, time series) left out."""
+    out: list[tuple[str, float, str]] = []
+    if isinstance(data, Mapping):
+        own = data.get("unit")
+        unit = own if isinstance(own, str) else unit
+        for k, v in data.items():
+            if k in skip or k == "unit":
+                continue
+            out += numbers_in(v, f"{prefix}.{k}" if prefix else str(k), unit, skip)
+    elif isinstance(data, list | tuple):
+        if len(data) <= MAX_LIST:
+            for i, v in enumerate(data):
+                out += numbers_in(v, f"{prefix}[{i}]", unit, skip)
+    elif isinstance(data, int | float) and not isinstance(data, bool):
+        out.append((prefix, float(data), unit))
+    return out
+
+
 def names_of(path: str) -> list[str]:
     """The names of a reported number's path, indices dropped (`peaks_hz.linear.F1[0]` -> peaks_hz, linear, F1)."""
     return [n.split("[")[0] for n in path.split(".") if n.split("[")[0]]

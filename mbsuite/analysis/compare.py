@@ -7,7 +7,7 @@ model group's command and its top-level alias are one: `pantograph freqresp` is 
 with a study; else a `MbsuiteError` names both kinds (exit 2). The headlines are the numbers of the results: a summary
 holding statistics (a time run's declared statistics, a catenary passage's EN 50318 statistics) or signal ranges
 (a time run's min/max/final) compares those, and any number named as a declared statistic of its scene's model (the
-static contact force); any other compares every number of its results (lists of at most `MAX_LIST`: modes, peaks)
+static contact force); any other compares every number of its results (short lists: modes, peaks)
 but bookkeeping (`BOOKKEEPING`: timings, solver counters, health figures, warnings, events). A headline's unit: the
 unit the summary records beside it, else the model's declarations (statistics, the command's units table passed in
 `units_for`, parameters, inputs, solver settings), else the unit its name spells (`results.unit_source`). A headline
@@ -32,10 +32,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MbsuiteError
-from ..results import Report, format_table, names_of, unit_source, write_csv
+from ..results import Report, format_table, names_of, numbers_in, unit_source, write_csv
 
-#: lists longer than this are curves or time series (the signals' business), not headlines
-MAX_LIST = 16
 #: keys of a summary's results that hold no physics to compare (at any depth)
 BOOKKEEPING = frozenset({"timing", "stats", "health", "error_estimate", "warnings", "events", "loss_events",
                          "input", "solver", "inaccurate", "files", "versions", "checkout", "command", "scene"})
@@ -116,23 +114,9 @@ def kind_of(body: Mapping[str, Any]) -> tuple[str, str]:
 
 
 def numbers(data: Any, prefix: str = "", unit: str = "") -> list[tuple[str, float, str]]:
-    """Every number of `data` as (dotted path, value, the unit recorded beside it: a mapping's "unit" holds for its
-    numbers), `BOOKKEEPING` keys, booleans, strings and lists longer than `MAX_LIST` left out."""
-    out: list[tuple[str, float, str]] = []
-    if isinstance(data, Mapping):
-        own = data.get("unit")
-        unit = own if isinstance(own, str) else unit
-        for k, v in data.items():
-            if k in BOOKKEEPING or k == "unit":
-                continue
-            out += numbers(v, f"{prefix}.{k}" if prefix else str(k), unit)
-    elif isinstance(data, list | tuple):
-        if len(data) <= MAX_LIST:
-            for i, v in enumerate(data):
-                out += numbers(v, f"{prefix}[{i}]", unit)
-    elif isinstance(data, int | float) and not isinstance(data, bool):
-        out.append((prefix, float(data), unit))
-    return out
+    """Every number of `data` as (dotted path, value, the unit recorded beside it), `BOOKKEEPING` keys, booleans,
+    strings and lists longer than `results.MAX_LIST` left out (`results.numbers_in`)."""
+    return numbers_in(data, prefix, unit, BOOKKEEPING)
 
 
 def display_name(path: str) -> str:

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypedDict
 
 from ..errors import MbsuiteError
-from ..results import names_of, unit_source
+from ..results import names_of, numbers_in, unit_source
 from ..trust.health import InaccurateResult
 from .options import SCENE_SECTIONS
 
@@ -42,7 +42,6 @@ SECTIONS = SCENE_SECTIONS
 INACCURATE = "_inaccurate"
 #: the key of a study point's result that holds its curves (`Curve` dictionaries)
 CURVES = "_curves"
-MAX_LIST = 16  # a list of numbers longer than this is a curve or a time series, not a quantity of the study
 #: at most this many value columns in one block of a wide table (a longer group is printed in several blocks)
 WIDE_COLUMNS = 8
 
@@ -113,19 +112,9 @@ def apply_sets(scene: Scene, sets: list[str] | None) -> Scene:
 
 
 def flatten(data: Any, prefix: str = "") -> dict[str, float]:
-    """The numbers of a report's data as `path -> value` (`reference[1].f_n`); booleans, strings and long lists (curves,
-    time series) are left out."""
-    out: dict[str, float] = {}
-    if isinstance(data, dict):
-        for k, v in data.items():
-            out.update(flatten(v, f"{prefix}.{k}" if prefix else str(k)))
-    elif isinstance(data, list | tuple):
-        if len(data) <= MAX_LIST:
-            for i, v in enumerate(data):
-                out.update(flatten(v, f"{prefix}[{i}]"))
-    elif isinstance(data, int | float) and not isinstance(data, bool):
-        out[prefix] = float(data)
-    return out
+    """The numbers of a report's data as `path -> value` (`reference[1].f_n`; `results.numbers_in`): booleans,
+    strings and long lists (curves, time series) left out."""
+    return {path: value for path, value, _ in numbers_in(data, prefix)}
 
 
 def study_point(target: str, options: dict[str, Any], job: tuple[dict | None, dict],

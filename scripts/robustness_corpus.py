@@ -633,6 +633,18 @@ def cli_attempts() -> Iterator[Attempt]:
     for v in ("0", "-1", "nan", "inf", "1e13", "abc", "0.5"):
         yield cli(f"run-max-steps={v}", a, f"run --max-steps {v}", ("run", "pantograph", "--max-steps", v),
                   culprit="max-steps|max_steps")
+    for v in ("0", "-1", "nan", "inf", "abc"):
+        yield cli(f"sweep-budget={v}", a, f"sweep --budget {v}",
+                  ("sweep", "pantograph", "--vary", "input.frequency=2,4", "--budget", v), culprit="budget")
+    yield cli("sweep-over-budget", a, "a sweep whose estimate exceeds --budget stops naming --yes",
+              "sweep pantograph --vary input.frequency=2,4,6,8 --workers 1 --budget 0.001", culprit="--yes")
+    yield cli("run-speed-without-a-speed", a, "--speed on a scene whose model has no speed",
+              "run pantograph --speed 200", culprit="speed")
+    yield cli("run-speed-and-set", a, "--speed and --set input.speed together",
+              "run catenary/en50318 --speed 200 --set input.speed=100", culprit="--speed")
+    yield cli("compare-one", a, "compare with a single summary", f"compare {DIR}", culprit="compare|two")
+    yield cli("compare-missing", a, "compare a summary that does not exist", f"compare {DIR}/a {DIR}/b",
+              culprit="a")
     yield cli("run-max-steps-guard", a, "run --max-steps 100 (the 10 000-step scene is refused)",
               "run pantograph --max-steps 100 --json", culprit="max_steps|max-steps")
     yield cli("run-out-file", a, "--out onto an existing file", f"run pantograph --out {DIR}/f.txt",

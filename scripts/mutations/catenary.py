@@ -123,4 +123,9 @@ MUTATIONS: tuple[Mutation, ...] = (
              "                   {})",
              "a line file's m_<wire> support masses read and checked, then lost on the way to the line",
              "tests/suite/test_declarations.py"),
+    Mutation("catenary_marks_every_reference_span", "mbsuite/models/catenary/marks.py",
+             "    sup = [float(s.x) for s in line.supports if a <= s.x <= b]",
+             "    sup = [60.0 * k for k in range(int(b // 60.0) + 1) if a <= 60.0 * k <= b]",
+             "the figures mark supports every 60 m (the reference line's) whatever the line's own spans",
+             "tests/catenary/test_line_shown.py"),
 )

@@ -63,9 +63,10 @@ bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tes
 	$(BIN)/python scripts/bench_paths.py
 	$(BIN)/python scripts/bench_sweep.py
 
-docs: $(STAMP)  ## the documentation site (API reference, model pages, gallery) -> out/site/; warnings are errors
+DOCS_FLAGS ?=
+docs: $(STAMP)  ## the documentation site -> out/site/; gallery figures cached in out/gallery-cache (DOCS_FLAGS=--rebuild)
 	$(BIN)/python -m pip install --quiet -c $(TESTED) -e ".[docs]"
-	$(BIN)/python scripts/build_docs.py
+	$(BIN)/python scripts/build_docs.py $(DOCS_FLAGS)
 
 mutants: $(STAMP)  ## seeded physics defects, one at a time: each caught by a physics assertion? (an hour or more)
 	$(BIN)/python scripts/mutants.py --json out/mutants.json --doc docs/mutations.md

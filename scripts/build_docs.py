@@ -2,26 +2,57 @@
 
 The pages are the repository's own documents, gathered into `docs/` at build time so that each exists once: the top
 README becomes the home page, each model's README its model page; `docs/gallery.md` shows every figure the suite writes
-beside the command that makes it (the figures are made here, by those very commands, unless `--no-figures`).
+beside the command that makes it and the CPU time that command took (the figures are made here, by those very
+commands, unless `--no-figures`).
 
     python scripts/build_docs.py               # -> out/site/
+    python scripts/build_docs.py --rebuild     # rerun every gallery command, ignoring the figure cache
     python scripts/build_docs.py --no-figures  # reuse the figures of an earlier build
+
+Figure cache. Some gallery commands are design studies of minutes, so each entry's result is kept under
+`out/gallery-cache/<key>/`: its figures, the command's whole `--out` directory (`out/`, which later entries such as
+`mbsuite compare` read) and `meta.json` (command, key, CPU time of the command -- the `RUSAGE_CHILDREN` user+system
+difference around the subprocess --, wall time, date). An entry whose key has a complete cache directory is copied
+from it; any other entry is run, and only it. The key (`cache_key`) is the SHA-256 of
+
+* the command line;
+* the content of every scene file it names (`model/scene` -> `mbsuite/models/<model>/scenes/<scene>.toml`) and of
+  every file such a scene names by a relative path (a line file, say);
+* the content of the tracked files (`git ls-files`, read from the work tree, so uncommitted edits count) of each model
+  package the command names (`pantograph`, `catenary/...`, `drive` -> drives, ...) and of the model packages those
+  import or name (`mbsuite.models.X`, `from ..X`, a string "X": the catenary runs the registry's pantograph), and of
+  `mbsuite/analysis`;
+* the keys of the gallery entries whose output it reads (`out/docs-figures/gallery_N` in the command).
+
+Deliberately not in the key: the rest of the package (`mbsuite/engines`, `components`, `cli`, the top-level modules)
+and the installed dependencies -- hashing them would rebuild every figure (a quarter of an hour) on any change to the
+shared code. After such a change, or a dependency upgrade, build with `--rebuild`. Old cache directories are not
+pruned; `rm -rf out/gallery-cache` empties the cache.
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import hashlib
+import json
 import os
 import re
+import resource
 import shlex
 import shutil
 import subprocess
 import sys
+import time
+import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 MODELS = ("pantograph", "coupler", "drives", "catenary", "iftomm")
+CACHE = ROOT / "out" / "gallery-cache"
+ALIASES = {"drive": "drives"}  # command words naming a model package under another name
 
 # (title, command, figure files written into --out, what the figure shows)
 GALLERY: list[tuple[str, str, list[str], str]] = [
@@ -66,17 +97,18 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
     ("Sensitivity of the Eppinger pantograph under the wire",
      "mbsuite sensitivity catenary/en50318_eppinger --set solver.engine=mujoco --vary pantograph.params.mh=10:17 "
      "--vary pantograph.params.kh=1500:3000 --vary pantograph.params.bh=5:20 --vary pantograph.params.b2=100:220 "
-     "--vary pantograph.params.Pg=6.8e5:7.6e5 --method morris --n 4 --seed 1", ["sensitivity.png"],
+     "--vary pantograph.params.Pg=6.8e5:7.6e5 --method morris --n 4 --seed 1 --yes", ["sensitivity.png"],
      "Morris elementary effects (mu*, with 95 % intervals) of five pantograph parameters on the EN 50318 statistics."),
     ("The best Eppinger pantograph for the line",
      "mbsuite optimise catenary/en50318_eppinger --set solver.engine=mujoco --vary pantograph.params.kh=1500:3000 "
      "--vary pantograph.params.b2=100:220 --vary pantograph.params.bh=5:20 --start pantograph.params.kh=2250 "
      "--start pantograph.params.b2=157.5 --start pantograph.params.bh=10.8 --objective sigma --band AC --speed 250 "
-     "--maxiter 1 --popsize 2 --seed 1", ["optimise.png"],
+     "--maxiter 1 --popsize 2 --seed 1 --yes", ["optimise.png"],
      "Differential evolution for the lowest sigma with Fm inside the EN 50367 band: every design evaluated."),
     ("Sigma against the mean force",
      "mbsuite optimise catenary/en50318 --vary params.c2=50:130 --vary params.F0=100:140 --objective sigma "
-     "--against Fm --pareto 95,105,115 --band AC --speed 250 --maxiter 3 --popsize 4 --seed 2", ["pareto.png"],
+     "--against Fm --pareto 95,105,115 --band AC --speed 250 --maxiter 3 --popsize 4 --seed 2 --yes",
+     ["pareto.png"],
      "The epsilon-constraint front of sigma against Fm at 250 km/h."),
     ("Lumped pantographs fitted to the multibody one", "mbsuite pantograph fit-lumped --stages 3", ["lumped_fit.png"],
      "The Eppinger pantograph's driving-point receptance against its 3-stage lumped and transfer-function fits."),
@@ -102,20 +134,159 @@ def _gather() -> None:
         (DOCS / "models" / f"{m}.md").write_text(page)
 
 
-def _figures(out: Path) -> None:
-    """Run every gallery command with --out and copy its figures into docs/gallery/."""
+def _tracked(root: Path, rel: str) -> list[Path]:
+    """The tracked files under `root/rel` (`git ls-files`); every file there when `root` is not a git work tree."""
+    try:
+        res = subprocess.run(["git", "ls-files", "-z", "--", rel], cwd=root, capture_output=True, check=True)
+        names = [n for n in res.stdout.decode().split("\0") if n]
+    except (OSError, subprocess.CalledProcessError):
+        names = []
+    if names:
+        return sorted(root / n for n in names)
+    return sorted(f for f in (root / rel).rglob("*") if f.is_file() and "__pycache__" not in f.parts)
+
+
+def _scene_inputs(scene: Path) -> list[Path]:
+    """A scene file and every existing file one of its string values names relative to it (a line file, say)."""
+    found = [scene]
+
+    def walk(v: object) -> None:
+        if isinstance(v, dict):
+            for x in v.values():
+                walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+        elif isinstance(v, str) and v and ("/" in v or "." in v) and (scene.parent / v).is_file():
+            found.append((scene.parent / v).resolve())
+
+    try:
+        walk(tomllib.loads(scene.read_text()))
+    except tomllib.TOMLDecodeError:
+        pass  # the command will say so; the file's content is in the key all the same
+    return found
+
+
+def _models_named(cmd: str, root: Path) -> set[str]:
+    """The model packages a command names (a word `model` or `model/scene`) and, transitively, those they import or
+    name in a string (`get_model("pantograph")`: the catenary runs the registry's pantograph under the wire)."""
+    models = root / "mbsuite" / "models"
+    known = {d.name for d in models.iterdir() if d.is_dir() and (d / "__init__.py").is_file()}
+    named = set()
+    for tok in shlex.split(cmd)[1:]:
+        word = ALIASES.get(tok, tok.split("/")[0])
+        if word in known:
+            named.add(word)
+    todo = list(named)
+    while todo:
+        for f in (models / todo.pop()).rglob("*.py"):
+            text = f.read_text(errors="replace")
+            for m in re.findall(r"mbsuite\.models\.(\w+)|from \.\.(\w+)|[\"'](\w+)[\"']", text):
+                dep = m[0] or m[1] or m[2]
+                if dep in known and dep not in named:
+                    named.add(dep)
+                    todo.append(dep)
+    return named
+
+
+def cache_key(cmd: str, root: Path = ROOT, deps: dict[int, str] | None = None) -> str:
+    """The figure-cache key of a gallery command: see the module docstring for what it covers."""
+    h = hashlib.sha256()
+    h.update(b"command\0" + cmd.encode() + b"\0")
+    files: set[Path] = set()
+    for tok in shlex.split(cmd)[1:]:
+        if tok.count("/") == 1 and not tok.startswith("out/"):
+            model, scene = tok.split("/")
+            path = root / "mbsuite" / "models" / ALIASES.get(model, model) / "scenes" / f"{scene}.toml"
+            if path.is_file():
+                files.update(_scene_inputs(path))
+    for model in sorted(_models_named(cmd, root)):
+        files.update(_tracked(root, f"mbsuite/models/{model}"))
+    files.update(_tracked(root, "mbsuite/analysis"))
+    for f in sorted(files):
+        rel = f.relative_to(root) if f.is_relative_to(root) else f
+        h.update(b"file\0" + str(rel).encode() + b"\0")
+        h.update(hashlib.sha256(f.read_bytes()).digest() if f.is_file() else b"missing")
+    for n in sorted(int(n) for n in re.findall(r"out/docs-figures/gallery_(\d+)", cmd)):
+        h.update(f"entry {n}\0{(deps or {}).get(n, 'unknown')}\0".encode())
+    return h.hexdigest()
+
+
+def _run(cmd: str, d: Path) -> None:
+    """Run one gallery command (`mbsuite ...`) with `--out d`, from the repository root."""
+    argv = [sys.executable, "-m", "mbsuite.cli", *shlex.split(cmd)[1:], "--out", str(d)]
+    subprocess.run(argv, check=True, cwd=ROOT, env={**os.environ, "MPLBACKEND": "Agg"}, stdout=subprocess.DEVNULL)
+
+
+def _cached(cache: Path, key: str, files: list[str]) -> dict | None:
+    """The metadata of a complete cache entry for `key` (its meta.json and every figure present), else None."""
+    meta = cache / key / "meta.json"
+    if not meta.is_file() or not all((cache / key / f).is_file() for f in files):
+        return None
+    try:
+        return json.loads(meta.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _entry(cmd: str, files: list[str], d: Path, key: str, cache: Path = CACHE, rebuild: bool = False,
+           run: Callable[[str, Path], None] = _run) -> dict:
+    """Make one gallery entry's figures in cache/<key>/ (or reuse them) and its output directory `d`; its metadata.
+
+    A reused entry's output directory is restored from the cache when absent, for later entries that read it."""
+    meta = None if rebuild else _cached(cache, key, files)
+    if meta is not None:
+        if not d.is_dir() and (cache / key / "out").is_dir():
+            shutil.copytree(cache / key / "out", d)
+        return {**meta, "reused": True}
+    if d.exists():
+        shutil.rmtree(d)
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    run(cmd, d)
+    wall = time.perf_counter() - t0
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)
+    tmp = cache / f"{key}.tmp"
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir(parents=True)
+    for f in files:
+        hits = sorted(d.rglob(f))
+        if not hits:
+            raise SystemExit(f"gallery: {cmd!r} wrote no {f} into {d}")
+        shutil.copy2(hits[0], tmp / f)
+    shutil.copytree(d, tmp / "out")
+    meta = {"command": cmd, "key": key, "cpu_seconds": round(cpu, 3), "wall_seconds": round(wall, 3),
+            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")}
+    (tmp / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")  # written last: an entry is complete or absent
+    if (cache / key).exists():
+        shutil.rmtree(cache / key)
+    tmp.rename(cache / key)
+    return {**meta, "reused": False}
+
+
+def _keys() -> list[str]:
+    """Every gallery entry's cache key, in order (an entry reading an earlier one's output depends on its key)."""
+    keys: list[str] = []
+    for _title, cmd, _files, _what in GALLERY:
+        keys.append(cache_key(cmd, ROOT, dict(enumerate(keys))))
+    return keys
+
+
+def _figures(out: Path, rebuild: bool = False) -> list[dict]:
+    """Make (or take from the cache) every gallery entry's figures and copy them into docs/gallery/; their metadata."""
     dest = DOCS / "gallery"
     dest.mkdir(exist_ok=True)
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    for i, (_title, cmd, files, _what) in enumerate(GALLERY):
-        d = out / f"gallery_{i}"
-        argv = [sys.executable, "-m", "mbsuite.cli", *shlex.split(cmd)[1:], "--out", str(d)]
-        subprocess.run(argv, check=True, env=env, stdout=subprocess.DEVNULL)
+    metas = []
+    for i, ((_title, cmd, files, _what), key) in enumerate(zip(GALLERY, _keys(), strict=True)):
+        meta = _entry(cmd, files, out / f"gallery_{i}", key, CACHE, rebuild)
+        how = "cached" if meta["reused"] else f"ran in {meta['wall_seconds']:.1f} s"
+        print(f"gallery {i:2d} {how}: {cmd}", file=sys.stderr)
         for f in files:
-            hits = sorted(d.rglob(f))
-            if not hits:
-                raise SystemExit(f"gallery: {cmd!r} wrote no {f} into {d}")
-            shutil.copy2(hits[0], dest / _name(i, f))
+            shutil.copy2(CACHE / key / f, dest / _name(i, f))
+        metas.append(meta)
+    return metas
 
 
 def _name(i: int, f: str) -> str:
@@ -123,11 +294,16 @@ def _name(i: int, f: str) -> str:
     return f"{i:02d}_{f}"
 
 
-def _gallery_page() -> None:
+def _gallery_page(metas: list[dict | None]) -> None:
     lines = ["# Gallery", "", "Every figure below is written by the command above it (`--out DIR`); the same "
-             "directory also holds the CSV files (SI units in the header) and `summary.json`.", ""]
-    for i, (title, cmd, files, what) in enumerate(GALLERY):
-        lines += [f"## {title}", "", f"```\n{cmd} --out DIR\n```", "", what, ""]
+             "directory also holds the CSV files (SI units in the header) and `summary.json`. The CPU time is the "
+             "command's (user plus system) on the machine and the day its figures were made: the build reuses a "
+             "figure whose command and inputs are unchanged (`scripts/build_docs.py`).", ""]
+    for i, ((title, cmd, files, what), meta) in enumerate(zip(GALLERY, metas, strict=True)):
+        lines += [f"## {title}", "", f"```\n{cmd} --out DIR\n```", ""]
+        if meta is not None:
+            lines += [f"CPU time: {meta['cpu_seconds']:.1f} s (made {meta['date'][:10]}).", ""]
+        lines += [what, ""]
         lines += [f"![{title}](gallery/{_name(i, f)})" for f in files] + [""]
     (DOCS / "gallery.md").write_text("\n".join(lines))
 
@@ -135,11 +311,15 @@ def _gallery_page() -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--no-figures", action="store_true", help="do not remake the gallery's figures")
+    ap.add_argument("--rebuild", action="store_true", help="rerun every gallery command, ignoring the figure cache")
     args = ap.parse_args(argv)
     _gather()
-    _gallery_page()
-    if not args.no_figures:
-        _figures(ROOT / "out" / "docs-figures")
+    if args.no_figures:
+        metas: list[dict | None] = [_cached(CACHE, key, files) for key, (_, _, files, _) in zip(_keys(), GALLERY,
+                                                                                               strict=True)]
+    else:
+        metas = list(_figures(ROOT / "out" / "docs-figures", args.rebuild))
+    _gallery_page(metas)
     missing = [_name(i, f) for i, (_, _, files, _) in enumerate(GALLERY) for f in files
                if not (DOCS / "gallery" / _name(i, f)).is_file()]
     if missing:

@@ -48,7 +48,7 @@ def register(sub, add_common, emit) -> str:
     add_scene_options(p)
     add_study_options(p)
     add_common(p)
-    p.set_defaults(func=cmd_catenary, emit=_without_unread_solver(emit))
+    p.set_defaults(func=cmd_catenary, emit=_recording(emit))
     return COMMAND
 
 
@@ -56,16 +56,49 @@ def register(sub, add_common, emit) -> str:
 SOLVER_READ = ("engine", "timestep", "duration", "allow_inaccurate", "max_steps")
 
 
-def _without_unread_solver(emit):
-    """The CLI's `emit` with the scene it records (summary.json) holding only the solver settings a catenary passage
-    reads (`SOLVER_READ`); a rerun of the summary fills the others with their defaults, which it does not read."""
+def recorded_scene(scene_dict: dict, data: dict) -> dict:
+    """The scene summary.json records of a passage whose report data is `data`: only the solver settings a catenary
+    passage reads (`SOLVER_READ`; a rerun fills the others with their defaults, which it does not read) and the
+    [params] the passage actually used pinned (the run's x_start/x_end, the statistics window and the element length:
+    a rerun takes them as given, whatever default made them)."""
+    out = dict(scene_dict)
+    if isinstance(out.get("solver"), dict):
+        out["solver"] = {k: v for k, v in out["solver"].items() if k in SOLVER_READ}
+    if "window" in data and "x_range" in data:
+        (x0, x1), (w0, w1) = data["x_range"], data["window"]
+        out["params"] = {**(out.get("params") or {}), "x_start": x0, "x_end": x1, "window_start": w0,
+                         "window_end": w1, "element_length": data["element_length"]}
+    return out
+
+
+def _recording(emit):
+    """The CLI's `emit` with the scene it records (summary.json) as `recorded_scene` makes it."""
 
     def out(report, args, scene_dict):
-        if scene_dict is not None and isinstance(scene_dict.get("solver"), dict):
-            scene_dict = {**scene_dict, "solver": {k: v for k, v in scene_dict["solver"].items() if k in SOLVER_READ}}
+        if scene_dict is not None:
+            scene_dict = recorded_scene(scene_dict, report.data)
         return emit(report, args, scene_dict)
 
     return out
+
+
+def check_summary_line(path: str) -> None:
+    """Before `mbsuite catenary summary.json` reruns it: a SceneError where a file of the line it recorded (the line
+    file, the tables it reads, the irregularity profile) no longer has the recorded content (`marks.line_changed`):
+    the rerun would not be the run it records."""
+    import json
+
+    from .marks import line_changed
+
+    try:
+        results = json.loads(Path(path).read_text()).get("results") or {}
+    except (OSError, ValueError, AttributeError):
+        return  # not readable as a summary: `scene_of` says why
+    line = results.get("line") if isinstance(results, dict) else None
+    changed = line_changed(line) if isinstance(line, dict) else []
+    if changed:
+        raise SceneError(f"{path}: the line's file(s) {', '.join(changed)} changed (or went) since the run it records "
+                         "(SHA-256 differs): a rerun would not be that run; run a scene on the files as they are now")
 
 
 class _Percent:
@@ -83,20 +116,29 @@ class _Percent:
 
 def line_scene(path: str) -> Scene:
     """The default scene (`catenary/en50318`: 2-mass reference pantograph, 250 km/h) on the line of a line file: the
-    run over [0, 0.7 L] and the statistics window [0.4 L, 0.6 L] of its length L (the EN 50318 scene's proportions,
-    420 and 240-360 of 600 m); a scene of your own (`[line] file = ...`) sets them."""
+    statistics window the line's default (`marks.default_window`, on its supports) and the run from 0 to 0.7 L (L:
+    its length; the EN 50318 scene's 420 of 600 m), or on to the middle of the span after the window where that lies
+    further (the uplift at the window's last steady arm is seen as the pantograph passes it); a scene of your own
+    (`[line] file = ...`) sets them."""
     from .linefile import read_line_file
+    from .marks import default_window
 
-    L = read_line_file(path)[0].length
+    line = read_line_file(path)[0]
+    L = line.length
+    a, b = default_window(line)
+    after = min((s.x for s in line.supports if s.x > b), default=L)
     d = load_scene("catenary/en50318").to_dict()
     d.update(name=Path(path).stem, description=f"the line of {path} under the scene catenary/en50318",
              line={"file": str(Path(path).resolve())},
-             params={"x_start": 0.0, "x_end": 0.7 * L, "window_start": 0.4 * L, "window_end": 0.6 * L})
+             params={"x_start": 0.0, "x_end": min(L, max(0.7 * L, 0.5 * (b + after))), "window_start": a,
+                     "window_end": b})
     return scene_from_dict(d, source=str(path))
 
 
 def _scene(args: argparse.Namespace) -> Scene:
     """The command's catenary scene with the command line's overrides."""
+    if str(args.scene).endswith(".json"):
+        check_summary_line(args.scene)
     scene = line_scene(args.scene) if is_line_file(args.scene) else scene_of(args.scene)
     if scene.model != "catenary":
         raise SceneError(f"scene {args.scene!r} is a '{scene.model}' scene; the catenary command needs a "

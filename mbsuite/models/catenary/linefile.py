@@ -328,7 +328,8 @@ def build_line(section: Mapping[str, Any] | None, p, set_params: Iterable[str] =
 
 def scene_params(scene) -> Any:
     """The `CatenaryParams` of a catenary scene (`ModelSpec.params_builder`): its [params] with the line of its
-    [line] section (`build_line`; a line file's before the run's positions are checked against its length)."""
+    [line] section (`build_line`; a line file's before the run's positions are checked against its length) and the
+    statistics window (`_windowed`: the scene's, else the line's default)."""
     from .params import CatenaryParams
 
     section = scene.sections.get("line")
@@ -336,16 +337,29 @@ def scene_params(scene) -> Any:
     if section is not None and section["kind"] == "file":
         line = build_line(section, None, scene.params)
         return _windowed(line, given, lambda **w: CatenaryParams(**{**given, **w}, line=line))
-    p = CatenaryParams(**given)
+    p = CatenaryParams(**given, **_provisional_window(given))
     line = build_line(section, p, scene.params) or line_of(p)
     return _windowed(line, given, lambda **w: dataclasses.replace(
         p, **w, **({} if section is None else {"line": line})))
 
 
+def _provisional_window(given: Mapping[str, Any]) -> dict[str, Any]:
+    """Where the scene sets no window: the whole run [x_start, x_end] as the window while the line is built (the
+    parameters' own default, [240, 360] m, need not lie in the run of a shorter simple line); `_windowed` replaces
+    it by the line's default."""
+    if "window_start" in given or "window_end" in given:
+        return {}
+    from .params import CatenaryParams
+
+    d = CatenaryParams()
+    return {"window_start": given.get("x_start", d.x_start), "window_end": given.get("x_end", d.x_end)}
+
+
 def _windowed(line: Line, given: Mapping[str, Any], make: Any) -> Any:
     """The parameters `make(**window)` with the statistics window: the scene's (a `WindowOffSupportWarning` where an
     edge is off the supports of `line`), else `marks.default_window(line)` (on the EN 50318 line the parameters'
-    own default, [240, 360] m)."""
+    own default, [240, 360] m); a default window outside the run is a ParameterError naming the rule and the keys
+    to set."""
     from .marks import WindowOffSupportWarning, default_window, window_off_supports
 
     if "window_start" in given or "window_end" in given:
@@ -355,4 +369,12 @@ def _windowed(line: Line, given: Mapping[str, Any], make: Any) -> Any:
             warnings.warn(msg, WindowOffSupportWarning, stacklevel=4)
         return p
     a, b = default_window(line)
-    return make(window_start=a, window_end=b)
+    try:
+        return make(window_start=a, window_end=b)
+    except ParameterError as exc:
+        if "statistics window" not in str(exc):
+            raise
+        raise ParameterError(
+            f"the default statistics window [{a:g}, {b:g}] m of the line {line.name!r} (its supports: model README, "
+            f"'The statistics window') does not lie in the run: {exc}; set params.window_start and "
+            "params.window_end, or params.x_start and params.x_end around it") from exc

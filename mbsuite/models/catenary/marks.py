@@ -58,7 +58,7 @@ def line_identity(p: CatenaryParams, file: str | Path | None = None) -> dict[str
     if file is not None:
         path = Path(file)
         out["file"] = str(path)
-        out["sha256"] = _sha256(path)
+        out["sha256"] = file_sha256(path)
         try:
             data = tomllib.loads(path.read_text())
         except (OSError, tomllib.TOMLDecodeError):
@@ -67,21 +67,33 @@ def line_identity(p: CatenaryParams, file: str | Path | None = None) -> dict[str
         irr = data.get("irregularity")
         if isinstance(irr, dict) and isinstance(irr.get("file"), str):
             refs.append(irr["file"])
-        out["files"] = {str(path.parent / r): _sha256(path.parent / r) for r in refs}
+        out["files"] = {str(path.parent / r): file_sha256(path.parent / r) for r in refs}
     return out
 
 
-def _sha256(path: Path) -> str | None:
+def line_changed(recorded: dict[str, Any]) -> list[str]:
+    """The files of a line's identity as `line_identity` recorded it (the line file, the tables it reads) whose
+    content is no longer the recorded one (changed or gone), by their paths; [] for a line without files."""
+    files = dict(recorded.get("files") or {})
+    if recorded.get("file") is not None:
+        files = {recorded["file"]: recorded.get("sha256"), **files}
+    return [f for f, h in files.items() if file_sha256(Path(f)) != h]
+
+
+def file_sha256(path: str | Path) -> str | None:
+    """The SHA-256 (hex) of the file's content; None where it cannot be read."""
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError:
         return None
 
 
 # --- the statistics window on the line's supports -------------------------------------------------------------------
-#: the default window: the two spans from the fifth support (index 4, counted from the line's start) to the seventh,
-#: [240, 360] m on the EN 50318 line (supports every 60 m); a line of fewer than seven supports: from the support
-#: nearest 0.4 L to the support nearest 0.6 L (L: its length). Model README, "The statistics window".
+#: the default window: the two spans from the fifth support (index 4, counted from the line's start at x = 0) to the
+#: seventh, where the line goes on at least one span past it (seven spans or more): [240, 360] m on the EN 50318 line
+#: (supports every 60 m), also when it is lengthened for a train; on a shorter line from the support nearest 0.4 L to
+#: the support nearest 0.6 L (L: its length; the middle span or two). Either way the first and the last span are out
+#: of it from three spans on. Model README, "The statistics window".
 WINDOW_SUPPORTS = (4, 6)
 WINDOW_FRACTIONS = (0.4, 0.6)
 #: a window edge within this distance (m) of a support is on it
@@ -95,11 +107,11 @@ class WindowOffSupportWarning(UserWarning):
 def default_window(line: Line) -> tuple[float, float]:
     """The default statistics window of `line` (a scene that sets neither window_start nor window_end; model README,
     "The statistics window"): from its fifth support to its seventh (`WINDOW_SUPPORTS`: [240, 360] m on the EN 50318
-    line); on a line of fewer than seven supports from the support nearest 0.4 L to the one nearest 0.6 L (the lower
-    of two equally near; the next support where both would be one)."""
-    xs = [float(s.x) for s in line.supports]
+    line) where an eighth follows; on a line of fewer than eight supports from the support nearest 0.4 L to the one
+    nearest 0.6 L (the lower of two equally near; the next support where both would be one)."""
+    xs = sorted(float(s.x) for s in line.supports)
     i, j = WINDOW_SUPPORTS
-    if len(xs) > j:
+    if len(xs) > j + 1:
         return xs[i], xs[j]
     L = line.length
 

@@ -163,11 +163,11 @@ def table_rows(q: dict[str, Any]) -> list[list[str]]:
     return [[r["label"], f"{r['value']:.2f}", r["limit"], "pass" if r["pass"] else "FAIL"] for r in q["rows"].values()]
 
 
-def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path) -> Path:
-    """Write `figure(assessments)` to `path` (PNG) and return it."""
+def plot(assessments: list[tuple[str, dict[str, Any]]], path: Path, line: str | None = None) -> Path:
+    """Write `figure(assessments, line)` to `path` (PNG) and return it."""
     from ...plotting import save
 
-    return save(figure(assessments), path)
+    return save(figure(assessments, line), path)
 
 
 #: each criterion's panel title and unit (the table's labels are longer)
@@ -176,11 +176,12 @@ _PANELS = {"mean_force": ("mean force Fm", "N"), "sigma": ("standard deviation �
            "arcing_nq": ("arcing NQ", "%"), "uplift": ("uplift at the steady arms", "mm")}
 
 
-def figure(assessments: list[tuple[str, dict[str, Any]]]) -> MplFigure:
+def figure(assessments: list[tuple[str, dict[str, Any]]], line: str | None = None) -> MplFigure:
     """The target band Fm(v) with each pantograph's Fm ± σ at its speed (left), and one panel per criterion in its
     own unit (right): each pantograph's value as a marker (green: pass, red: fail; a zero is drawn like any other
     value) against the criterion's limit drawn as a line (σ ≤ r Fm: each pantograph's own limit as a short line at
-    its marker; Fm: the band between the two target curves; Fm − 3σ: the floor, passing above it)."""
+    its marker; Fm: the band between the two target curves; Fm − 3σ: the floor, passing above it); `line` (the
+    line's name, `marks.line_label`) is named in the title."""
     import numpy as np
 
     from ...plotting import figure as new_figure
@@ -231,6 +232,7 @@ def figure(assessments: list[tuple[str, dict[str, Any]]]) -> MplFigure:
     ax.set_title("mean contact force Fm ± standard deviation σ vs the target band", fontsize=10)
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7, loc="upper left")
-    fig.suptitle(f"current-collection criteria ({c.system}) at {assessments[0][1]['speed_kmh']:g} km/h "
+    on = "" if line is None else f" on the {line}"
+    fig.suptitle(f"current-collection criteria ({c.system}) at {assessments[0][1]['speed_kmh']:g} km/h{on} "
                  "(green: pass, red: fail)", fontsize=10)
     return fig

@@ -13,7 +13,7 @@ from ...results import Report, SimResult, format_table, write_csv
 from ...results import assemble as assemble_result
 from .analysis import CatenaryRun, scene_config, single
 from .config import health_of_regime
-from .marks import line_identity, line_label
+from .marks import file_sha256, line_identity, line_label
 from .plots import force_uplift_figure, train_figure
 from .quality import QualityCriteria, assess, criteria_from
 from .quality import plot as quality_plot
@@ -61,10 +61,15 @@ def _scalar_stats(run: CatenaryRun) -> dict:
 
 
 def rerun_record(p, scene_dict: dict | None) -> dict[str, Any]:
-    """What a rerun needs besides the scene (summary.json's results): the statistics `window` actually used
-    ([start, end] m) and the `line`'s identity (`marks.line_identity`: its name; a line file's path and SHA-256)."""
-    file = ((scene_dict or {}).get("line") or {}).get("file")
-    return {"window": [p.window_start, p.window_end], "line": line_identity(p, file)}
+    """What a rerun needs besides the scene (summary.json's results): the statistics `window` and the run's `x_range`
+    actually used ([start, end] m) and the `line`'s identity (`marks.line_identity`: its name; a line file's path and
+    SHA-256, and the SHA-256 of each table it reads and of the scene's [line.irregularity] profile)."""
+    section = (scene_dict or {}).get("line") or {}
+    ident = line_identity(p, section.get("file"))
+    irr = section.get("irregularity")
+    if isinstance(irr, dict) and isinstance(irr.get("file"), str):
+        ident["files"] = {**ident.get("files", {}), irr["file"]: file_sha256(irr["file"])}
+    return {"window": [p.window_start, p.window_end], "x_range": [p.x_start, p.x_end], "line": ident}
 
 
 def window_time(stats: dict, dt: float) -> float:
@@ -140,7 +145,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
     def write(out: Path) -> list[Path]:
         files = write_run_files(runs, out)
         if assessments:
-            files.append(quality_plot(assessments, Path(out) / f"quality_{run.pantograph}_{run.speed_kmh:g}kmh.png"))
+            files.append(quality_plot(assessments, Path(out) / f"quality_{run.pantograph}_{run.speed_kmh:g}kmh.png",
+                                      line_label(run.params)))
         return files
 
     return Report(data=data, table="\n".join(lines), write=write)
@@ -232,7 +238,7 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
         files.append(save(train_figure(run, labels), out / f"train_force_{run.speed_kmh:g}kmh.png"))
         if qs:
             files.append(quality_plot(list(zip(labels, qs, strict=True)),
-                                      out / f"quality_train_{run.speed_kmh:g}kmh.png"))
+                                      out / f"quality_train_{run.speed_kmh:g}kmh.png", line_label(run.params)))
         return files
 
     return Report(data=data, table="\n".join(lines), write=write)

@@ -10,6 +10,9 @@ real number type a Python or numpy user passes (int, float, `fractions.Fraction`
 and floats of every width, 0-d arrays of them), taken as the Python int or float it holds. Bools (Python's and
 numpy's) are not numbers here, so true/false is never taken for 1/0; complex numbers are refused even with a zero
 imaginary part.
+
+numpy is not imported here: a value can only be a numpy one once numpy is loaded (`_numpy`), so that a declaration
+(a command's options, for its --help) loads no numpy.
 """
 
 from __future__ import annotations
@@ -18,16 +21,20 @@ import dataclasses
 import decimal
 import math
 import numbers
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
-import numpy as np
-
 from .errors import ParameterError
-from .trust import perturbation
 
 _NO_DEFAULT = object()
+
+
+def _numpy() -> ModuleType | None:
+    """numpy if it is loaded, else None (then no value is a numpy one)."""
+    return sys.modules.get("numpy")
 
 
 def real(value: Any) -> int | float | None:
@@ -36,13 +43,14 @@ def real(value: Any) -> int | float | None:
     float16/float32 give the shortest decimal that reads back as the same narrow float (`np.float32(0.001)` is
     0.001, the number the user wrote, not its binary neighbour 0.0010000000474974513). A Fraction or Decimal too
     large for a float gives inf (then refused as not finite)."""
-    if isinstance(value, np.ndarray) and value.ndim == 0:
+    np = _numpy()
+    if np is not None and isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
-    if isinstance(value, bool | np.bool_):
+    if isinstance(value, bool) or np is not None and isinstance(value, np.bool_):
         return None
     if isinstance(value, numbers.Integral):
         return int(value)
-    if isinstance(value, np.floating) and value.dtype.itemsize < 8:
+    if np is not None and isinstance(value, np.floating) and value.dtype.itemsize < 8:
         return float(str(value))
     if isinstance(value, numbers.Real | decimal.Decimal):
         try:
@@ -104,7 +112,8 @@ class Limit:
         (`where`, a phrase with a leading space) and the range."""
         bad = f"{name} = {value!r}{where} is invalid; valid: {self.describe()}"
         if self.kind is bool:
-            if not isinstance(value, bool | np.bool_):
+            np = _numpy()
+            if not (isinstance(value, bool) or np is not None and isinstance(value, np.bool_)):
                 raise error(bad)
             return bool(value)
         if self.kind is str or (self.choices is not None and all(isinstance(c, str) for c in self.choices)):
@@ -172,7 +181,9 @@ def check_fields(obj: Any, owner: str, error: type[Exception] = ParameterError) 
         v = lim.check(f"{owner} {f.name}", getattr(obj, f.name), error)
         if v is not getattr(obj, f.name):
             object.__setattr__(obj, f.name, v)
-    perturbation.fields(obj)  # inside `perturbation.perturbed` (the stability check) every float is perturbed
+    perturbation = sys.modules.get(f"{__package__}.trust.perturbation")  # not loaded: not inside `perturbed`
+    if perturbation is not None:
+        perturbation.fields(obj)  # inside `perturbation.perturbed` (the stability check) every float is perturbed
 
 
 def limits_table(cls: Any) -> list[tuple[str, str, str, str, str]]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import ast
 import importlib
+import re
 from collections.abc import Callable
 from pathlib import Path
 
@@ -48,16 +49,28 @@ def declared_commands() -> dict[str, dict[str, str]] | None:
         cli = folder / "cli.py"
         if not cli.is_file():
             continue
-        value = None
-        for node in ast.parse(cli.read_text()).body:
-            target = node.target if isinstance(node, ast.AnnAssign) else (
-                node.targets[0] if isinstance(node, ast.Assign) and len(node.targets) == 1 else None)
-            if isinstance(target, ast.Name) and target.id == "CLI_COMMANDS" and node.value is not None:
-                value = ast.literal_eval(node.value)
+        value = _literal(cli.read_text(), "CLI_COMMANDS")
         if not value:
             return None
         out[folder.name] = dict(value)
     return out
+
+
+def _literal(source: str, name: str) -> object:
+    """The literal a module-level statement `name = ...` (or `name: T = ...`) of `source` assigns, the last one if
+    several (None without one): the statement alone is parsed, not the module (a few lines, not a few hundred)."""
+    lines = source.splitlines()
+    starts = [i for i, line in enumerate(lines) if re.match(rf"{name}\s*(:[^=]*)?=", line)]
+    for i in reversed(starts):
+        for j in range(i + 1, len(lines) + 1):  # the statement's lines: the first chunk that parses
+            try:
+                node = ast.parse("\n".join(lines[i:j])).body[0]
+            except SyntaxError:
+                continue
+            if isinstance(node, ast.Assign | ast.AnnAssign) and node.value is not None:
+                return ast.literal_eval(node.value)
+            break
+    return None
 
 
 def command_of(argv: list[str]) -> str | None:
@@ -307,16 +320,19 @@ def _design_ranges(p: argparse.ArgumentParser) -> None:
 
 
 def add_model_groups(sub: argparse._SubParsersAction, only: str | None = None) -> dict[str, str]:
-    """Let each model that declares a command module (`SPEC.commands`; `only`: that model alone) add its command
-    group; returns model -> the group's command name."""
-    from .. import registry
+    """Let each model that declares a command module (`SPEC.commands`; `only`: that model alone, from its package's
+    `cli` module, which `declared_commands` read, without the registry: its --help imports no other model module)
+    add its command group; returns model -> the group's command name."""
+    if only is not None:
+        modules = {only: f"{__package__.rpartition('.')[0]}.models.{only}.cli"}
+    else:
+        from .. import registry
 
+        modules = {name: spec.commands for name, spec in sorted(registry.models().items()) if spec.commands}
     groups: dict[str, str] = {}
-    for name, spec in sorted(registry.models().items()):
-        if spec.commands is None or only is not None and name != only:
-            continue
-        group = importlib.import_module(spec.commands).register(sub, add_common, emit)
+    for name, module in modules.items():
+        group = importlib.import_module(module).register(sub, add_common, emit)
         if group not in sub.choices:
-            raise TypeError(f"{spec.commands}.register returned {group!r}, not the command it added")
+            raise TypeError(f"{module}.register returned {group!r}, not the command it added")
         groups[name] = group
     return groups

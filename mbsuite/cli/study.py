@@ -29,7 +29,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypedDict
 
 from ..errors import MbsuiteError
-from ..results import names_of, numbers_in, unit_source
 from ..trust.health import InaccurateResult
 from .options import SCENE_SECTIONS
 
@@ -114,6 +113,8 @@ def apply_sets(scene: Scene, sets: list[str] | None) -> Scene:
 def flatten(data: Any, prefix: str = "") -> dict[str, float]:
     """The numbers of a report's data as `path -> value` (`reference[1].f_n`; `results.numbers_in`): booleans,
     strings and long lists (curves, time series) left out."""
+    from ..results import numbers_in
+
     return {path: value for path, value, _ in numbers_in(data, prefix)}
 
 
@@ -240,6 +241,8 @@ def study(args: argparse.Namespace, scene: Scene | None, target: str, *, units: 
 def unit_of(quantity: str, units: dict[str, str]) -> str:
     """A quantity's unit by its last name (`reference[1].f_n` -> units["f_n"]), else as a name of its path spells it
     (`results.unit_source`)."""
+    from ..results import unit_source
+
     return unit_source(quantity, units)[1]
 
 
@@ -293,6 +296,8 @@ def study_report(scene: Scene | None, axes: list[tuple[str, str, list]], combos:
 
 def headlines(quantities: list[str], wide: tuple[str, ...]) -> list[str]:
     """The quantities a name of whose path is one of `wide` (`f_n` picks `reference[1].f_n`)."""
+    from ..results import names_of
+
     return [q for q in quantities if set(names_of(q)) & set(wide)] if wide else []
 
 
@@ -312,7 +317,7 @@ def wide_table(heads: list[str], combos: list[tuple], results: list[dict], shown
                qunits: dict[str, str]) -> str:
     """One block per group of quantities (the first name of their path: `reference`, `mujoco`, `peaks_hz`), one row
     per point, one column per quantity with its unit (at most `WIDE_COLUMNS` per block)."""
-    from ..results import format_table
+    from ..results import format_table, names_of
 
     groups: dict[str, list[str]] = {}
     for q in shown:
@@ -454,6 +459,7 @@ def plot_study(head: list[str], axis_units: dict[str, str], combos: list[tuple],
     every `peaks_hz.*` in another; its words from `words` on the axis), one line per quantity and combination of
     the other axes (at most 6 panels)."""
     from ..plotting import figure
+    from ..results import unit_source
 
     def echo(q: str) -> bool:  # a quantity that only repeats an axis' value (the input, reported back)
         return any(all(r.get(q) == c[i] for r, c in zip(results, combos, strict=True)) for i in range(len(head)))

@@ -1,6 +1,6 @@
-"""The command line answers at once: `mbsuite --version`, `--help` and argument errors import no engine, model,
-numpy, scipy or matplotlib (which modules a command loads is behaviour; how long it takes is measured by
-scripts/cli_startup.py, not asserted here)."""
+"""The command line answers at once: `mbsuite --version`, `--help`, every command's `--help` and argument errors import
+no engine, numpy, scipy or matplotlib, and a model's command's help no other model (which modules a command loads is
+behaviour; how long it takes is measured by scripts/cli_startup.py, not asserted here)."""
 
 from __future__ import annotations
 
@@ -72,26 +72,85 @@ def test_light_and_whole_parser_read_a_generic_command_alike():
     assert light == whole
 
 
-ENGINES = ("scipy", "matplotlib", "mujoco", "pinocchio", "mbsuite.engines.core", "mbsuite.engines.mujoco_engine",
-           "mbsuite.engines.pinocchio_engine", "mbsuite.engines.native")
+#: what no command's --help may import: the engines, the plotting and numerical stack, numpy itself
+ENGINES = ("numpy", "scipy", "matplotlib", "mujoco", "pinocchio", "mbsuite.engines")
+
+#: runs `mbsuite ARGV` for each argv of its JSON argument in a fork of one interpreter that has imported only the
+#: command line (each fork starts from the same modules, as a fresh process would), printing what each loaded
+FORKED = """
+import contextlib, io, json, os, sys
+from mbsuite.cli import main
+out = {}
+for argv in json.loads(sys.argv[1]):
+    r, w = os.pipe()
+    if os.fork() == 0:
+        os.close(r)
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            code = main(argv)
+        os.write(w, json.dumps({"code": code, "modules": sorted(sys.modules)}).encode())
+        os._exit(0)
+    os.close(w)
+    with os.fdopen(r) as f:
+        out[" ".join(argv)] = json.loads(f.read())
+    os.wait()
+print(json.dumps(out))
+"""
 
 
-@pytest.mark.parametrize("argv", [["catenary", "--help"], ["pantograph", "--help"], ["pantograph", "fit-lumped",
-                                                                                    "--help"],
-                                  ["modes", "--help"], ["coupler", "criteria", "--help"], ["optimise", "--help"],
-                                  ["compare", "--help"], ["drive", "run", "--help"], ["rotational", "--help"]])
-def test_a_commands_help_loads_its_own_model_only_and_no_engine(argv):
-    """A model command's --help builds that model's command group alone (no other model's cli module) and imports
-    no engine, scipy or matplotlib."""
-    out = subprocess.run([sys.executable, "-c", PROBE, *argv], capture_output=True, text=True, check=True).stdout
-    data = json.loads(out)
-    assert data["code"] == 0
-    clis = [m for m in data["modules"] if m.startswith("mbsuite.models.") and m.endswith(".cli")]
+def help_commands() -> list[list[str]]:
+    """`[command, ..., "--help"]` of every command of the whole parser: each top-level command and each command of
+    every group, at every depth (`drive design cadjs`)."""
+    out: list[list[str]] = []
+
+    def walk(parser: argparse.ArgumentParser, path: list[str]) -> None:
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, child in action.choices.items():
+                    out.append([*path, name, "--help"])
+                    walk(child, [*path, name])
+
+    walk(build_parser(), [])
+    return out
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="the probe forks")
+def test_every_commands_help_loads_no_engine_numpy_or_other_model():
+    """Every command's --help (each top-level command, each command of a group at any depth) builds its parser from
+    the light parser and, for a model's command, that model's `cli` module alone: it imports no numpy, scipy,
+    matplotlib, MuJoCo, Pinocchio or engine, and no module of another model (what it costs: scripts/cli_startup.py)."""
+    commands = help_commands()
+    assert ["drive", "run", "--help"] in commands and ["coupler", "criteria", "--help"] in commands
+    out = subprocess.run([sys.executable, "-c", FORKED, json.dumps(commands)], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = json.loads(out)
     declared = declared_commands() or {}
-    owner = [f"mbsuite.models.{model}.cli" for model, commands in declared.items() if argv[0] in commands]
-    assert clis == owner, clis
-    heavy = [m for m in data["modules"] if m.startswith(ENGINES)]
-    assert heavy == [], f"mbsuite {' '.join(argv)} imports {heavy[:8]}"
+    bad = {}
+    for argv in commands:
+        data = loaded[" ".join(argv)]
+        owner = [model for model, names in declared.items() if argv[0] in names]
+        heavy = [m for m in data["modules"] if m.startswith(ENGINES)]
+        others = [m for m in data["modules"] if m.startswith("mbsuite.models.") and m.split(".")[2] not in owner]
+        clis = [m for m in data["modules"] if m.startswith("mbsuite.models.") and m.endswith(".cli")]
+        if data["code"] != 0 or heavy or others or clis != [f"mbsuite.models.{m}.cli" for m in owner]:
+            bad[" ".join(argv)] = {"exit": data["code"], "heavy": heavy[:6], "other models": others[:6], "cli": clis}
+    assert not bad, bad
+
+
+def test_a_models_package_loads_its_spec_on_first_use():
+    """A model package hands on `SPEC` at its first use (`spec.py`), so importing the package (its `cli`) loads no
+    other module of the model; the registry's `SPEC.commands` is the package's `cli`, which the light parser imports
+    by that name."""
+    probe = ("import json, sys; import mbsuite.models.catenary as m; before = sorted(sys.modules); spec = m.SPEC; "
+             "print(json.dumps([before, spec.name, spec.commands]))")
+    before, name, commands = json.loads(subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                                                       check=True).stdout)
+    assert name == "catenary" and commands == "mbsuite.models.catenary.cli"
+    assert [m for m in before if m.startswith("mbsuite.models.catenary.")] == []
+    from mbsuite import registry
+
+    for model, spec in registry.models().items():
+        if spec.commands is not None:
+            assert spec.commands == f"mbsuite.models.{model}.cli", model
 
 
 def test_fit_defaults_reach_the_command_line_and_the_api():
@@ -104,3 +163,15 @@ def test_fit_defaults_reach_the_command_line_and_the_api():
 
     args = build_parser().parse_args(["pantograph", "fit-lumped"])
     assert args.order == DEFAULT_ORDER == inspect.signature(lumped_study.fit_report).parameters["order"].default == 7
+
+
+def test_the_startup_benchmark_times_every_top_level_commands_help():
+    """scripts/cli_startup.py measures the help of every top-level command the parser lists."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("cli_startup", MODELS_DIR.parents[1] / "scripts" / "cli_startup.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    top = build_parser(models=False)._subparsers._group_actions[0].choices
+    assert list(bench.TOP_LEVEL) == list(top)
+    assert all([c, "--help"] in bench.COMMANDS.values() for c in top)

@@ -6,14 +6,16 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ...cli.options import add_error_estimate, add_scene_options, check_workers, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import SceneError
 from ...progress import Progress
-from ...results import Report
-from ...scenes import Scene, load_scene, scene_from_dict
-from .linefile import is_line_file
+
+if TYPE_CHECKING:  # imported where the command runs: its --help loads no model module
+    from ...results import Report
+    from ...scenes import Scene
 
 COMMAND = "catenary"
 # the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
@@ -120,6 +122,7 @@ def line_scene(path: str) -> Scene:
     its length; the EN 50318 scene's 420 of 600 m), or on to the middle of the span after the window where that lies
     further (the uplift at the window's last steady arm is seen as the pantograph passes it); a scene of your own
     (`[line] file = ...`) sets them."""
+    from ...scenes import load_scene, scene_from_dict
     from .linefile import read_line_file
     from .marks import default_window
 
@@ -137,6 +140,8 @@ def line_scene(path: str) -> Scene:
 
 def _scene(args: argparse.Namespace) -> Scene:
     """The command's catenary scene with the command line's overrides."""
+    from .linefile import is_line_file
+
     if str(args.scene).endswith(".json"):
         check_summary_line(args.scene)
     scene = line_scene(args.scene) if is_line_file(args.scene) else scene_of(args.scene)

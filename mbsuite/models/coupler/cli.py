@@ -8,16 +8,18 @@ import textwrap
 import warnings
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ...cli.options import add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import ParameterError, SceneError
 from ...limits import Limit, limit_of
-from ...results import Report, format_table
-from ...scenes import Scene
 from ...trust.health import InaccurateResult
-from . import analysis
 from .params import GAMMA_17DEG, CouplerParams
+
+if TYPE_CHECKING:  # imported where the commands run: their --help loads no analysis, engine or numpy
+    from ...results import Report
+    from ...scenes import Scene
 
 # the top-level commands `register` adds, with their help (read by `mbsuite --help` without importing the model)
 CLI_COMMANDS = {"coupler": "4-link coupler kinematics (Jacobian, FPP, criteria) and dynamics"}
@@ -64,6 +66,8 @@ def _params(args: argparse.Namespace) -> CouplerParams:
 def jacobian_of(scene: None, args: argparse.Namespace) -> Report:
     """The single coupler's Jacobian report at the command's geometry, singularity warnings stated in it (the
     command's, or a point of its --vary study)."""
+    from . import analysis
+
     p = _params(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", analysis.SingularityWarning)
@@ -104,6 +108,8 @@ def _count(name: str) -> partial:
 
 def fpp_of(scene: None, args: argparse.Namespace) -> Report:
     """The single coupler's pose over one revolution at the command's geometry (size-guarded sample count)."""
+    from . import analysis
+
     if not 3 <= args.n <= args.max_n:
         raise ParameterError(f"--n = {args.n} is invalid; valid: integer in [3, {args.max_n}] (the size guard "
                              f"--max-n, default {FPP_MAX_N}; each sample is one FPP solve, ~0.2 ms)")
@@ -118,6 +124,8 @@ def cmd_fpp(args: argparse.Namespace, emit) -> None:
 
 def cmd_criteria(args: argparse.Namespace, emit) -> None:
     """`mbsuite coupler criteria`: c1-c5 over the design grid (a small grid with --quick)."""
+    from . import analysis
+
     if args.quick:
         rep = analysis.criteria_report(gammas=(0.297,), eys=(0.1,), alphas=(0.0, 0.035, 0.07), zcs=(0.0, 0.05),
                                        lbs=(2.0,), n=61)
@@ -136,6 +144,8 @@ def _plain(v: object) -> str:
 
 def dynamics_table(scene_input: dict, res) -> str:
     """The human table of `coupler dynamics`: resolved input, statistics with units, health, link forces."""
+    from ...results import format_table
+
     st = {**res.statistics, **res.stats}
     units = {**COUNTER_UNITS, **{k: (u or "-") for k, u in res.statistic_units.items()}}
     inp_units = {"omega": "rad/s", "load_torque": "N m", "alpha_cx": "rad", "alpha_cz": "rad", "x_c": "m",
@@ -190,6 +200,8 @@ def dynamics_of(scene: Scene, args: argparse.Namespace) -> Report:
     """The double-coupler run of `scene` with its statistics and health (the command's, or a study point's)."""
     # health figures judged (AccuracyError past a bound unless allowed); an error estimate above its tolerance keeps
     # the result, flagged (InaccurateResult carrying the report: the command prints it and exits 3)
+    from ...results import Report
+
     inaccurate = None
     try:
         res = mbsuite_run(scene, error_estimate=bool(getattr(args, "error_estimate", False)))

@@ -6,18 +6,17 @@ import argparse
 import textwrap
 from functools import partial
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ...cli.options import SCENE_HELP, add_error_estimate, add_scene_options, scene_of
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError, SceneError
 from ...limits import Limit
-from ...results import Report, format_table, write_csv
-from ...scenes import scene_from_dict
 from ...trust.health import InaccurateResult, judge, judge_estimate
-from . import design as D
-from .design_scene import BASE_SETS, DesignInputs, design_scene, scene_toml
+from .params import BASE_SETS
+
+if TYPE_CHECKING:  # the design tools, results and numpy are imported where the commands run: their --help loads none
+    from ...results import Report
 
 #: the commands `register` adds (read by the command line's light parser without importing the model)
 CLI_COMMANDS = {"drive": "switched-mode drives: design tools, runs, efficiency",
@@ -127,6 +126,7 @@ def _csv_writer(name: str, columns: list[tuple[str, str, list]], figure=None):
 def _write_csv(name: str, columns: list[tuple[str, str, list]], figure, out: Path) -> list[Path]:
     """The files of a design command's `--out`: `name`.csv and, with a figure, `name`.png."""
     from ...plotting import save
+    from ...results import write_csv
 
     files = [write_csv(Path(out) / f"{name}.csv", columns)]
     if figure is not None:
@@ -136,6 +136,8 @@ def _write_csv(name: str, columns: list[tuple[str, str, list]], figure, out: Pat
 
 def _quantity_table(items: list[tuple[str, str, float | str, str]]) -> str:
     """A transposed table: one row per quantity (name, symbol/meaning, value, unit)."""
+    from ...results import format_table
+
     return format_table(["quantity", "meaning", "value", "unit"],
                         [[k, m, (f"{v:.6g}" if isinstance(v, float) else v), u] for k, m, v, u in items])
 
@@ -195,9 +197,9 @@ def register(sub, add_common, emit) -> str:
     q.add_argument("--K", type=float, required=True, help=_help("--K"))
     q.add_argument("--xmax", type=float, required=True, help=_help("--xmax"))
     q.add_argument("--fatigue", type=float, default=0.25, help=_help("--fatigue", "default 0.25"))
-    q.add_argument("--sigma-uts", type=float, default=D.SIGMA_UTS_CALIBRATED,
+    q.add_argument("--sigma-uts", type=float, default=None,
                    help="ultimate tensile stress, Pa (default: calibrated to the thesis' 1.58e-4 m^3, not a material)")
-    q.add_argument("--E", type=float, default=D.E_TABLE_6_3, help="Young's modulus, Pa (default: implied by Table 6.3)")
+    q.add_argument("--E", type=float, default=None, help="Young's modulus, Pa (default: implied by Table 6.3)")
     add_common(q)
     q.set_defaults(func=partial(springsz_cmd, emit))
 
@@ -249,6 +251,9 @@ def _inputs(a: argparse.Namespace, *flags: str) -> dict:
 
 def srmin_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design srmin`: Eq 5.1."""
+    from ...results import Report
+    from . import design as D
+
     flags = ("--P", "--wmin", "--wrip", "--Jl")
     _check_options(a, *flags)
     v = D.srmin(a.P, a.wmin, a.wrip, a.Jl)
@@ -261,6 +266,9 @@ def srmin_cmd(emit, a: argparse.Namespace) -> None:
 
 def cadjs_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design cadjs`: the CADJS families (Eqs 5.9-5.13 corrected), or one read at --tau-c."""
+    from ...results import Report, format_table
+    from . import design as D
+    from .design_scene import scene_toml
     from .plots import cadjs_figure
 
     flags = ("--P", "--srmin", "--wmin", "--wmax", "--vm", "--js", "--tau-c", "--wop", "--Jl", "--taul", "--pmotor",
@@ -299,6 +307,9 @@ def cadjs_cmd(emit, a: argparse.Namespace) -> None:
 def _design_scene(a: argparse.Namespace) -> dict:
     """The scene of `drive design cadjs ... --scene-out FILE` (checked before any file is written): one design point,
     at --tau-c or at a single --js (`design_scene.design_scene`)."""
+    from ...scenes import scene_from_dict
+    from .design_scene import DesignInputs, design_scene
+
     if len(a.srmin) != 1:
         raise MbsuiteError(f"--scene-out writes one design: give one --srmin, got {len(a.srmin)} ({a.srmin})")
     if (a.tau_c is None) == (a.js is None or len(a.js) != 1):
@@ -322,6 +333,13 @@ def _design_scene(a: argparse.Namespace) -> dict:
 
 def springsz_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design springsz`: SPRINGSZ (Eqs 5.14-5.21)."""
+    from ...results import Report
+    from . import design as D
+
+    if a.sigma_uts is None:
+        a.sigma_uts = D.SIGMA_UTS_CALIBRATED
+    if a.E is None:
+        a.E = D.E_TABLE_6_3
     _check_options(a, "--K", "--xmax", "--fatigue", "--sigma-uts", "--E")
     r = dict(D.springsz(a.K, a.xmax, a.fatigue, sigma_uts=a.sigma_uts, E=a.E))
     items = [("K", "spring rate", a.K, "N m/rad"), ("x_max", "largest twist", a.xmax, "rad"),
@@ -338,6 +356,9 @@ def springsz_cmd(emit, a: argparse.Namespace) -> None:
 
 def gains_cmd(emit, a: argparse.Namespace) -> None:
     """`drive design gains`: gain selection (Eqs 5.32-5.37), closed-loop poles and the stability line (5.36)."""
+    from ...results import Report
+    from . import design as D
+
     _check_options(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
     inputs = _inputs(a, "--Jl", "--ts", "--taul", "--w0", "--btotal", "--P")
     if a.btotal is None:
@@ -371,7 +392,10 @@ def run_cmd(emit, a: argparse.Namespace) -> None:
 def run_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive run` on scene `sc` (the command's, or a study point's): health figures judged as by
     `mbsuite.run` (with `--error-estimate` the estimated error of every headline, `accuracy.py`)."""
+    import numpy as np
+
     from ...analysis.errorestimate import error_estimate
+    from ...results import Report
     from . import accuracy
     from .analysis import simulate_scene
     from .plots import loss_label
@@ -428,6 +452,8 @@ def efficiency_cmd(emit, a: argparse.Namespace) -> None:
 
 def efficiency_of(sc, a: argparse.Namespace) -> Report:
     """The report of `drive efficiency` on scene `sc` (`analysis.efficiency`)."""
+    import numpy as np
+
     from .analysis import efficiency
 
     loads = a.loads if a.loads is not None else list(np.round(np.linspace(0.0, 0.3, 7), 4))

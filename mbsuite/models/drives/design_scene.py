@@ -32,10 +32,7 @@ from ...limits import Limit, param, positive
 from ...schema import Rule, Section, of_dataclass
 from . import design as D
 from .config import check_scene
-from .params import PARAM_SETS, DriveParams
-
-#: the parameter sets whose motor, bearings, delays and controller rate a design scene may take (step-up/step-down)
-BASE_SETS = ("design_100w", "proto_100w", "proto_50w", "example_500w")
+from .params import BASE_SETS, PARAM_SETS, DriveParams
 
 
 def _one_point(c: dict[str, Any]) -> str | None:

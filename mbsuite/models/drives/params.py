@@ -67,6 +67,10 @@ PARAM_SETS: dict[str, dict[str, float]] = {
     "example_500w": EXAMPLE_500W,
 }
 
+#: the parameter sets whose motor, bearings, delays and controller rate a design scene may take (step-up/step-down;
+#: `design_scene.py`)
+BASE_SETS = ("design_100w", "proto_100w", "proto_50w", "example_500w")
+
 
 #: the least rotor inertia [kg m^2]: far below any drive of this kind, far above MuJoCo's mjMINVAL (1e-15), which a
 #: rotor's inertia must exceed (the same floor as the coupler's)

@@ -5,6 +5,7 @@ freqresp SCENE` with the same options are aliases of the first three."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from ...cli.options import (
     SCENE_HELP,
@@ -17,8 +18,10 @@ from ...cli.options import (
 )
 from ...cli.study import add_study_options, run_or_study
 from ...errors import MbsuiteError
-from ...scenes import Scene
 from .freq_grid import DEFAULTS, LIMITS, METHODS, check_grid
+
+if TYPE_CHECKING:
+    from ...scenes import Scene
 
 MODEL = "pantograph"
 COMMANDS = {

@@ -5,12 +5,13 @@ the `freqresp` analysis and the command line."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ...errors import SceneError
 from ...limits import Limit
+
+if TYPE_CHECKING:  # numpy where the grid is made: the command line's help reads the declarations here without it
+    import numpy as np
 
 FR_SIGNALS = ("F1", "F2", "HD", "y_d")
 #: each response signal in words (axes of the figures, a study's curves); every one is a height in m, as is the
@@ -43,6 +44,8 @@ MAX_FREQUENCIES = 2000
 def check_grid(f_min: float, f_max: float, df: float, peak_tol: float, methods: str | Sequence[str],
                err: type[Exception] = SceneError) -> tuple[np.ndarray, tuple[str, ...]]:
     """The grid `f_min:df:f_max` and the methods, each value checked against `LIMITS` (an `err` naming it)."""
+    import numpy as np
+
     for k, v in (("f_min", f_min), ("f_max", f_max), ("df", df), ("peak_tol", peak_tol)):
         LIMITS[k].check(k, v, err)
     if f_max < f_min:

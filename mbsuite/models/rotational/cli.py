@@ -8,15 +8,16 @@ import argparse
 import math
 from functools import partial
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ...cli.options import add_error_estimate, add_scene_options
 from ...errors import MbsuiteError
 from ...limits import Limit
-from ...results import Report, format_table, write_csv
-from ...scenes import DEFAULT_MAX_STEPS, load_scene
+from ...settings import DEFAULT_MAX_STEPS
 from ...trust.health import judge_estimate
+
+if TYPE_CHECKING:  # numpy, the results and the scenes where the command runs: its --help loads none of them
+    import numpy as np
 
 #: the commands `register` adds (read by the command line's light parser without importing the model)
 CLI_COMMANDS = {"rotational": "Modelica Rotational examples: CoupledClutches on both paths vs the Dymola reference"}
@@ -76,6 +77,10 @@ def _nan(x: float | None) -> float:
 
 def coupled_clutches_cmd(emit, a: argparse.Namespace) -> None:
     """`rotational coupled-clutches`: both paths against the Dymola reference (`analysis.coupled_clutches_table`)."""
+    import numpy as np
+
+    from ...results import Report, format_table
+    from ...scenes import load_scene
     from . import coupled_clutches as cc  # here, not at parse time (the command's help imports no engine)
     from .analysis import coupled_clutches_table
 
@@ -129,6 +134,7 @@ def _write_coupled_clutches(d: dict, ref_t: np.ndarray, ref_w: np.ndarray, ev_co
                             out: Path) -> list[Path]:
     """The files of `rotational coupled-clutches --out`: events and speeds as CSV, the comparison figure."""
     from ...plotting import save
+    from ...results import write_csv
     from .plots import coupled_clutches_figure
 
     fig = coupled_clutches_figure(d, ref_t, ref_w)

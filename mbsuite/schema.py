@@ -164,8 +164,11 @@ class Section:
             rows.append((f"{p}<name>", "optional", lim.describe(), lim.unit, lim.doc))
         return rows
 
-    def markdown(self) -> str:
-        """The section's parameter table (Markdown), its rules below it; nested sections follow as their own."""
+    def markdown(self, _seen: set[int] | None = None) -> str:
+        """The section's parameter table (Markdown), its rules below it; nested sections follow as their own (a
+        section nested at several keys once)."""
+        seen = set() if _seen is None else _seen
+        seen.add(id(self))
         lines = [f"**{self.title}**" + (f": {self.doc}" if self.doc else ""), "",
                  "| key | required / default | valid | unit | meaning |", "|---|---|---|---|---|"]
         lines += [f"| `{k}` | {need} | {valid} | {unit} | {doc} |" for k, need, valid, unit, doc in self.rows()]
@@ -174,8 +177,8 @@ class Section:
         out = ["\n".join(lines)]
         for d in self.keys.values():
             sub = d if isinstance(d, Section) else d.of if isinstance(d, Items) and isinstance(d.of, Section) else None
-            if sub is not None:
-                out.append(sub.markdown())
+            if sub is not None and id(sub) not in seen:
+                out.append(sub.markdown(seen))
         return "\n\n".join(out)
 
     def walk(self, path: tuple[str, ...] = ()) -> list[tuple[tuple[str, ...], Limit | Items | Section]]:

@@ -16,7 +16,7 @@ from mbsuite.models.catenary.quality import CRITERIA, criteria_from
 from mbsuite.models.catenary.reports import quality_of, train_assessments
 from mbsuite.results import format_table
 
-SCENES = ("en50318", "en50318_linear", "en50318_eppinger", "eppinger_lab", "en50318_two_pantographs")
+SCENES = ("en50318", "en50318_linear", "en50318_eppinger", "eppinger_lab", "en50318_two_pantographs", "en50318_aero")
 
 
 def main() -> None:

@@ -3,9 +3,13 @@ catenary (its `[pantograph]` section) and fitted by the pantograph model (`mbsui
 
 Both are one linear state-space model of the head (`LinearPantograph`), x' = A x + b0 F0 - B f, head = c x, with f
 the contact force (N, >= 0 pushes the head down) entering where it acts (B: the response to an upward force on the
-head), F0 the static uplift entering through b0. Integrated with the wire's own trapezoidal rule,
+head), F0 the static uplift entering through b0. A constant aerodynamic uplift (`aerodynamic(head, frame)`, N upward;
+the catenary's `[aerodynamics]`) adds B Fa_h (on the head) + bf Fa_f (on the frame: the last stage of a lumped chain,
+bf = b0; a transfer function has only its head port, so its frame force enters by the path F0 takes, bf = b0 = B:
+the frame's uplift adds to the static force, one for one against a rigid wire) to the constant input. Integrated with
+the wire's own trapezoidal rule,
 
-    (I - h A) x1 = (I + h A) x0 + h (2 b0 F0 - B (f0 + f1)),   h = dt / 2,
+    (I - h A) x1 = (I + h A) x0 + h (2 (b0 F0 + B Fa_h + bf Fa_f) - B (f0 + f1)),   h = dt / 2,
 
 the head at t + dt is exactly affine in the end-of-step force f1 (`affine_map`), as the 2-mass reference pantograph's
 (whose Newmark average-acceleration scheme is this rule on its first-order form: the same numbers to rounding).
@@ -283,16 +287,20 @@ class TransferParams:
 
 
 class LinearPantograph:
-    """A linear pantograph under the wire (module docstring): x' = A x + b0 F0 - B f, the outputs `Cout` x (row 0 the
-    head), named `names`; `energy_of(x)` (J) where the model has one."""
+    """A linear pantograph under the wire (module docstring): x' = A x + b0 F0 + B Fa_h + bf Fa_f - B f, the outputs
+    `Cout` x (row 0 the head, the last row the frame), named `names`; `energy_of(x)` (J) where the model has one;
+    `b_frame` (bf) where a force on the frame enters (default b0, F0's path)."""
 
     affine = True
     engine = "reference"
 
     def __init__(self, A: np.ndarray, B: np.ndarray, b0: np.ndarray, F0: float, Cout: np.ndarray,
-                 names: Sequence[str], name: str, energy_of: Callable[[np.ndarray], float] | None = None):
+                 names: Sequence[str], name: str, energy_of: Callable[[np.ndarray], float] | None = None,
+                 b_frame: np.ndarray | None = None):
         self.name = name
         self.A, self.B, self.b0 = np.asarray(A, float), np.asarray(B, float), np.asarray(b0, float)
+        self.b_frame = self.b0 if b_frame is None else np.asarray(b_frame, float)
+        self.aero = (0.0, 0.0)  # the aerodynamic uplift (N, upward) on the head and on the frame
         self.F0 = float(F0)
         self.Cout = np.atleast_2d(np.asarray(Cout, float))
         self.c = self.Cout[0]
@@ -302,24 +310,34 @@ class LinearPantograph:
         self._dt = None
         self._pending = None
 
+    def aerodynamic(self, head: float, frame: float) -> None:
+        """The constant aerodynamic uplift (N, upward) on the head and on the frame (before `static`)."""
+        self.aero = (float(head), float(frame))
+        self._dt = None  # the step's constant term changes
+
+    def _aero_input(self) -> np.ndarray:
+        """The aerodynamic uplift's constant input B Fa_h + bf Fa_f (zeros without one)."""
+        fa_h, fa_f = self.aero
+        return self.B * fa_h + self.b_frame * fa_f
+
     def _prepare(self, dt: float) -> None:
         h = dt / 2
         n = len(self.B)
         lu = np.linalg.inv(np.eye(n) - h * self.A)
         self._Phi = lu @ (np.eye(n) + h * self.A)
-        self._G0 = 2 * h * self.F0 * (lu @ self.b0)
+        self._G0 = 2 * h * self.F0 * (lu @ self.b0) + 2 * h * (lu @ self._aero_input())
         self._Gf = h * (lu @ self.B)
         self._cPhi, self._cG0, self._cGf = self.c @ self._Phi, float(self.c @ self._G0), float(self.c @ self._Gf)
         self._dt = dt
 
     def static(self, y_wire: float, k_wire: float) -> float:
-        """Static state pressing on a wire at y_wire through k_wire: A x + b0 F0 - B f = 0, f = k_wire (c x - y_wire)
-        (k_wire = 0: free, f = 0); returns f."""
+        """Static state pressing on a wire at y_wire through k_wire: A x + b0 F0 + B Fa_h + bf Fa_f - B f = 0,
+        f = k_wire (c x - y_wire) (k_wire = 0: free, f = 0); returns f."""
         n = len(self.B)
         M = np.zeros((n + 1, n + 1))
         M[:n, :n], M[:n, n] = self.A, -self.B
         M[n, :n], M[n, n] = k_wire * self.c, -1.0
-        rhs = np.concatenate([-self.b0 * self.F0, [k_wire * y_wire]])
+        rhs = np.concatenate([-self.b0 * self.F0 - self._aero_input(), [k_wire * y_wire]])
         try:
             z = np.linalg.solve(M, rhs)
         except np.linalg.LinAlgError:
@@ -370,10 +388,12 @@ class LinearPantograph:
         return {k: float(v) for k, v in zip(self.names, y, strict=True)}
 
     def energy(self) -> float:
-        """The model's energy (J): kinetic + springs - work of F0 (lumped pantographs only)."""
+        """The model's energy (J): kinetic + springs - work of F0 and of the aerodynamic uplift on the head (row 0 of
+        `Cout`) and the frame (its last row) (lumped pantographs only)."""
         if self._energy_of is None:
             raise SolverError(f"the {self.name} pantograph (a transfer function) has no energy to report")
-        return self._energy_of(self.x)
+        fa_h, fa_f = self.aero
+        return self._energy_of(self.x) - fa_h * float(self.c @ self.x) - fa_f * float(self.Cout[-1] @ self.x)
 
 
 def lumped(p: LumpedParams, name: str = LUMPED) -> LinearPantograph:
@@ -395,13 +415,14 @@ def lumped(p: LumpedParams, name: str = LUMPED) -> LinearPantograph:
         q, v = x[:n], x[n:]
         return float(0.5 * v @ M @ v + 0.5 * q @ K @ q - p.F0 * q[-1])
 
-    return LinearPantograph(A, B, b0, p.F0, Cout, names, name, energy)
+    return LinearPantograph(A, B, b0, p.F0, Cout, names, name, energy, b_frame=b0)
 
 
 def transfer(p: TransferParams, name: str = TRANSFER) -> LinearPantograph:
-    """The transfer-function pantograph of `p` under the wire: its state is the model's, its output the head."""
+    """The transfer-function pantograph of `p` under the wire: its state is the model's, its output the head; a
+    force on the frame enters by F0's path (B: the model has only its head port)."""
     A, B, C = p.arrays()
-    return LinearPantograph(A, B, B, p.F0, C[None, :], ["head_displacement"], name)
+    return LinearPantograph(A, B, B, p.F0, C[None, :], ["head_displacement"], name, b_frame=B)
 
 
 # --- the scene's [pantograph] section ----------------------------------------------------------------------------

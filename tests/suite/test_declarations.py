@@ -45,6 +45,7 @@ LOADERS: dict[str, Callable[[Any], Any]] = {
     "catenary.line": lambda d: validate_line_section(d, LINES),
     "catenary.train": models()["catenary"].sections["train"],
     "catenary.quality": models()["catenary"].sections["quality"],
+    "catenary.aerodynamics": models()["catenary"].sections["aerodynamics"],
     "drives.design": models()["drives"].sections["design"],
     "catenary.pantograph_lumped": lambda d: models()["catenary"].sections["pantograph"]({"params": d}),
     "catenary.pantograph_transfer": lambda d: models()["catenary"].sections["pantograph"]({"params": d}),

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
+from .aerodynamics import Uplift
 from .config import PassageConfig
 from .fe import CatenaryFE
 from .pantographs import TWO_MASS, Pantograph
@@ -47,6 +48,7 @@ class CatenaryRun:
     engine_warnings: dict[str, int] = field(default_factory=dict)
     is_reference: bool = False  # the EN 50318 reference scene (2-mass pantograph, specification's parameters)
     engine: str = "reference"  # the pantograph's engine path (the catenary is always the FE reference code)
+    aerodynamics: Uplift | None = None  # the pantograph's aerodynamic uplift (None: no [aerodynamics] section)
 
 
 #: the timings of a single passage (`CatenaryRun.timing`, besides `method`)
@@ -58,14 +60,15 @@ def simulate(p: CatenaryParams, speed_kmh: float, dt: float, dropper_law: str = 
              progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
              engine: str = "reference", pantograph_section: dict[str, Any] | None = None,
              max_steps: float | None = None, native: bool | None = None,
-             allow_inaccurate: bool = False) -> CatenaryRun:
+             allow_inaccurate: bool = False, aerodynamics: dict[str, Any] | None = None) -> CatenaryRun:
     """Build, run and analyse one pantograph passage (the EN 50318 procedure): the `PassageConfig` of these arguments
     (a train of one) through `train.run_passage`. `pantograph` is a name (the scene's `pantograph` effect, built on the
     engine path `engine` with the `[pantograph]` section `pantograph_section`; see `pantographs.build`) or an object
     of the pantograph protocol. Everything is checked before anything is built (`PassageConfig.check`). `native`: the
-    compiled step core (None: whenever it applies; False: the readable Python path)."""
+    compiled step core (None: whenever it applies; False: the readable Python path). `aerodynamics`: an
+    `[aerodynamics]` section (`aerodynamics.py`: F = c v^2 on the head and the frame)."""
     cfg = PassageConfig(p, speed_kmh, dt, (pantograph,), (), dropper_law, contact, engine, pantograph_section,
-                        max_steps, allow_inaccurate)
+                        max_steps, allow_inaccurate, aerodynamics=aerodynamics)
     return single(run_passage(cfg, progress=progress, fe=fe, native=native))
 
 
@@ -98,7 +101,7 @@ def single(run: TrainRun) -> CatenaryRun:
                        result=res, stats=stats, filtered=run.filtered[0], regime=run.regime, timing=timing,
                        ranges=check_ranges(stats, run.speed_kmh) if is_reference else None, warnings=warn,
                        static_force=float(res.force[0]), engine_warnings=eng_warn, is_reference=is_reference,
-                       engine=run.engines[0])
+                       engine=run.engines[0], aerodynamics=None if run.aerodynamics is None else run.aerodynamics[0])
 
 
 # --- scene plumbing ---------------------------------------------------------------------------------------------
@@ -113,9 +116,9 @@ def scene_speed(scene, speed_kmh: float | None) -> float:
 def scene_config(scene, engine: str, speed_kmh: float | None = None, spacings: Sequence[float] | None = None,
                  train: bool = True, **overrides: Any) -> PassageConfig:
     """The passage of a catenary scene with its pantographs on the engine path `engine`: its parameters (with
-    `overrides`), speed, time step, effects, the `[pantograph]` section; the pantographs of its `[train]` section
-    (`spacings` overrides the section's; `train = False` ignores the section), else the one its `pantograph` effect
-    names."""
+    `overrides`), speed, time step, effects, the `[pantograph]` and `[aerodynamics]` sections; the pantographs of its
+    `[train]` section (`spacings` overrides the section's; `train = False` ignores the section), else the one its
+    `pantograph` effect names."""
     p = scene.build_params()
     if overrides:
         p = dataclasses.replace(p, **overrides)
@@ -127,7 +130,7 @@ def scene_config(scene, engine: str, speed_kmh: float | None = None, spacings: S
     sv = scene.solver
     return PassageConfig(p, scene_speed(scene, speed_kmh), sv.timestep, names, sp, scene.effects["droppers"],
                          scene.effects["contact"], engine, scene.sections.get("pantograph"), sv.max_steps,
-                         sv.allow_inaccurate)
+                         sv.allow_inaccurate, aerodynamics=scene.sections.get("aerodynamics"))
 
 
 def run_scene(scene, speed_kmh: float | None = None, progress=None, **overrides) -> CatenaryRun:

@@ -2,7 +2,8 @@
 several (leading first, `spacings` between consecutive contact points), its speed, time step, dropper and contact laws,
 the engine path of its pantographs and the size guard. `PassageConfig.check` judges all of it before anything is
 built: the speed (a number, below the contact wire's wave speed; warned above 70 %), the time step (the 20 Hz filter's
-Nyquist bound, then the FE wave resolution), the spacings, the size of the job. The health figures of a run
+Nyquist bound, then the FE wave resolution), the spacings, the size of the job, each pantograph's aerodynamic uplift
+(`aerodynamics.py`: the scene's `[aerodynamics]` section at this speed). The health figures of a run
 (`health_of_regime`) are read from the same quantities."""
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from ...errors import ParameterError, SceneError
 from ...limits import Limit
 from ...schema import Items, Rule, Section
 from ...trust.health import Figure, judge
+from .aerodynamics import Uplift, uplifts
 from .pantographs import PANTOGRAPHS, TWO_MASS, Pantograph
 from .params import CatenaryParams
 
@@ -169,12 +171,14 @@ def check_train(p: CatenaryParams, spacings: Sequence[float], head_width: float 
 
 class Admitted(NamedTuple):
     """What `PassageConfig.check` found: the speed (m/s), the regime (`speed_regime`), the pantographs' offsets
-    behind the leading one (m) and the warnings to carry with the run."""
+    behind the leading one (m), the warnings to carry with the run and each pantograph's aerodynamic uplift
+    (`aerodynamics.Uplift`, leading first; None without an `[aerodynamics]` section)."""
 
     V: float
     regime: dict[str, Any]
     offsets: list[float]
     warnings: list[str]
+    uplift: list[Uplift] | None = None
 
 
 @dataclass(frozen=True)
@@ -183,8 +187,8 @@ class PassageConfig:
     (names of the `pantograph` effect or objects of the `pantographs.Pantograph` protocol, leading first) with the
     `spacings` (m) between consecutive contact points (a single pantograph: a train of one, no spacings), the
     `dropper_law` and `contact` effects, the pantographs' engine path `engine` with the scene's `[pantograph]` section,
-    the scene's `solver.max_steps` and `solver.allow_inaccurate`, and the head width below which two contact points
-    would share one head."""
+    the scene's `solver.max_steps` and `solver.allow_inaccurate`, the head width below which two contact points
+    would share one head, and the scene's `[aerodynamics]` section (`aerodynamics.py`; None: no aerodynamic force)."""
 
     params: CatenaryParams
     speed_kmh: float
@@ -198,11 +202,13 @@ class PassageConfig:
     max_steps: float | None = None
     allow_inaccurate: bool = False
     head_width: float = HEAD_WIDTH
+    aerodynamics: Mapping[str, Any] | None = None
 
     def check(self) -> Admitted:
         """Every check of the passage, before anything is built: the pantograph count against the spacings, the
         speed, the time step, the spacings (`check_train`), the speed regime, the size of the whole train's job
-        (`check_size`) and the FE wave resolution (`check_wave_resolution`); errors name the culprit."""
+        (`check_size`), the FE wave resolution (`check_wave_resolution`) and the aerodynamic uplift of each pantograph
+        (`aerodynamics.uplifts`: the case each one runs, its coefficients); errors name the culprit."""
         p, dt, speed = self.params, self.dt, self.speed_kmh
         n, ns = len(self.pantographs), len(self.spacings)
         if n != ns + 1:
@@ -215,7 +221,8 @@ class PassageConfig:
         regime = speed_regime(p, V)
         check_size(dataclasses.replace(p, x_end=p.x_end + offsets[-1]), V, dt, self.max_steps)
         step_warn = check_wave_resolution(p, dt, self.allow_inaccurate)
-        return Admitted(V, regime, offsets, list(regime["warnings"]) + step_warn)
+        up = uplifts(self.aerodynamics, V, n)
+        return Admitted(V, regime, offsets, list(regime["warnings"]) + step_warn, up)
 
 
 # --- the scene's [train] section -------------------------------------------------------------------------------------

@@ -31,7 +31,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 4
+ABI = 5
 
 
 class _Job(ctypes.Structure):

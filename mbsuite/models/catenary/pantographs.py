@@ -15,7 +15,10 @@ varies linearly from f_n to f_{n+1}. A pantograph only has to answer:
 `affine_map(dt, f0) -> (P, g)` with head height P - g f1. A nonlinear pantograph is coupled by a secant iteration on
 f1. Optional: `engine` (the name of the pantograph's engine path, for reports; default "reference"),
 `engine_warnings() -> {name: count}` (warnings of its engine, reported with the run), `energy()` (J, for the energy
-diagnostics).
+diagnostics), `aerodynamic(head, frame)`: the constant aerodynamic uplift (N, upward) on its head and on its frame
+(`aerodynamics.py`), given before `static` (whose state then includes it) and acting in every trial, the one-port's
+included; every pantograph the catenary knows has it (the model README, "Aerodynamic uplift", says where each applies
+the two forces).
 
 `native(dt) -> NativePort` (optional) gives the pantograph as a one-port in C (`engines/native/mbsuite.h`), which
 the catenary's compiled loop steps without Python: `.port` the filled `mbs_port`, `.load()` / `.pull()` the committed
@@ -98,10 +101,11 @@ class UnderWire(Protocol):
 
 class TwoMassPantograph:
     """EN 50318 reference pantograph: head m1 on k1, c1 to the frame; frame m2 on k2, c2 to a fixed base; the static
-    uplift F0 acts on the frame; k2 is referenced to the undisturbed CW level (catenary.md).
+    uplift F0 acts on the frame; k2 is referenced to the undisturbed CW level (catenary.md). The constant aerodynamic
+    uplifts Fa_h on the head and Fa_f on the frame (`aerodynamic`; 0 until given) act on their masses:
 
-        m1 x1'' = -k1 (x1 - x2) - c1 (x1' - x2') - f
-        m2 x2'' =  k1 (x1 - x2) + c1 (x1' - x2') - k2 x2 - c2 x2' + F0
+        m1 x1'' = -k1 (x1 - x2) - c1 (x1' - x2') - f + Fa_h
+        m2 x2'' =  k1 (x1 - x2) + c1 (x1' - x2') - k2 x2 - c2 x2' + F0 + Fa_f
 
     Integrated with the trapezoidal rule (the catenary's scheme), hence exactly affine in the contact force."""
 
@@ -114,10 +118,15 @@ class TwoMassPantograph:
         self.Km = np.array([[k1, -k1], [-k1, k1 + k2]])
         self.Cm = np.array([[c1, -c1], [-c1, c1 + c2]])
         self.F0 = F0
+        self.aero = (0.0, 0.0)  # the aerodynamic uplift (N, upward) on the head and on the frame
         self.x = np.zeros(2)
         self.v = np.zeros(2)
         self._dt = None
         self._pending = None
+
+    def aerodynamic(self, head: float, frame: float) -> None:
+        """The constant aerodynamic uplift (N, upward) on the head mass and on the frame mass (before `static`)."""
+        self.aero = (float(head), float(frame))
 
     def _prepare(self, dt: float) -> None:
         h = dt / 2
@@ -131,14 +140,16 @@ class TwoMassPantograph:
         (m1, m2), (k11, k12, k22) = self._m, self._k
         x1, x2 = float(self.x[0]), float(self.x[1])
         v1, v2 = float(self.v[0]), float(self.v[1])
-        return (m1 * v1 - h * (k11 * x1 + k12 * x2) - h * (f0 + f1) / 2,
-                m2 * v2 - h * (k12 * x1 + k22 * x2) + h * self.F0)
+        fa_h, fa_f = self.aero
+        return (m1 * v1 - h * (k11 * x1 + k12 * x2) - h * (f0 + f1) / 2 + h * fa_h,
+                m2 * v2 - h * (k12 * x1 + k22 * x2) + h * (self.F0 + fa_f))
 
     def static(self, y_wire: float, k_wire: float) -> float:
-        """Static state against a wire at y_wire through k_wire: K x = [-f, F0], f = k_wire (x1 - y_wire)."""
-        # K x = [-f, F0] with f = k_wire (x1 - y_wire)
+        """Static state against a wire at y_wire through k_wire: K x = [-f + Fa_h, F0 + Fa_f], f = k_wire (x1 -
+        y_wire)."""
+        fa_h, fa_f = self.aero
         A = self.Km + np.array([[k_wire, 0.0], [0.0, 0.0]])
-        self.x = np.linalg.solve(A, np.array([k_wire * y_wire, self.F0]))
+        self.x = np.linalg.solve(A, np.array([k_wire * y_wire + fa_h, self.F0 + fa_f]))
         self.v = np.zeros(2)
         return float(k_wire * (self.x[0] - y_wire))
 
@@ -184,12 +195,14 @@ class TwoMassPantograph:
 
     def pack(self, out: np.ndarray, dt: float) -> None:
         """The state and step constants into the native core's one-port (x1 x2 v1 v2, S^-1 row-major, m1 m2,
-        k11 k12 k22, F0): `native/catenary.c` advances this pantograph by the same rule."""
+        k11 k12 k22, the frame's constant uplift F0 + Fa_f, the head's Fa_h): `native/catenary.c` advances this
+        pantograph by the same rule."""
         if dt != self._dt:
             self._prepare(dt)
         (m1, m2), (k11, k12, k22), S = self._m, self._k, self._S
-        out[:14] = (self.x[0], self.x[1], self.v[0], self.v[1], S[0][0], S[0][1], S[1][0], S[1][1], m1, m2, k11,
-                    k12, k22, self.F0)
+        fa_h, fa_f = self.aero
+        out[:15] = (self.x[0], self.x[1], self.v[0], self.v[1], S[0][0], S[0][1], S[1][0], S[1][1], m1, m2, k11,
+                    k12, k22, self.F0 + fa_f, fa_h)
 
     def unpack(self, src: np.ndarray) -> None:
         """The state back from the native core (`pack`)."""
@@ -197,8 +210,10 @@ class TwoMassPantograph:
         self.v = np.array([src[2], src[3]], dtype=float)
 
     def energy(self) -> float:
-        """Kinetic + spring energy (J) minus the potential of F0."""
-        return float(0.5 * self.v @ self.Mm @ self.v + 0.5 * self.x @ self.Km @ self.x - self.F0 * self.x[1])
+        """Kinetic + spring energy (J) minus the potential of F0 and of the aerodynamic uplift."""
+        fa_h, fa_f = self.aero
+        return float(0.5 * self.v @ self.Mm @ self.v + 0.5 * self.x @ self.Km @ self.x - (self.F0 + fa_f) * self.x[1]
+                     - fa_h * self.x[0])
 
 
 # --- the kinds of pantograph -------------------------------------------------------------------------------------

@@ -36,13 +36,16 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
     signal `uplift` stands for one column per support, `uplift_<x>m` (x = the support's position), in its unit.
     `statistics` (declared in `stats.STATISTICS`): the eight EN 50318 statistics, the static contact force and the
     quality verdicts (`quality_pass`, `quality_<criterion>_pass`, `quality_nq_pct`; limits from the scene's
-    `[quality]` section, else the AC defaults); `stats`: timings and the pantograph engine's warnings;
+    `[quality]` section, else the AC defaults); `stats`: timings, the pantograph engine's warnings and, with an
+    `[aerodynamics]` section, the uplift (`aerodynamics`: case, coefficients, forces);
     `events`: the contact losses in the window."""
     r = run.result
     signals = {"contact_force": r.force, "contact_force_filtered": run.filtered, "position": r.x,
                "head_height": r.head, "wire_height": r.wire, "slack_droppers": r.n_slack.astype(float)}
     q = quality_of(run, criteria_from(scene.sections.get("quality")))
     stats = {**{k: v for k, v in run.timing.items() if k != "method"}, "warnings": dict(run.engine_warnings)}
+    if run.aerodynamics is not None:  # the uplift the statistics include (N, at this speed)
+        stats["aerodynamics"] = run.aerodynamics.as_dict()
     statistics = {**_scalar_stats(run), "static_contact_force": run.static_force, "quality_pass": q["pass"],
                   **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
                   "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
@@ -117,6 +120,8 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
     lines.append(f"speed ratio V/c = {run.regime['speed_ratio']:.3f} (c = {run.regime['cw_wave_speed_kmh']:.1f} km/h), "
                  f"regime: {run.regime['regime']}")
     lines[-1] = textwrap.fill(lines[-1], 100, subsequent_indent="  ")
+    if run.aerodynamics is not None:  # [aerodynamics]: the statistics and the quality check include the uplift
+        lines.append(textwrap.fill(run.aerodynamics.describe(), 100, subsequent_indent="  "))
     for w in run.warnings:
         lines.append(textwrap.fill(f"WARNING: {w}", 100, subsequent_indent="  "))
     data = {"speed_kmh": run.speed_kmh, "pantograph": run.pantograph, "engine": run.engine,
@@ -124,6 +129,7 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
             "timestep": run.dt, **rerun_record(run.params, scene_dict),
             "regime": {k: v for k, v in run.regime.items() if k != "warnings"},
             "warnings": run.warnings,
+            "aerodynamics": None if run.aerodynamics is None else run.aerodynamics.as_dict(),
             "runs": {r.dropper_law: {"statistics": _scalar_stats(r), "ranges": r.ranges,
                                      "uplift_at_supports_mm": r.stats["uplift_at_supports_mm"],
                                      "loss_counts": r.stats["loss_counts"], "loss_events": r.stats["loss_events"],
@@ -137,8 +143,9 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
             q = quality_of(r, quality)
             assessments.append((f"{r.pantograph} ({r.dropper_law} droppers)", q))
             data["runs"][r.dropper_law]["quality"] = q
+            aero = "" if r.aerodynamics is None else " (Fm with the aerodynamic uplift)"
             lines.append(f"current-collection quality [{r.dropper_law} droppers], {quality.system} criteria, "
-                         f"{r.speed_kmh:g} km/h: {'PASS' if q['pass'] else 'FAIL'}")
+                         f"{r.speed_kmh:g} km/h{aero}: {'PASS' if q['pass'] else 'FAIL'}")
             lines.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
         data["quality_pass"] = all(q["pass"] for _, q in assessments)
 
@@ -204,6 +211,8 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
         lines.append(f"{labels[k]}: static contact force {run.static_forces[k]:.2f} N; contact losses in window "
                      f"{len(s['loss_events'])} (<5 ms: {c['short_lt_5ms']}, 5-20 ms: {c['damaging_5_20ms']}, "
                      f">20 ms: {c['power_loss_gt_20ms']})")
+        if run.aerodynamics is not None:
+            lines.append(f"{labels[k]}: {run.aerodynamics[k].describe()}")
     for w in run.warnings:
         lines.append(f"WARNING: {w}")
     data = {"speed_kmh": run.speed_kmh, "element_length": run.params.element_length, "timestep": run.dt,
@@ -213,7 +222,9 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
                              "static_contact_force": run.static_forces[k],
                              "statistics": {key: run.stats[k][key] for key in STAT_KEYS},
                              "uplift_at_supports_mm": run.stats[k]["uplift_at_supports_mm"],
-                             "loss_events": run.stats[k]["loss_events"]} for k in range(len(run.names))],
+                             "loss_events": run.stats[k]["loss_events"],
+                             "aerodynamics": None if run.aerodynamics is None else run.aerodynamics[k].as_dict()}
+                            for k in range(len(run.names))],
             "warnings": run.warnings}
     qs = []
     if quality is not None:

@@ -11,6 +11,7 @@ from ...registry import Band, Effect, ModelSpec, RunPath, Studies, Uses
 from ...settings import SolverSettings
 from ...trust.estimate import AccuracySpec
 from . import accuracy
+from .aerodynamics import validate_section as validate_aerodynamics
 from .config import validate_train_section
 from .linefile import scene_params, validate_line_section
 from .pantographs import PANTOGRAPHS, SECTION_PANTOGRAPHS, TWO_MASS, validate_section
@@ -62,7 +63,7 @@ SPEC = ModelSpec(
     },
     solver=SolverSettings(engine="reference", timestep=1e-4, duration=6.1),
     sections={"pantograph": validate_section, "quality": validate_quality, "train": validate_train_section,
-              "line": validate_line_section},
+              "line": validate_line_section, "aerodynamics": validate_aerodynamics},
     cases="mbsuite.models.catenary.cases",
     accuracy=AccuracySpec(accuracy.headlines, accuracy.values, accuracy.refinement),
     uses=USES,

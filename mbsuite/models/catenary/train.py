@@ -30,8 +30,9 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import SolverError
+from ...errors import SceneError, SolverError
 from ...stepping import Stepping
+from .aerodynamics import Uplift
 from .config import HEAD_WIDTH, PassageConfig
 from .fe import CatenaryFE, assemble
 from .native_core import NativeCore
@@ -74,6 +75,7 @@ class TrainRun:
     x: np.ndarray | None = None  # (steps + 1, pantographs) positions on the global time
     regime: dict = field(default_factory=dict)  # `config.speed_regime` of the speed
     engine_warnings: list[dict[str, int]] = field(default_factory=list)  # per pantograph: its engine's warnings
+    aerodynamics: list[Uplift] | None = None  # per pantograph: its aerodynamic uplift (None: no [aerodynamics])
 
 
 class TrainPassage(Stepping):
@@ -231,6 +233,8 @@ def run_passage(cfg: PassageConfig, progress: Callable[[int, int], None] | None 
     t0, c0 = time.perf_counter(), time.process_time()
     fe = fe if fe is not None else assemble(p)
     pans = build_pantographs(list(cfg.pantographs), p, cfg.engine, dt, cfg.pantograph_section, cfg.contact)
+    if adm.uplift is not None:
+        apply_uplift(pans, adm.uplift)
     sim = CoupledSimulation(fe, pans[0], adm.V, dt, dropper_law=cfg.dropper_law, contact=cfg.contact)
     t1 = time.perf_counter()
     diagnostics = bool(record_energy or record_droppers)
@@ -275,7 +279,19 @@ def run_passage(cfg: PassageConfig, progress: Callable[[int, int], None] | None 
                     energy=energy, energy_t=None if energy is None else np.array(tp.energy_t),
                     warnings=adm.warnings, dropper_elastic=None if tp is None else tp.DE,
                     dropper_slack=None if tp is None else tp.DS, t=T, x=X, regime=adm.regime,
-                    engine_warnings=[pn.engine_warnings() if hasattr(pn, "engine_warnings") else {} for pn in pans])
+                    engine_warnings=[pn.engine_warnings() if hasattr(pn, "engine_warnings") else {} for pn in pans],
+                    aerodynamics=adm.uplift)
+
+
+def apply_uplift(pans: Sequence[Pantograph], uplift: Sequence[Uplift]) -> None:
+    """Hand each pantograph its constant aerodynamic forces (`aerodynamic(head, frame)`, N upward) before its static
+    state is set; a pantograph object without the method is refused naming it (its forces would be lost)."""
+    for k, (pan, up) in enumerate(zip(pans, uplift, strict=True)):
+        if not hasattr(pan, "aerodynamic"):
+            raise SceneError(f"pantograph {k + 1} ({getattr(pan, 'name', type(pan).__name__)}) takes no aerodynamic "
+                             "forces (it has no `aerodynamic(head, frame)`): remove the [aerodynamics] section or "
+                             "give the pantograph the method")
+        pan.aerodynamic(up.head, up.frame)
 
 
 def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -> tuple[dict, np.ndarray]:
@@ -300,12 +316,13 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
                    progress: Callable[[int, int], None] | None = None, fe: CatenaryFE | None = None,
                    record_energy: int = 0, stepwise: bool = False, head_width: float = HEAD_WIDTH,
                    record_droppers: bool = False, max_steps: float | None = None,
-                   allow_inaccurate: bool = False) -> TrainRun:
+                   allow_inaccurate: bool = False, aerodynamics: dict[str, Any] | None = None) -> TrainRun:
     """A train of pantographs (leading first) at `speed_kmh` with `spacings` (m, between consecutive contact
     points): the `PassageConfig` of these arguments through `run_passage` (its options: `record_energy`,
-    `record_droppers`, `stepwise`). Names are built on `engine` where they have it (`pantographs.build_train`)."""
+    `record_droppers`, `stepwise`). Names are built on `engine` where they have it (`pantographs.build_train`).
+    `aerodynamics`: an `[aerodynamics]` section (`aerodynamics.py`)."""
     cfg = PassageConfig(p, speed_kmh, dt, tuple(pantographs), tuple(spacings), dropper_law, contact, engine,
-                        pantograph_section, max_steps, allow_inaccurate, head_width)
+                        pantograph_section, max_steps, allow_inaccurate, head_width, aerodynamics)
     return run_passage(cfg, progress=progress, fe=fe, record_energy=record_energy, record_droppers=record_droppers,
                        stepwise=stepwise)
 

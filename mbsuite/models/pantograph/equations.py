@@ -71,11 +71,14 @@ class PantographODE:
     """x' = f(t, x) for the pantograph: x = [q, q', P?] with q = theta (compliant elbow) or (theta_1, theta_h) (rigid).
 
     `y_w(t)` is the ram/wire height. Use `rhs_with_force` to drive the head with an external vertical force instead
-    (catenary coupling)."""
+    (catenary coupling). `aero` = (F_head, F_frame): constant vertical forces (N, upward; the catenary's aerodynamic
+    uplift) at the head's and the upper arm's mass centres (`aero_forces_theta`); none by default."""
 
-    def __init__(self, params: PantographParams | None = None, config: PantographConfig | None = None, **effects):
+    def __init__(self, params: PantographParams | None = None, config: PantographConfig | None = None, *,
+                 aero: tuple[float, float] = (0.0, 0.0), **effects):
         self.p = params or PantographParams()
         self.cfg = config or PantographConfig(**effects)
+        self.aero = (float(aero[0]), float(aero[1]))
         self.elbow = Elbow(self.p, exact=self.cfg.elbow_kinematics == "exact")
         self.nq = 3 if self.cfg.elbow == "compliant" else 2
         self.has_P = self.cfg.cylinder in ("linear", "nonlinear")
@@ -206,11 +209,26 @@ class PantographODE:
         Te = self.p.ke * (e.theta_e - t[1]) + self.p.be * (e.dtheta_e * td[0] - td[1])
         return Te, e.dtheta_e
 
+    def aero_forces_theta(self, t: np.ndarray, R: np.ndarray) -> None:
+        """Add to R the generalised forces of the aerodynamic uplift `aero` = (F_head, F_frame): vertical, F_head at
+        the head's mass centre y = l1 sin t1 + l2 sin t2 + dh sin th, F_frame at the upper arm's (the frame's body
+        that meets the airflow above the roof) y = l1 sin t1 + d2 sin t2, the points where the MuJoCo path applies
+        them (xfrc_applied at the bodies' mass centres): F_head (l1 cos t1, l2 cos t2, dh cos th) + F_frame
+        (l1 cos t1, d2 cos t2, 0)."""
+        p = self.p
+        fh, ff = self.aero
+        R[0] += (fh + ff) * (p.l1 * math.cos(t[0]))
+        R[1] += (fh * p.l2 + ff * p.d2) * math.cos(t[1])
+        R[2] += fh * (p.dh * math.cos(t[2]))
+
     def applied_forces_theta(self, t: np.ndarray, td: np.ndarray, f_s: float, P: float | None) -> np.ndarray:
-        """R without joint friction: centripetal + gravity + catenary + head spring + cylinder + elbow."""
+        """R without joint friction: centripetal + gravity + catenary + aerodynamic uplift + head spring + cylinder +
+        elbow."""
         p = self.p
         R = self.velocity_forces_theta(t, td) + self.gravity_forces_theta(t)
         R += f_s * self.contact_jacobian_theta(t)
+        if self.aero != (0.0, 0.0):
+            self.aero_forces_theta(t, R)
         R[2] -= p.kh * t[2]
         R[0] += self.cylinder_force(t[0], P) * self.cylinder_lever(t[0])[1]
         if self.nq == 3:
@@ -283,6 +301,9 @@ class PantographODE:
         dy = y_w - y_d
         Vs = 0.5 * p.ks * (min(dy, 0.0) if self.cfg.contact == "unilateral" else dy) ** 2
         V = Vg + Vs + 0.5 * p.kh * t[2] ** 2
+        fh, ff = self.aero  # the potential of the constant aerodynamic uplift at the two mass centres
+        V -= fh * (p.l1 * math.sin(t[0]) + p.l2 * math.sin(t[1]) + p.dh * math.sin(t[2]))
+        V -= ff * (p.l1 * math.sin(t[0]) + p.d2 * math.sin(t[1]))
         if nq == 3:
             V += 0.5 * p.ke * (self.elbow(t[0]).theta_e - t[1]) ** 2
         xp = self.cylinder_lever(t[0])[0]
@@ -301,6 +322,8 @@ class PantographODE:
         f_s = self.contact_force(y_w, self.contact_height(np.concatenate([q, np.zeros(self.nq)])))
         p = self.p
         R = self.gravity_forces_theta(t) + f_s * self.contact_jacobian_theta(t)
+        if self.aero != (0.0, 0.0):
+            self.aero_forces_theta(t, R)
         R[2] -= p.kh * t[2]
         R[0] += p.Pg * p.Ap * self.cylinder_lever(t[0])[1]
         if self.nq == 3:
@@ -328,7 +351,8 @@ class PantographODE:
         if self.cfg.contact == "unilateral":
             # the guess puts y_d = y_w, on the kink of the clipped force, where fsolve stalls: start from the closed
             # contact's (smooth) equilibrium, which is this one whenever it pushes the wire (f_s <= 0)
-            closed = PantographODE(p, PantographConfig(**{**self.cfg.__dict__, "contact": "bilateral"}))
+            closed = PantographODE(p, PantographConfig(**{**self.cfg.__dict__, "contact": "bilateral"}),
+                                   aero=self.aero)
             guess = closed.equilibrium(y_w)[: self.nq]
         q, info, ier, msg = fsolve(lambda q: self.static_residual(q, y_w), guess, xtol=1e-14, full_output=True)
         res = np.max(np.abs(self.static_residual(q, y_w)))

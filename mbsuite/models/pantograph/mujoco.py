@@ -94,6 +94,19 @@ class MujocoPantograph:
         self.i_cat = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "catenary")
         self.i_cyl = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "cylinder")
         self._ode = PantographODE(self.p, self.cfg)
+        self.xfrc: np.ndarray | None = None  # constant body forces (nbody x 6) every static state carries
+
+    def set_uplift(self, head: float, frame: float) -> None:
+        """Constant vertical forces (N, upward) at the mass centres of the bodies `head` and `upper_arm` (the
+        catenary's aerodynamic uplift on the head and the frame; `PantographODE.aero_forces_theta` applies them at
+        the same points), as xfrc_applied: `set_static` puts them in the data, so the integration state saved from
+        it carries them into every step; the statics (`static_residual`) include them."""
+        m = self.model
+        x = np.zeros((m.nbody, 6))
+        x[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "head"), 2] = float(head)
+        x[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "upper_arm"), 2] = float(frame)
+        self.xfrc = x if np.any(x) else None
+        self._ode = PantographODE(self.p, self.cfg, aero=(float(head), float(frame)))
 
     # ------------------------------------------------------------------ statics
     def cylinder_rest(self, q1: float) -> float | None:
@@ -105,11 +118,13 @@ class MujocoPantograph:
         return None
 
     def set_static(self, q: np.ndarray, y_w: float, data: mujoco.MjData | None = None) -> None:
-        """Put the data (default: this object's) at rest at joint positions q, ram height y_w, cylinder at rest;
-        then mj_forward."""
+        """Put the data (default: this object's) at rest at joint positions q, ram height y_w, cylinder at rest, the
+        constant body forces of `set_uplift` applied; then mj_forward."""
         d, m = (self.data if data is None else data), self.model
         mujoco.mj_resetData(m, d)
         d.qpos[:] = q
+        if self.xfrc is not None:
+            d.xfrc_applied[:] = self.xfrc
         d.ctrl[self.i_cat] = y_w
         if m.na:
             d.act[m.actuator_actadr[self.i_cyl]] = self.cylinder_rest(float(q[0]))
@@ -117,10 +132,15 @@ class MujocoPantograph:
         core.check_plugin_faults(m, d, "pantograph statics (MuJoCo)")
 
     def static_residual(self, q: np.ndarray, y_w: float) -> np.ndarray:
-        """qfrc_passive + qfrc_actuator - qfrc_bias at rest (friction-free), from MuJoCo's own force evaluation."""
+        """qfrc_passive + qfrc_actuator - qfrc_bias at rest (friction-free), from MuJoCo's own force evaluation, plus
+        the generalised force of the constant body forces (`set_uplift`; mj_applyFT at each body's mass centre, as
+        MuJoCo applies xfrc_applied)."""
         self.set_static(q, y_w)
-        d = self.data
+        d, m = self.data, self.model
         r = d.qfrc_passive + d.qfrc_actuator - d.qfrc_bias
+        if self.xfrc is not None:
+            for b in np.flatnonzero(np.any(self.xfrc != 0.0, axis=1)):
+                mujoco.mj_applyFT(m, d, self.xfrc[b, :3], self.xfrc[b, 3:], d.xipos[b], int(b), r)
         if self.cfg.elbow == "rigid":  # reduce onto the constraint manifold: tangent direction (1, dq2/dq1, 0)
             coef, _ = rigid_elbow_fit(self.p, self.cfg.elbow_kinematics == "exact")
             dq2 = np.polynomial.polynomial.polyval(q[0], np.polynomial.polynomial.polyder(coef))

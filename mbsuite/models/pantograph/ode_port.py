@@ -6,8 +6,9 @@ without Python.
 A trial is one classical RK4 step of `PantographODE.rhs_with_force` (`equations.py`, followed statement by statement)
 with the contact force varying linearly f0 -> f1 over the step; it answers the contact height less y_op. The two agree
 to rounding (the 3x3 solve is Gaussian elimination in C, LAPACK in numpy): `tests/pantograph/test_ode_port.py`.
-`OdePort(ref)` copies the parameters, effects and committed state of an `EppingerReference`; outputs per recorded
-row: head_displacement, theta_1, theta_2, theta_h (`EppingerReference.signals`).
+`OdePort(ref)` copies the parameters, effects, aerodynamic uplift (`PantographODE.aero`) and committed state of an
+`EppingerReference`; outputs per recorded row: head_displacement, theta_1, theta_2, theta_h
+(`EppingerReference.signals`).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ Reference = Any
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 1
+ABI = 2
 #: largest state (MBS_PANTO_ODE_NX): 3 angles, 3 rates, the cylinder state
 NX = 7
 #: outputs per row, in order (the keys of `EppingerReference.signals`)
@@ -50,6 +51,7 @@ class _State(ctypes.Structure):
         *((name, _D) for name in PARAMS),
         ("g", _D), ("b", _D * 3), ("c", _D * 3),
         ("K12", _D), ("K13", _D), ("K23", _D), ("r_crit", _D), ("gas", _D), ("phi1_0", _D), ("lfb0", _D), ("h2", _D),
+        ("aero_head", _D), ("aero_frame", _D),
         ("m_lam", _D), ("dp_lam", _D),
         ("x", _D * NX), ("pending", _D * NX), ("has_pending", _I),
         ("fail_code", _I), ("fail_stage", _I), ("fail_index", _I),
@@ -111,6 +113,7 @@ class OdePort:
         s.r_crit, s.gas = float(ode.r_crit), float(ode.gas)
         s.phi1_0, s.lfb0 = float(ode.elbow.phi1_0), float(ode.elbow.lfb0)
         s.h2 = H_SECOND
+        s.aero_head, s.aero_frame = ode.aero
         self.port = Port()
         self.lib.mbs_panto_ode_port(ctypes.byref(self.port), ctypes.byref(s))
         self.push(ref)

@@ -10,7 +10,12 @@ the head down and the wire up) varies linearly from f0 to f1:
 - `trial(t, dt, f0, f1) -> y`: contact-point height (m, same datum) at t + dt under that force history, state
   unchanged; `commit()` accepts the last trial;
 - `head() -> y`, `signals() -> {name: value}`; `affine = False` (the catenary couples by a secant iteration on f1);
-  `engine` names the path; `engine_warnings()` (MuJoCo path) the MuJoCo warnings raised.
+  `engine` names the path; `engine_warnings()` (MuJoCo path) the MuJoCo warnings raised;
+- `aerodynamic(head, frame)`: constant vertical forces (N, upward; the catenary's aerodynamic uplift, F = c v^2) on the
+  head body at its mass centre and on the frame's upper arm at its mass centre, before `static` (whose equilibrium
+  then includes them). Both paths apply them at the same points: the hand-derived ODE by their generalised forces
+  (`PantographODE.aero_forces_theta`), MuJoCo as xfrc_applied on the bodies `head` and `upper_arm` (applied at a
+  body's mass centre), carried by the saved integration state into every step.
 
 Heights: the contact-point height y_d is measured from the base pivot; the undisturbed wire is at the operating height
 y_op, so the catenary sees y_d - y_op. The static uplift is not a parameter: it follows from the supply pressure Pg (the
@@ -82,10 +87,17 @@ class EppingerReference:
         self.name = name
         self.params = PantographParams(**(params or {}))
         self.cfg = config(effects, self.coulomb_law)
+        self.aero = (0.0, 0.0)
         self.ode = PantographODE(self.params, self.cfg)
         self.y_op = self.params.y_op
         self.x = np.zeros(self.ode.n)
         self._pending = None
+
+    def aerodynamic(self, head: float, frame: float) -> None:
+        """The constant aerodynamic uplift (N, upward) at the head's and the upper arm's mass centres (module
+        docstring); before `static`."""
+        self.aero = (float(head), float(frame))
+        self.ode = PantographODE(self.params, self.cfg, aero=self.aero)
 
     @classmethod
     def build(cls, params: dict[str, Any], effects: dict[str, Any], timestep: float) -> EppingerReference:
@@ -100,7 +112,7 @@ class EppingerReference:
     def static(self, y_wire: float, k_wire: float) -> float:
         """Static equilibrium under the wire at height y_w; returns the contact force."""
         _no_free_equilibrium(k_wire, self.params)
-        ode = PantographODE(dataclasses.replace(self.params, ks=float(k_wire)), self.cfg)
+        ode = PantographODE(dataclasses.replace(self.params, ks=float(k_wire)), self.cfg, aero=self.aero)
         y_w = self.y_op + y_wire
         self.x = ode.equilibrium(y_w)
         return float(k_wire * (ode.contact_height(self.x) - y_w))
@@ -222,6 +234,11 @@ class EppingerMujoco:
         m.actuator_biasprm[i, :] = 0.0
         m.actuator_forcelimited[i] = 0
         m.actuator_ctrllimited[i] = 0
+
+    def aerodynamic(self, head: float, frame: float) -> None:
+        """The constant aerodynamic uplift (N, upward) as xfrc_applied at the head's and the upper arm's mass centres
+        (module docstring; `MujocoPantograph.set_uplift`); before `static`, whose saved state carries it."""
+        self.sim.set_uplift(head, frame)
 
     def static(self, y_wire: float, k_wire: float) -> float:
         """Static equilibrium under the wire at height y_w; returns the contact force."""

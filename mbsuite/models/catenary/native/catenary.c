@@ -23,7 +23,7 @@
 
 #include "mbsuite.h"
 
-#define CAT_ABI 4
+#define CAT_ABI 5
 /* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
  * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
  * rounding) */
@@ -859,14 +859,15 @@ int mbs_cat_check(cat_job* J) {
 
 /* ---------------------------------------------------------------------------------- 2-mass pantographs */
 /* The EN 50318 2-mass pantograph as a one-port (mbsuite.h), the twin of `pantographs.TwoMassPantograph`: its state in
- * TM_SIZE doubles, x1 x2 v1 v2, S^-1 (S00 S01 S10 S11, S = M + hC + h^2 K), m1 m2, k11 k12 k22, F0, then the pending
- * x1 x2 v1 v2 of the last trial. The trapezoidal rule makes its head height exactly affine in the end force. */
-#define TM_SIZE 18
+ * TM_SIZE doubles, x1 x2 v1 v2, S^-1 (S00 S01 S10 S11, S = M + hC + h^2 K), m1 m2, k11 k12 k22, the frame's constant
+ * uplift F0 + Fa_f, the head's aerodynamic uplift Fa_h, then the pending x1 x2 v1 v2 of the last trial. The
+ * trapezoidal rule makes its head height exactly affine in the end force. */
+#define TM_SIZE 19
 
 static void twomass_map(void* self, double t, double dt, double f0, double* P, double* g) {
   const double* s = (const double*)self;
   const double h = 0.5 * dt;
-  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + 0.0) / 2;
+  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + 0.0) / 2 + h * s[14];
   const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
   *P = s[0] + 2 * h * (s[4] * r1 + s[5] * r2);
   *g = h * h * s[4];
@@ -875,21 +876,21 @@ static void twomass_map(void* self, double t, double dt, double f0, double* P, d
 static int twomass_trial(void* self, double t, double dt, double f0, double f1, double* y) {
   double* s = (double*)self;
   const double h = 0.5 * dt;
-  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + f1) / 2;
+  const double r1 = s[8] * s[2] - h * (s[10] * s[0] + s[11] * s[1]) - h * (f0 + f1) / 2 + h * s[14];
   const double r2 = s[9] * s[3] - h * (s[11] * s[0] + s[12] * s[1]) + h * s[13];
   const double vb1 = s[4] * r1 + s[5] * r2;
   const double vb2 = s[6] * r1 + s[7] * r2;
-  s[14] = s[0] + 2 * h * vb1;
-  s[15] = s[1] + 2 * h * vb2;
-  s[16] = 2 * vb1 - s[2];
-  s[17] = 2 * vb2 - s[3];
-  *y = s[14];
+  s[15] = s[0] + 2 * h * vb1;
+  s[16] = s[1] + 2 * h * vb2;
+  s[17] = 2 * vb1 - s[2];
+  s[18] = 2 * vb2 - s[3];
+  *y = s[15];
   return 0;
 }
 
 static void twomass_commit(void* self) {
   double* s = (double*)self;
-  memcpy(s, s + 14, 4 * sizeof(double));
+  memcpy(s, s + 15, 4 * sizeof(double));
 }
 
 static void twomass_outputs(const void* self, double* out) {

@@ -24,7 +24,7 @@
 
 #include "mbsuite.h"
 
-#define MBS_PANTO_ODE_ABI 1
+#define MBS_PANTO_ODE_ABI 2
 #define MBS_PANTO_ODE_NX 7 /* largest state: 3 angles, 3 rates, the cylinder state */
 
 /* failure codes (ode_port.py mirrors them) */
@@ -56,6 +56,7 @@ typedef struct {
   double b[3], c[3]; /* viscous and Coulomb coefficients (0 when the effect is off) */
   double K12, K13, K23, r_crit, gas, phi1_0, lfb0;
   double h2;         /* step of Elbow.second_derivative */
+  double aero_head, aero_frame; /* PantographODE.aero: vertical uplift (N) at the head's / upper arm's mass centre */
   /* derived by mbs_panto_ode_port: the orifice's laminar band */
   double m_lam, dp_lam;
   /* states */
@@ -247,7 +248,8 @@ static int po_cylinder_rate(mbs_panto_ode* s, double t1, double t1d, double P, d
   return PO_OK;
 }
 
-/* `applied_forces_theta`: R without joint friction (centripetal, gravity, catenary, head spring, cylinder, elbow) */
+/* `applied_forces_theta`: R without joint friction (centripetal, gravity, catenary, aerodynamic uplift, head spring,
+ * cylinder, elbow) */
 static int po_applied_forces(mbs_panto_ode* s, const double* t, const double* td, double f_s, double P, double* R) {
   /* velocity_forces_theta */
   double s12 = sin(t[0] + t[1]);
@@ -263,6 +265,12 @@ static int po_applied_forces(mbs_panto_ode* s, const double* t, const double* td
   R[0] += f_s * (s->l1 * cos(t[0]));
   R[1] += f_s * (s->l2 * cos(t[1]));
   R[2] += f_s * (s->lh * cos(t[2]));
+  /* + aero_forces_theta: F_head at the head's mass centre, F_frame at the upper arm's */
+  if (s->aero_head != 0.0 || s->aero_frame != 0.0) {
+    R[0] += (s->aero_head + s->aero_frame) * (s->l1 * cos(t[0]));
+    R[1] += (s->aero_head * s->l2 + s->aero_frame * s->d2) * cos(t[1]);
+    R[2] += s->aero_head * (s->dh * cos(t[2]));
+  }
   R[2] -= s->kh * t[2];
   double xp, dxp;
   po_cylinder_lever(s, t[0], &xp, &dxp);

@@ -64,7 +64,7 @@ bench: $(STAMP)  ## benchmarks (ratios measured side by side in one run; not tes
 	$(BIN)/python scripts/bench_sweep.py
 
 DOCS_FLAGS ?=
-docs: $(STAMP)  ## the documentation site -> out/site/; gallery figures cached in out/gallery-cache (DOCS_FLAGS=--rebuild)
+docs: $(STAMP)  ## the documentation site -> out/site/ (figures cached in out/gallery-cache, studies stored in docs/gallery-stores; DOCS_FLAGS=--rebuild)
 	$(BIN)/python -m pip install --quiet -c $(TESTED) -e ".[docs]"
 	$(BIN)/python scripts/build_docs.py $(DOCS_FLAGS)
 

@@ -96,7 +96,9 @@ class Plan:
     """What a piece of long work will run: `runs` (an upper bound when `upto`: an optimiser may stop early),
     `parallel` at a time, `detail` in words; `cheaper(runs)` names a setting of the analysis that fits in `runs`
     runs (None: the analysis knows none); `weights`: the runs' relative costs where they differ (an error estimate's
-    companions), in the order of the sweep that runs them."""
+    companions), in the order of the sweep that runs them; `unit`: the wall time (s) of work of weight 1 when it is
+    known before the work starts (an error estimate's run, timed before its companions): then the estimate, and the
+    budget's check, come before the first run."""
 
     what: str
     runs: int
@@ -105,6 +107,7 @@ class Plan:
     detail: str = ""
     cheaper: Callable[[int], str | None] | None = None
     weights: tuple[float, ...] = ()
+    unit: float | None = None
     done: int = 0
     started: float = field(default_factory=time.perf_counter)
     finished: list[Any] = field(default_factory=list)
@@ -114,7 +117,16 @@ class Plan:
         n = f"up to {self.runs}" if self.upto else str(self.runs)
         detail = f" ({self.detail})" if self.detail else ""
         par = "one at a time" if self.parallel <= 1 else f"{self.parallel} in parallel"
-        return f"{self.what}: {n} run{'s' if self.runs != 1 else ''}{detail}, {par}; time estimate after the first"
+        ahead = self.ahead()
+        when = ("time estimate after the first" if ahead is None else
+                f"about {duration(ahead)} (the run took {duration(self.unit)})")
+        return f"{self.what}: {n} run{'s' if self.runs != 1 else ''}{detail}, {par}; {when}"
+
+    def ahead(self) -> float | None:
+        """The wall time of all runs estimated before any has run, from `unit` and `weights`; None without them."""
+        if self.unit is None or not self.weights or self.unit <= 0:
+            return None
+        return self.unit * max(sum(self.weights) / max(self.parallel, 1), max(self.weights))
 
     def estimate(self, first: float, index: int | None = None) -> float:
         """The wall time of all runs from the first finished run's (s; `index`: which run it was, with `weights`:
@@ -154,9 +166,16 @@ class Study:
                 print(text, file=self.stream, flush=True)
 
     def start(self, plan: Plan) -> None:
-        """Declare `plan` (say it; open the bar)."""
+        """Declare `plan` (say it; open the bar); a plan whose time is known before it starts (`Plan.ahead`) is
+        checked against the budget here, before any of its runs."""
         self.plan = self.last = plan
         self.say(plan.statement())
+        ahead = plan.ahead()
+        if ahead is not None and self.budget is not None and ahead > self.budget and not self.confirmed:
+            self.plan = None
+            raise OverBudget(f"{plan.what}: about {duration(ahead)} for {plan.runs} runs ({plan.detail}; the run "
+                             f"took {duration(plan.unit)}, {plan.parallel} in parallel), above the budget of "
+                             f"{duration(self.budget)} (--budget SECONDS): run it with --yes")
         if self.bar_wanted:
             self._bar = Progress(plan.runs, plan.what, enabled=True)
 
@@ -251,15 +270,16 @@ def study(command: str, **kw: Any) -> Iterator[Study]:
 
 @contextmanager
 def planned(what: str, runs: int, parallel: int, *, upto: bool = False, detail: str = "",
-            cheaper: Callable[[int], str | None] | None = None, weights: tuple[float, ...] = ()
-            ) -> Iterator[Study | None]:
+            cheaper: Callable[[int], str | None] | None = None, weights: tuple[float, ...] = (),
+            unit: float | None = None) -> Iterator[Study | None]:
     """Declare the plan of an analysis that knows its whole size (module docstring); the sweeps it runs report into
-    it. Yields the study, or None outside a command line or inside another plan."""
+    it (`unit`: `Plan.unit`, its time known ahead). Yields the study, or None outside a command line or inside
+    another plan."""
     s = active()
     if s is None or s.plan is not None:
         yield None
         return
-    s.start(Plan(what, max(int(runs), 1), max(int(parallel), 1), upto, detail, cheaper, tuple(weights)))
+    s.start(Plan(what, max(int(runs), 1), max(int(parallel), 1), upto, detail, cheaper, tuple(weights), unit))
     try:
         yield s
     finally:

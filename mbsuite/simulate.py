@@ -3,6 +3,8 @@ optional error estimate of its headline outputs (`mbsuite.analysis.errorestimate
 
 from __future__ import annotations
 
+import time
+
 from .errors import SceneError
 from .pathrun import run_judged, run_name
 from .scenes import Scene, load_scene
@@ -25,11 +27,13 @@ def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool =
         scene = scene.replace(solver={"engine": engine})
     if error_estimate and spec.paths and spec.accuracy is None:
         raise SceneError(f"model '{spec.name}' declares no headline outputs: no error estimate")
+    t0 = time.perf_counter()
     res = run_judged(scene)
     if error_estimate:
         from .analysis.errorestimate import error_estimate as estimate_error
 
-        res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers)
+        res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers,
+                                            base_seconds=time.perf_counter() - t0)
         figures = res.error_estimate.figures()
         res.health.extend(figures)
         inaccurate = judge_estimate(figures, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene))

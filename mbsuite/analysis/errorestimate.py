@@ -76,13 +76,15 @@ def coarse_companions(scene: Scene, ref: Refinement) -> list[Scene]:
 
 def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
                    evaluate: Callable[[dict], Mapping[str, float]] = run_values, workers: int = 0,
-                   companions: str | None = None) -> ErrorEstimate:
+                   companions: str | None = None, base_seconds: float | None = None) -> ErrorEstimate:
     """The estimated error of every headline of `scene` from its companions (module docstring,
     `mbsuite.trust.estimate`).
 
     `base`: the headline values of the scene's own run when the caller has it (only the companions run then);
     `workers`: local processes for the levels (0 = all cores); `companions`: "fine" or "coarse" to override the
-    model's declaration (`Refinement.companions`; None: as declared)."""
+    model's declaration (`Refinement.companions`; None: as declared); `base_seconds`: the wall time of the run whose
+    values `base` are, when known: the companions' time is then estimated (their work relative to the run's, `cost`)
+    and checked against the command's budget before any of them runs (`mbsuite.progress`)."""
     acc = scene.spec.accuracy
     heads = declared(scene)
     ref = acc.refinement(scene)
@@ -91,7 +93,7 @@ def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
         raise ValueError(f"companions must be 'fine' or 'coarse', got {kind!r}")
     fallback, coarse = "", None
     if kind == "coarse":
-        coarse, why, run = _coarse_estimate(scene, ref, heads, base, evaluate, workers)
+        coarse, why, run = _coarse_estimate(scene, ref, heads, base, evaluate, workers, base_seconds)
         if coarse is not None and coarse.passed:
             return coarse
         base = base if base is not None else run  # the run's values, when they were computed, are not run again
@@ -104,7 +106,8 @@ def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
     # the most refined copy is the longest: submit it first, so the others share the remaining cores
     w = [cost(ref, k) for k in (range(1, 3) if base is not None else range(3))][::-1]
     with planned("error estimate (refined companions)", len(jobs), min(n_workers(workers), len(jobs)),
-                 detail=_work(w) + (", after the coarse ones" if fallback else ""), weights=tuple(w)):
+                 detail=_work(w) + (", after the coarse ones" if coarse is not None else ""), weights=tuple(w),
+                 unit=base_seconds if base is not None else None):
         results = run_sweep(evaluate, jobs[::-1], workers=workers, desc="error estimate", executor="local")[::-1]
     vals: list[Any] = ([dict(base)] if base is not None else []) + [dict(r) for r in results]
     est = estimate(vals, heads, ref, settings=level_settings(scene, levels))
@@ -113,8 +116,8 @@ def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
 
 
 def _coarse_estimate(scene: Scene, ref: Refinement, heads, base: Mapping[str, float] | None,
-                     evaluate: Callable[[dict], Mapping[str, float]],
-                     workers: int) -> tuple[ErrorEstimate | None, str, dict[str, float] | None]:
+                     evaluate: Callable[[dict], Mapping[str, float]], workers: int,
+                     base_seconds: float | None = None) -> tuple[ErrorEstimate | None, str, dict[str, float] | None]:
     """(the estimate from the coarse companions or None, why they could not run, the run's values if computed
     here)."""
     try:
@@ -126,7 +129,7 @@ def _coarse_estimate(scene: Scene, ref: Refinement, heads, base: Mapping[str, fl
         (functools.partial(companion_values, evaluate), sc.to_dict()) for sc in comps]
     w = [cost(ref, k) for k in ((-1, -2) if base is not None else (0, -1, -2))]
     with planned("error estimate (coarse companions)", len(jobs), min(n_workers(workers), len(jobs)),
-                 detail=_work(w), weights=tuple(w)):
+                 detail=_work(w), weights=tuple(w), unit=base_seconds if base is not None else None):
         results = run_sweep(_call, jobs, workers=workers, desc="error estimate", executor="local")
     run = dict(results[0]) if base is None else None
     failed = [(k, r[FAILED]) for k, r in enumerate(results[-2:], start=1) if FAILED in r]

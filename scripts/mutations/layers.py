@@ -122,4 +122,10 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    v = getattr(args, \"speed\", None)\n    if v is None or True:\n        return scene\n",
              "--speed accepted and ignored on run, sweep and sensitivity (the scene's own speed runs)",
              "tests/suite/test_progress.py"),
+    Mutation("progress_ahead_unit_ignored", "mbsuite/progress.py",
+             "        return self.unit * max(sum(self.weights) / max(self.parallel, 1), max(self.weights))",
+             "        return self.unit * sum(self.weights) / max(self.parallel, 1)",
+             "an error estimate's companions estimated ahead as if they shared the workers evenly (the 16x "
+             "companion alone outlasts the others: the estimate, and the budget's check, too low)",
+             "tests/suite/test_progress.py"),
 )

@@ -156,6 +156,28 @@ def test_weighted_estimate_scales_the_first_run_by_its_share_of_the_work():
     assert plan.estimate(1.0, index=2) == pytest.approx(16.0 * (1 + 0.25 + 0.0625))
 
 
+def test_error_estimate_with_the_run_timed_is_judged_before_its_companions():
+    """Refined companions after a run of 50 s: 16 + 4 times its work on two workers, at least the 16x one alone:
+    800 s, said before any companion starts and over a 300 s budget stopped there (nothing of theirs has run)."""
+    out = io.StringIO()
+    st = progress.Study("catenary", budget=300.0, stream=out, bar=False)
+    plan = progress.Plan("error estimate (refined companions)", 2, 2, detail="about 16 and 4 x the run's work",
+                         weights=(16.0, 4.0), unit=50.0)
+    assert plan.ahead() == 50.0 * max(20.0 / 2, 16.0)
+    with pytest.raises(progress.OverBudget) as exc:
+        st.start(plan)
+    assert "about 13.3 min (the run took 50 s)" in _lines(out)[0]
+    assert "about 13.3 min for 2 runs" in str(exc.value) and "--yes" in str(exc.value)
+    assert st.plan is None and plan.done == 0
+    st.confirmed = True  # --yes: the plan starts
+    st.start(plan)
+    assert st.plan is plan
+    # coarse companions (1/4, 1/16) on two workers: the 1/4 one's time, 12.5 s, within the budget
+    st2 = progress.Study("catenary", budget=300.0, stream=io.StringIO(), bar=False)
+    st2.start(progress.Plan("error estimate (coarse companions)", 2, 2, weights=(0.25, 0.0625), unit=50.0))
+    assert st2.plan.ahead() == pytest.approx(12.5)
+
+
 @pytest.mark.parametrize("command", [["run"], ["sweep", "--vary", "params.F0=110,120"],
                                      ["sensitivity", "--vary", "params.F0=100:140"]])
 def test_speed_means_input_speed_on_every_command(command, monkeypatch):

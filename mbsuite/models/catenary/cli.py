@@ -5,6 +5,7 @@ statistics' estimated errors (`accuracy.py`)."""
 from __future__ import annotations
 
 import argparse
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -195,38 +196,44 @@ def catenary_of(scene: Scene, args: argparse.Namespace) -> Report:
             sec["system"] = args.system
         criteria = criteria_from(sec)
     workers = check_workers(args.workers)
+    t0 = time.perf_counter()
     if "train" in scene.sections:
         with Progress(100, desc="catenary train") as bar:
             run = run_train_scene(scene, progress=_Percent(bar))
         rep = train_report(run, quality=criteria, scene_dict=scene.to_dict())
         if args.error_estimate:
-            add_estimate(rep, scene, run.stats, workers)
+            add_estimate(rep, scene, run.stats, workers, time.perf_counter() - t0)
         return rep
     variants = [scene]
     if args.with_linear and scene.effects["droppers"] != "linear":
         variants.append(scene.replace(effects={"droppers": "linear"}))
-    runs = []
+    runs, took = [], []
     for sc in variants:
+        t0 = time.perf_counter()
         with Progress(100, desc=f"catenary {sc.effects['droppers']}") as bar:
             runs.append(run_scene(sc, progress=_Percent(bar)))
+        took.append(time.perf_counter() - t0)
     rep = report(runs[0], scene.to_dict(), runs[1:], quality=criteria)
     if args.error_estimate:
-        add_estimate(rep, scene, [runs[0].stats], workers)
+        add_estimate(rep, scene, [runs[0].stats], workers, took[0])
     return rep
 
 
-def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0) -> None:
+def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0,
+                 seconds: float | None = None) -> None:
     """Estimate the error of every pantograph's statistics of the passage `stats` (the scene's own run, leading
     pantograph first) from its companions (`accuracy.refinement`: coarsened once and twice, else refined once and
     twice; run in parallel), judge each estimate against its tolerance and add the table, `error_estimate` and the
     warnings to the report. An estimate above its tolerance keeps the report: a warning where the scene allows
     inaccurate results, else `InaccurateResult` carrying the report (the command prints it, writes its files and
-    exits 3)."""
+    exits 3). `seconds`: the run's wall time, from which the companions' time is estimated (and checked against the
+    budget) before they start."""
     from ...analysis.errorestimate import error_estimate
     from ...trust.health import InaccurateResult, judge_estimate
     from .accuracy import passage_values, stats_values
 
-    est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers)
+    est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers,
+                         base_seconds=seconds)
     warned = judge_estimate(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
                             what=f"catenary scene {scene.name or scene.source or ''}".strip())
     rep.data["error_estimate"] = est.to_dict()

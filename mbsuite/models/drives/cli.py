@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import textwrap
+import time
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -401,12 +402,14 @@ def run_of(sc, a: argparse.Namespace) -> Report:
     from .plots import loss_label
     from .scene_run import sim_result
 
+    t0 = time.perf_counter()
     res = sim_result(sc, *simulate_scene(sc))
+    took = time.perf_counter() - t0
     what = f"drives scene {sc.name or sc.source or ''}".strip()
     res.warnings.extend(judge(res.health, allow_inaccurate=sc.solver.allow_inaccurate, what=what))
     inaccurate = []
     if a.error_estimate:  # an estimate above its tolerance keeps the report, flagged (exit 3) unless allowed
-        res.error_estimate = error_estimate(sc, base=accuracy.values(sc, res))
+        res.error_estimate = error_estimate(sc, base=accuracy.values(sc, res), base_seconds=took)
         res.health.extend(res.error_estimate.figures())
         inaccurate = judge_estimate(res.error_estimate.figures(), allow_inaccurate=sc.solver.allow_inaccurate,
                                     what=what)

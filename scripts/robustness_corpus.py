@@ -638,6 +638,8 @@ def cli_attempts() -> Iterator[Attempt]:
                   ("sweep", "pantograph", "--vary", "input.frequency=2,4", "--budget", v), culprit="budget")
     yield cli("sweep-over-budget", a, "a sweep whose estimate exceeds --budget stops naming --yes",
               "sweep pantograph --vary input.frequency=2,4,6,8 --workers 1 --budget 0.001", culprit="--yes")
+    yield cli("estimate-over-budget", a, "an error estimate whose companions exceed --budget stops before they run, "
+              "naming --yes", "catenary catenary/en50318 --error-estimate --workers 1 --budget 0.001", culprit="--yes")
     yield cli("run-speed-without-a-speed", a, "--speed on a scene whose model has no speed",
               "run pantograph --speed 200", culprit="speed")
     yield cli("run-speed-and-set", a, "--speed and --set input.speed together",

@@ -32,7 +32,7 @@ demo: $(STAMP)  ## the headline in ~1 min: pantograph frequency response, EN 503
 	$(BIN)/python scripts/demo.py --out out/demo
 
 test: $(STAMP)  ## default suite (slow studies excluded)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist worksteal
 
 test-slow: $(STAMP)  ## long studies only
 	$(BIN)/python -m pytest -q -m slow
@@ -42,12 +42,12 @@ test-slow: $(STAMP)  ## long studies only
 PERTURB_SEEDS ?= 1 2 3 4 5 6
 test-perturbed: $(STAMP)  ## the `rounding` tests under seeded 1e-12...1e-10 input perturbations, one run per seed
 	@status=0; for s in $(PERTURB_SEEDS); do \
-	  $(BIN)/python -m pytest -q --perturb 1e-12:1e-10 --perturb-seed $$s || status=1; \
+	  $(BIN)/python -m pytest -q -n auto --dist worksteal --perturb 1e-12:1e-10 --perturb-seed $$s || status=1; \
 	done; exit $$status
 
 test-lowest: $(LOW_STAMP)  ## default suite at the lowest versions pyproject.toml allows, in .venv-lowest
 	$(LOW_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|matplotlib|distributed|tqdm|mujoco|pin|pytest|hypothesis|pandas)=='
-	$(LOW_VENV)/bin/python -m pytest -q
+	$(LOW_VENV)/bin/python -m pytest -q -n auto --dist worksteal
 
 lock:  ## constraints/tested.txt <- the versions installed in .venv (after `make test` passed there)
 	@test -f $(STAMP) || { echo "make lock: no installed .venv; run make test first" >&2; exit 1; }

@@ -42,7 +42,11 @@ BUDGET = 300.0
 
 
 class OverBudget(MbsuiteError):
-    """The estimated time of a study exceeds its budget (the command line's --budget) and --yes was not given."""
+    """The estimated time of a study exceeds its budget (the command line's --budget) and --yes was not given.
+    `result`: what was finished before the study and is kept (an error estimate's run: the command prints and writes
+    it, then stops with this error); None where nothing was."""
+
+    result: Any = None
 
 
 class Progress:
@@ -175,7 +179,8 @@ class Study:
             self.plan = None
             raise OverBudget(f"{plan.what}: about {duration(ahead)} for {plan.runs} runs ({plan.detail}; the run "
                              f"took {duration(plan.unit)}, {plan.parallel} in parallel), above the budget of "
-                             f"{duration(self.budget)} (--budget SECONDS): run it with --yes")
+                             f"{duration(self.budget)} (--budget SECONDS): run it with --yes or --budget "
+                             f"{math.ceil(ahead * 1.2 / 60) * 60}, or without it")
         if self.bar_wanted:
             self._bar = Progress(plan.runs, plan.what, enabled=True)
 

@@ -33,7 +33,9 @@ def _params(spec: ModelSpec) -> dict[str, Any]:
     props = {}
     for f in dataclasses.fields(spec.params_cls):
         lim = f.metadata.get("limit")
-        if lim is None:
+        if lim is None and str(f.type).startswith("list[list"):  # rows of numbers (a catenary's windows)
+            props[f.name] = {"type": "array", "items": {"type": "array", "items": {"type": "number"}}}
+        elif lim is None:
             props[f.name] = {"type": "array", "items": {"type": "number"}}
         else:
             props[f.name] = json_of(lim)

@@ -30,7 +30,8 @@ the value came from: the file, the dictionary, Python (`Scene.replace`) or the c
 Values are taken as a numpy user passes them (`plain`): every real number type (`mbsuite.limits.real`: numpy scalars
 and 0-d arrays, `Fraction`, `Decimal`) is the Python number it holds, tuples and arrays are lists. A string is never
 split into a list: where a list is meant (`outputs.signals`, list-valued parameters such as the catenary's
-`dropper_positions`, a model section's lists) a string is an error, except `replace(outputs="F1")`, one signal.
+`dropper_positions`, a model section's lists; a list of rows, a catenary's `windows`) a string is an error, except
+`replace(outputs="F1")`, one signal.
 """
 
 from __future__ import annotations
@@ -199,6 +200,12 @@ def _param_value(spec: ModelSpec, key: str, value: Any, where: str) -> Any:
         if isinstance(value, str):
             raise SceneError(f"parameter {key} = {value!r}{where} is a string, but a list of numbers is meant: "
                              f"{key} = [x1, x2, ...] (SI units)")
+        if str(f.type).startswith("list[list"):  # a list of rows of numbers (a catenary's windows)
+            if not isinstance(value, list) or any(not isinstance(r, list) or any(real(x) is None for x in r)
+                                                  for r in value):
+                raise SceneError(f"parameter {key} = {value!r}{where} must be a list of lists of numbers "
+                                 f"({key} = [[a, b], ...], SI units)")
+            return [[float(real(x)) for x in r] for r in value]
         if not isinstance(value, list) or any(real(x) is None for x in value):
             raise SceneError(f"parameter {key} = {value!r}{where} must be a list of numbers (SI units)")
         return [float(real(x)) if "float" in str(f.type) else real(x) for x in value]

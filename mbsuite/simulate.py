@@ -31,9 +31,14 @@ def run(scene: Scene | str, engine: str | None = None, *, error_estimate: bool =
     res = run_judged(scene)
     if error_estimate:
         from .analysis.errorestimate import error_estimate as estimate_error
+        from .progress import OverBudget
 
-        res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers,
-                                            base_seconds=time.perf_counter() - t0)
+        try:
+            res.error_estimate = estimate_error(scene, base=spec.accuracy.values(scene, res), workers=workers,
+                                                base_seconds=time.perf_counter() - t0)
+        except OverBudget as exc:  # the run is kept (`OverBudget.result`): the command line shows it, then stops
+            exc.result = res
+            raise
         figures = res.error_estimate.figures()
         res.health.extend(figures)
         inaccurate = judge_estimate(figures, allow_inaccurate=scene.solver.allow_inaccurate, what=run_name(scene))

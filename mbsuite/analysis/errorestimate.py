@@ -26,7 +26,7 @@ from typing import Any
 
 from ..engines.core import n_workers
 from ..errors import MbsuiteError
-from ..progress import planned
+from ..progress import active, planned
 from ..scenes import Scene
 from ..trust.estimate import ErrorEstimate, Refinement, declared, estimate
 from .sweep import run_sweep
@@ -101,6 +101,9 @@ def error_estimate(scene: Scene, *, base: Mapping[str, float] | None = None,
             why = (f"the coarse companions ({'; '.join(coarse.settings[1:])}) are not in the asymptotic range for "
                    f"{coarse.failure_text()}")
         fallback = f"refined companions run instead of coarse ones: {why}"
+        study = active()
+        if study is not None:  # said before the (far longer) refined companions start
+            study.say(f"error estimate: {fallback}")
     levels = [ref.refine(scene, k) for k in (0, 1, 2)]
     jobs = [sc.to_dict() for sc in levels[1:]] if base is not None else [sc.to_dict() for sc in levels]
     # the most refined copy is the longest: submit it first, so the others share the remaining cores

@@ -80,10 +80,16 @@ def cmd_run(args: argparse.Namespace) -> None:
     from .. import run
 
     scene = apply_speed(apply_sets(load(args), args.set_values), args)
+    from ..progress import OverBudget
+
     try:
         rep = run(scene, error_estimate=args.error_estimate).report()
     except InaccurateResult as exc:  # an error estimate above its tolerance: the result kept, flagged (exit 3)
         rep = exc.report()
+    except OverBudget as exc:  # an error estimate over the budget: the run shown and written, then the error (exit 2)
+        if exc.result is not None:
+            emit(exc.result.report(), args, scene.to_dict())
+        raise
     emit(rep, args, scene.to_dict())
 
 

@@ -180,10 +180,16 @@ def run_or_study(args: argparse.Namespace, scene: Scene | None, target: str, *, 
     scene_d = scene.to_dict() if scene is not None else None
     if not getattr(args, "vary", None):
         module, _, name = target.partition(":")
+        from ..progress import OverBudget
+
         try:
             rep = getattr(importlib.import_module(module), name)(scene, args)
         except InaccurateResult as exc:  # an error estimate above its tolerance: the result kept, flagged (exit 3)
             rep = exc.report()
+        except OverBudget as exc:  # an error estimate over the budget: its run kept, shown, then the error (exit 2)
+            if exc.result is not None:
+                out(exc.result, args, scene_d)
+            raise
         out(rep, args, scene_d)
         return
     out(study(args, scene, target, units=units or {}, parallel_inside=parallel_inside, wide=wide, words=words,

@@ -23,12 +23,13 @@ SHORT = {"n_spans": 2, "element_length": 0.5, "x_end": 100.0, "window_start": 40
 
 
 def test_every_scalar_parameter_declares_its_range():
-    # a list checked by code (inside the span, sorted) and a `Line` (checked by its own dataclasses)
-    assert undeclared(CatenaryParams) == ["dropper_positions", "line"]
+    # lists checked by code (droppers inside the span, sorted; windows [start, end] inside the run: test_overlap.py)
+    # and a `Line` (checked by its own dataclasses)
+    assert undeclared(CatenaryParams) == ["dropper_positions", "windows", "line"]
 
 
 @pytest.mark.parametrize("name", [f.name for f in dataclasses.fields(CatenaryParams)
-                                  if f.name not in ("dropper_positions", "line")])
+                                  if f.name not in ("dropper_positions", "windows", "line")])
 def test_nan_inf_and_out_of_range_parameters_raise_naming_the_field(name):
     lim = limit_of(CatenaryParams, name)
     bad = [math.nan, math.inf, -math.inf, True]

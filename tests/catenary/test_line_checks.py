@@ -676,13 +676,14 @@ STITCH = '[[wires]]\nname = "stitch"\nrole = "stitch"\nmass = 0.31\ntension = 35
     ({"upper": "mesenger"}, ["10.0", "mesenger"]),
     ({"extra_wire": STITCH, "upper": "stitch"}, ["10.0", "off wire 'stitch'", "[45.0, 55.0]"]),
     ({"extra_wire": STITCH.replace('"stitch"\nmass', '"contact"\nmass')},
-     ["exactly one wire with role 'contact'", "2"]),
-    ({"role": "messenger"}, ["exactly one wire with role 'contact'", "0"]),
+     ["contact wire 'stitch'", "[45.0, 55.0]", "lies inside the contact wires before it (to 100.0 m)"]),
+    ({"role": "messenger"}, ["needs a wire with role 'contact', has none"]),
 ])
 def test_line_file_errors_name_the_culprit_and_the_file(tmp_path, change, culprits):
     """Bad line files (an unknown key in a wire and at the top, a dropper naming a missing wire, a dropper off its
-    wire, two contact wires, none): `linefile.read_line_file` and `load_scene` of a scene with `[line] file = ...`
-    raise a SceneError naming the culprit and the file; the good file reads."""
+    wire, a second contact wire inside the first (a route's contact wires must each reach further), none):
+    `linefile.read_line_file` and `load_scene` of a scene with `[line] file = ...` raise a SceneError naming the
+    culprit and the file; the good file reads."""
     good = tmp_path / "good.toml"
     good.write_text(LINE_FILE.format(**GOOD))
     assert len(read_line_file(good)[0].droppers) == 6

@@ -178,6 +178,16 @@ def test_error_estimate_with_the_run_timed_is_judged_before_its_companions():
     assert st2.plan.ahead() == pytest.approx(12.5)
 
 
+@pytest.mark.parametrize("argv", [["catenary", "catenary/en50318"], ["run", "pantograph"]])
+def test_error_estimate_over_budget_keeps_the_run_and_stops_before_its_companions(argv, tmp_path, capsys):
+    """The run is printed and written (its summary.json says the estimate was not run), then exit 2 naming --yes."""
+    code = main([*argv, "--error-estimate", "--budget", "0.001", "--out", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert code == 2
+    assert "above the budget" in err and "--yes" in err and len(err.strip().splitlines()) == 1
+    assert (tmp_path / "summary.json").is_file() and "wrote" in out
+
+
 @pytest.mark.parametrize("command", [["run"], ["sweep", "--vary", "params.F0=110,120"],
                                      ["sensitivity", "--vary", "params.F0=100:140"]])
 def test_speed_means_input_speed_on_every_command(command, monkeypatch):

@@ -155,3 +155,14 @@ def test_no_import_circle_in_the_package():
         if v not in index:
             visit(v)
     assert not circles, f"import circles: {circles}"
+
+
+def test_every_shipped_scene_is_in_its_model_readme():
+    """A scene a model ships (`scenes/*.toml`) is named in its README (`name` in backquotes): a user finds it there."""
+    missing = []
+    for readme in sorted((ROOT / "models").glob("*/README.md")):
+        text = readme.read_text(encoding="utf-8")
+        for scene in sorted((readme.parent / "scenes").glob("*.toml")):
+            if f"`{scene.stem}`" not in text:
+                missing.append(f"{readme.parent.name}/{scene.stem}")
+    assert not missing, missing

@@ -185,14 +185,17 @@ HARD_CASES: tuple[HardCase, ...] = (
 
 def random_input(scene: Scene, rng: np.random.Generator) -> dict:
     """A random train speed of 150-300 km/h over a 1 s stretch of line from the scene's start (statistics window:
-    20-90 % of the stretch). The pantograph keeps its engine path where it has a MuJoCo one; the 2-mass reference
-    pantograph runs on the reference path (the catenary is FE code, only registry pantographs have other paths)."""
+    20-90 % of the stretch, also as the one window of a scene that sets `windows`). The pantograph keeps its engine
+    path where it has a MuJoCo one; the 2-mass reference pantograph runs on the reference path (the catenary is FE
+    code, only registry pantographs have other paths)."""
     v = rng.uniform(150.0, 300.0)
     length = v / 3.6 * 1.0  # 1 s of travel
     x0 = float(scene.build_params().x_start)
     out = {"input": {**scene.input, "speed": v},
            "params": {"x_end": x0 + length, "window_start": x0 + 0.2 * length, "window_end": x0 + 0.9 * length},
            "solver": {"duration": 1.0}}
+    if (scene.params or {}).get("windows"):  # a scene's own windows (an overlap's) become the stretch's one
+        out["params"]["windows"] = [[x0 + 0.2 * length, x0 + 0.9 * length]]
     if scene.effects["pantograph"] not in PANTOGRAPH_MODELS:
         out["solver"]["engine"] = "reference"
     return out

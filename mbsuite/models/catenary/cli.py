@@ -229,11 +229,18 @@ def add_estimate(rep: Report, scene: Scene, stats: list[dict], workers: int = 0,
     exits 3). `seconds`: the run's wall time, from which the companions' time is estimated (and checked against the
     budget) before they start."""
     from ...analysis.errorestimate import error_estimate
+    from ...progress import OverBudget
     from ...trust.health import InaccurateResult, judge_estimate
     from .accuracy import passage_values, stats_values
 
-    est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers,
-                         base_seconds=seconds)
+    try:
+        est = error_estimate(scene, base=stats_values(stats), evaluate=passage_values, workers=workers,
+                             base_seconds=seconds)
+    except OverBudget as exc:  # the run is kept: printed and written, then the command stops (exit 2)
+        rep.table = "\n".join([rep.table, f"error estimate not run: {exc}"])
+        rep.data["error_estimate"] = {"not_run": str(exc)}
+        exc.result = rep
+        raise
     warned = judge_estimate(est.figures(), allow_inaccurate=scene.solver.allow_inaccurate,
                             what=f"catenary scene {scene.name or scene.source or ''}".strip())
     rep.data["error_estimate"] = est.to_dict()

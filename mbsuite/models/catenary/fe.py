@@ -97,6 +97,65 @@ class CatenaryFE:
     k_drop: np.ndarray  # dropper stiffnesses with both wires' point-load defects in series (N/m)
     contact: PointCorrection  # the contact wire's point-load defect under the contact point
     irregularity: Irregularity | None = None
+    #: every contact wire's point-load defect (a route's, in `line.contacts` order; `contact` is the first) and node
+    #: range [i0, i1]
+    contacts: tuple[PointCorrection, ...] = ()
+    contact_ranges: tuple[tuple[int, int], ...] = ()
+
+    @property
+    def n_contact_wires(self) -> int:
+        """Number of contact wires (1 on a tension section; a route's sections' own)."""
+        return len(self.line.contacts)
+
+    def cw_dof_of(self, c: int) -> np.ndarray:
+        """(nnode, 2) free index of contact wire c's (w, theta) at each node, -1 where pinned or absent."""
+        s = self.slot[c]
+        ok = s >= 0
+        w = np.where(ok, self.full_to_free[np.maximum(s, 0)], -1)
+        t = np.where(ok, self.full_to_free[np.maximum(s, 0) + 1], -1)
+        return np.stack([w, t], axis=1)
+
+    def cw_w0_of(self, c: int) -> np.ndarray:
+        """(nnode, 2) static (w, theta) of contact wire c at each node (0 where absent)."""
+        s = self.slot[c]
+        ok = s >= 0
+        return np.stack([np.where(ok, self.w0_full[np.maximum(s, 0)], 0.0),
+                         np.where(ok, self.w0_full[np.maximum(s, 0) + 1], 0.0)], axis=1)
+
+    @property
+    def arms(self) -> tuple[np.ndarray, np.ndarray]:
+        """The uplift points: (support index, contact wire index) of each contact wire at each support its x-range
+        holds, support by support (on a tension section: every support, the contact wire)."""
+        si, ci = [], []
+        for i, xs in enumerate(self.x[self.supports]):
+            for c, w in enumerate(self.line.contacts):
+                if w.x0 - 1e-9 <= xs <= w.x1 + 1e-9:
+                    si.append(i)
+                    ci.append(c)
+        return np.array(si, dtype=int), np.array(ci, dtype=int)
+
+    @property
+    def arm_cw(self) -> np.ndarray:
+        """(narm,) free index of the contact wire's w at each uplift point (`arms`), -1 where pinned."""
+        si, ci = self.arms
+        return self.full_to_free[self.slot[ci, self.supports[si]]]
+
+    @property
+    def arm_names(self) -> list[str]:
+        """The name of each uplift point (`arms`): its x (m, "%g"), with its contact wire's name where several
+        contact wires have one at that support ("360_contact_a")."""
+        si, ci = self.arms
+        xs = self.x[self.supports[si]]
+        names = []
+        for j, (i, c) in enumerate(zip(si, ci, strict=True)):
+            shared = int(np.sum(si == i)) > 1
+            names.append(f"{xs[j]:g}_{self.line.contacts[c].name}" if shared else f"{xs[j]:g}")
+        return names
+
+    @property
+    def arm_x(self) -> np.ndarray:
+        """(narm,) position of each uplift point (`arms`, m)."""
+        return self.x[self.supports[self.arms[0]]]
 
     @property
     def n(self) -> int:
@@ -198,7 +257,8 @@ def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
                       free=free, full_to_free=full_to_free, M=M, K0=K0, Kd=Kd, B=B,
                       dropper_upper=full_to_free[ps.up], dropper_lower=full_to_free[ps.low], dropper_slack=slack,
                       w0_full=w0_full, T0=T0, support_preload=preload, k_drop=ps.k_drop, contact=pcs[0],
-                      irregularity=line.irregularity)
+                      irregularity=line.irregularity, contacts=tuple(pcs[:len(line.contacts)]),
+                      contact_ranges=tuple(ranges[:len(line.contacts)]))
 
 
 def _free_dofs(line: Line, slot: np.ndarray, ranges: list[tuple[int, int]], ps: PointSprings,

@@ -3,10 +3,14 @@ contact-wire irregularity. `fe.assemble` meshes and solves any `Line`; `lines.py
 EN 50318 simple line, its stitched variant, a compound line) and `linefile.py` reads one from TOML/CSV.
 
 Conventions (SI units, x along the track from the first pinned end, heights up):
-- a `Wire` is a tensioned Euler-Bernoulli beam over [x0, x1]; its ends are pinned (w = 0) or free (held by whatever
-  springs act there, e.g. a stitch wire's clamps). Exactly one wire has role "contact" and it spans the whole line;
-  its tension is uniform (one tension section); other wires may carry `tension_segments` (x_a, x_b, T) that override
-  the wire's tension between x_a and x_b (a messenger between the clamps of a stitch wire).
+- a `Wire` is a tensioned Euler-Bernoulli beam over [x0, x1]; its ends are pinned (w = 0 from the static state) or
+  free (held by whatever springs act there, e.g. a stitch wire's clamps). The wires with role "contact" cover the
+  line: one spanning it (a tension section), or several, each over its own x-range (a route: tension sections chained
+  into one line, overlapping where a pantograph passes from one contact wire to the next); the first starts the line
+  at x = 0 and each next one starts before the previous ones end. A contact wire's tension is uniform; other wires
+  may carry `tension_segments` (x_a, x_b, T) that override the wire's tension between x_a and x_b (a messenger
+  between the clamps of a stitch wire). A contact wire may carry `heights`, its design-height profile (x, z) points,
+  piecewise linear (an overlap's rise out of the running plane); the presag adds to it.
 - a `Support` at x holds ground springs `k` (N/m) on named wires (steady arm on the contact wire, messenger support)
   and point masses `m` (kg: clamps, steady arm) on named wires; the contact wire is held at its design height at every
   support in the static state (its reaction is the steady arm's pre-load).
@@ -15,8 +19,10 @@ Conventions (SI units, x along the track from the first pinned end, heights up):
   In the static state the lower wire is held at its design height at the dropper (the dropper length is whatever that
   needs); the dropper's static tension is the hold's reaction.
 - a `Clamp` at x is a bilateral spring k between the w displacements of wires a and b (rotations independent).
-- `Presag`: the contact wire's design height between consecutive supports a, b: z(x) = -4 s (x - a)(b - x) / (b - a)
-  with s = ratio (mid-span presag / span length; 0: level).
+- `Presag`: the contact wire's design height between consecutive supports a, b (of that wire): z(x) = -4 s (x - a)
+  (b - x) / (b - a) with s = ratio (mid-span presag / span length; 0: level), plus the wire's `heights` profile.
+- Overlapping contact wires never touch: no dropper or clamp joins them (directly or through other wires), and their
+  design heights may meet at single points (the crossing of an overlap) but not run together over an interval.
 - `Irregularity`: a height profile r(x) of the contact wire (m) on a uniform grid, piecewise linear, 0 outside; it
   enters the contact gap (y_wire = N . (w0 + u) + r), the wire-height signal and the pantograph's static state.
 """
@@ -48,6 +54,10 @@ PRESAG = Limit(lo=0.0, hi=0.05, hi_open=True, unit="", doc="mid-span presag / sp
 #: a support's ground spring on a wire (`k_<wire>` in a line file) and its point mass there (`m_<wire>`)
 SUPPORT_K = Limit(lo=0.0, hi=1e12, unit="N/m", doc="ground spring on the wire named after k_ (steady arm, support)")
 SUPPORT_M = Limit(lo=0.0, hi=1e3, unit="kg", doc="point mass on the wire named after m_ (clamp, steady arm)")
+#: a point of a contact wire's design-height profile: [x, z]
+HEIGHT_POINT = (Limit(lo=0.0, hi=1e6, unit="m", doc="x (m)"), Limit(lo=-10.0, hi=10.0, unit="m", doc="z (m)"))
+#: two overlapping contact wires whose design heights differ by less than this (m) at a key point meet there
+TOUCH = 1e-6
 #: a tension segment of a wire: [x_a, x_b, T]
 SEGMENT = (Limit(lo=0.0, hi=1e6, unit="m", doc="x_a (m)"), Limit(lo=0.0, hi=1e6, unit="m", doc="x_b (m)"),
            Limit(lo=0.0, hi=1e6, unit="N", doc="T (N)"))
@@ -70,6 +80,10 @@ class Wire:
     #: (x_a, x_b, T): tension T (N) between x_a and x_b instead of `tension`
     tension_segments: tuple[tuple[float, float, float], ...] = field(default=(), metadata={"schema": Items(
         SEGMENT, max=10_000, default=(), doc="tension T (N) between x_a and x_b (m) instead of tension")})
+    #: (x, z): a contact wire's design height z (m, 0 = the running plane) at x, piecewise linear from x0 to x1
+    heights: tuple[tuple[float, float], ...] = field(default=(), metadata={"schema": Items(
+        HEIGHT_POINT, max=10_000, default=(), doc="a contact wire's design height z (m; 0: the running plane) at x "
+        "(m), piecewise linear; the first point at x0, the last at x1, x increasing")})
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -95,6 +109,29 @@ class Wire:
             if a1 < b0:
                 raise ParameterError(f"wire {self.name!r}: tension segments [{a0}, {b0}] and one from {a1} m overlap")
         object.__setattr__(self, "tension_segments", tuple(segs))
+        pts = check_value(_WIRE_SCHEMA["heights"], "heights", self.heights, where, ParameterError)
+        pts = tuple((float(x), float(z)) for x, z in pts)
+        if pts:
+            if self.role != "contact":
+                raise ParameterError(f"wire {self.name!r}: heights (a design-height profile) is for a contact wire; "
+                                     f"this one has role {self.role!r}")
+            xs = [x for x, _ in pts]
+            if len(pts) < 2 or abs(xs[0] - self.x0) > 1e-9 or abs(xs[-1] - self.x1) > 1e-9:
+                raise ParameterError(f"wire {self.name!r}: heights = {[list(q) for q in pts]} must have at least two "
+                                     f"points, the first at x0 = {self.x0} m and the last at x1 = {self.x1} m")
+            for i in range(1, len(xs)):
+                if not xs[i] > xs[i - 1]:
+                    raise ParameterError(f"wire {self.name!r}: heights[{i}] x = {xs[i]} m must lie beyond heights"
+                                         f"[{i - 1}] x = {xs[i - 1]} m (x increasing)")
+        object.__setattr__(self, "heights", pts)
+
+    def height_at(self, x: np.ndarray) -> np.ndarray:
+        """The `heights` profile at x (m; 0 without one), linear between its points."""
+        x = np.asarray(x, float)
+        if not self.heights:
+            return np.zeros_like(x)
+        px, pz = np.array(self.heights, dtype=float).T
+        return np.interp(x, px, pz)
 
     def tension_at(self, xm: np.ndarray) -> np.ndarray:
         """Tension (N) at positions xm (element midpoints)."""
@@ -229,8 +266,8 @@ class Irregularity:
 
 @dataclass(frozen=True)
 class Line:
-    """One tension section (module docstring). `supports` sorted by x; the first and last wire ends define the
-    line's extent [0, length]."""
+    """A tension section, or several chained into a route (module docstring). `supports` sorted by x; the contact
+    wires define the line's extent [0, length]."""
 
     wires: tuple[Wire, ...]
     supports: tuple[Support, ...]
@@ -248,25 +285,35 @@ class Line:
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise ParameterError(f"line {self.name!r}: wire name(s) {dup} appear more than once")
-        contact = [w for w in self.wires if w.role == "contact"]
-        if len(contact) != 1:
-            raise ParameterError(f"line {self.name!r} needs exactly one wire with role 'contact', has {len(contact)}"
-                                 + (f": {[w.name for w in contact]}" if contact else ""))
+        contact = sorted((w for w in self.wires if w.role == "contact"), key=lambda w: (w.x0, w.x1))
+        if not contact:
+            raise ParameterError(f"line {self.name!r} needs a wire with role 'contact', has none")
         cw = contact[0]
         if cw.x0 != 0.0:
             raise ParameterError(f"line {self.name!r}: the contact wire {cw.name!r} has x0 = {cw.x0!r} m; valid: 0 "
                                  "(it starts the line)")
-        beyond = [w.name for w in self.wires if w.x1 > cw.x1]
+        reach = cw.x1
+        for w in contact[1:]:
+            if not w.x0 < reach:
+                raise ParameterError(f"line {self.name!r}: the contact wire {w.name!r} starts at x0 = {w.x0} m, past "
+                                     f"the end of the contact wires before it ({reach} m): a pantograph would have no "
+                                     "wire between; the contact wires of a route overlap")
+            if w.x1 <= reach:
+                raise ParameterError(f"line {self.name!r}: the contact wire {w.name!r} [{w.x0}, {w.x1}] m lies inside "
+                                     f"the contact wires before it (to {reach} m): each next one reaches further")
+            reach = w.x1
+        beyond = [w.name for w in self.wires if w.x1 > reach]
         if beyond:
             raise ParameterError(f"line {self.name!r}: wire(s) {beyond} end beyond the contact wire (x1 > "
-                                 f"{cw.x1} m); every wire lies on [0, {cw.x1}] m")
-        if cw.tension_segments:
-            raise ParameterError(f"line {self.name!r}: the contact wire's tension must be uniform (one tension "
-                                 "section); tension_segments are for the other wires")
-        if not cw.tension > 0 or not cw.mass > 0:
-            raise ParameterError(f"line {self.name!r}: the contact wire needs a positive mass and tension")
-        # the contact wire first (the FE's DOF order)
-        object.__setattr__(self, "wires", (cw, *[w for w in self.wires if w is not cw]))
+                                 f"{reach} m); every wire lies on [0, {reach}] m")
+        for w in contact:
+            if w.tension_segments:
+                raise ParameterError(f"line {self.name!r}: the contact wire's tension must be uniform (one tension "
+                                     "section); tension_segments are for the other wires")
+            if not w.tension > 0 or not w.mass > 0:
+                raise ParameterError(f"line {self.name!r}: the contact wire needs a positive mass and tension")
+        # the contact wires first, in the order they start (the FE's DOF order)
+        object.__setattr__(self, "wires", (*contact, *[w for w in self.wires if w.role != "contact"]))
         wires = {w.name: w for w in self.wires}
 
         def on(wire: str, x: float, what: str) -> None:
@@ -284,7 +331,8 @@ class Line:
                 raise ParameterError(f"line {self.name!r}: two supports at x = {a.x} m")
         object.__setattr__(self, "supports", sup)
         for s in sup:
-            on(cw.name, s.x, f"a support at x = {s.x} m")
+            if not any(w.x0 - 1e-9 <= s.x <= w.x1 + 1e-9 for w in contact):
+                on(cw.name, s.x, f"a support at x = {s.x} m")
             for w in (*s.k, *s.m):
                 on(w, s.x, f"support at x = {s.x} m")
             for what, d in (("k", s.k), ("m", s.m)):
@@ -320,26 +368,66 @@ class Line:
             n = sum(w.x0 <= x <= w.x1 for w in self.wires)
             if n > MAX_WIRES_AT_A_NODE:
                 raise ParameterError(f"line {self.name!r}: {n} wires at x = {x} m; at most {MAX_WIRES_AT_A_NODE}")
+        if len(contact) > 1:
+            self._check_apart(contact)
+
+    def _check_apart(self, contact: list[Wire]) -> None:
+        """Overlapping contact wires never touch (module docstring): not joined by droppers or clamps, directly or
+        through other wires; their design heights not equal (to `TOUCH`) at two consecutive key points both have."""
+        wi = {w.name: k for k, w in enumerate(self.wires)}
+        parent = list(range(len(self.wires)))
+
+        def root(a: int) -> int:
+            while parent[a] != a:
+                a = parent[a]
+            return a
+
+        for a, b in [(d.upper, d.lower) for d in self.droppers] + [(c.a, c.b) for c in self.clamps]:
+            parent[root(wi[a])] = root(wi[b])
+        keys = self.key_points()
+        for i, a in enumerate(contact):
+            for b in contact[i + 1:]:
+                lo, hi = max(a.x0, b.x0), min(a.x1, b.x1)
+                if not lo < hi:
+                    continue
+                if root(wi[a.name]) == root(wi[b.name]):
+                    raise ParameterError(f"line {self.name!r}: the contact wires {a.name!r} and {b.name!r} overlap on "
+                                         f"[{lo}, {hi}] m and are joined by droppers or clamps: overlapping contact "
+                                         "wires must not touch (each section hangs from its own wires)")
+                xs = keys[(keys >= lo - 1e-9) & (keys <= hi + 1e-9)]
+                near = np.abs(self.design_height(xs, a) - self.design_height(xs, b)) < TOUCH
+                both = np.nonzero(near[:-1] & near[1:])[0]
+                if both.size:
+                    j = int(both[0])
+                    raise ParameterError(f"line {self.name!r}: the contact wires {a.name!r} and {b.name!r} are at the "
+                                         f"same design height from x = {xs[j]:g} to {xs[j + 1]:g} m: overlapping "
+                                         "contact wires must not touch (they may cross at a point); change heights")
 
     @staticmethod
     def pinned_end(wire: Wire, x: float) -> bool:
         """True when x (m) is a pinned end of `wire` (to 1e-9 m)."""
         return any(e == "pinned" and abs(x - xe) <= 1e-9 for e, xe in zip(wire.ends, (wire.x0, wire.x1), strict=True))
 
-    def steady_arm(self, s: Support) -> bool:
-        """True when support `s` holds the contact wire at its design height: a ground spring on it, or its pinned
-        end (the static state's hold; its reaction is the support's pre-load)."""
-        return self.contact.name in s.k or self.pinned_end(self.contact, s.x)
+    def steady_arm(self, s: Support, wire: Wire | None = None) -> bool:
+        """True when support `s` holds the contact wire `wire` (default: the first) at its design height: a ground
+        spring on it, or its pinned end (the static state's hold; its reaction is the support's pre-load)."""
+        w = self.contact if wire is None else wire
+        return w.name in s.k or self.pinned_end(w, s.x)
 
     @property
     def contact(self) -> Wire:
-        """The contact wire (always `wires[0]`)."""
+        """The (first) contact wire (always `wires[0]`)."""
         return self.wires[0]
 
     @property
+    def contacts(self) -> tuple[Wire, ...]:
+        """The contact wires, in the order they start (`wires[:n]`)."""
+        return tuple(w for w in self.wires if w.role == "contact")
+
+    @property
     def length(self) -> float:
-        """Length of the line (m): the contact wire's."""
-        return self.contact.x1
+        """Length of the line (m): the contact wires' reach."""
+        return max(w.x1 for w in self.contacts)
 
     def wire(self, name: str) -> Wire:
         """The wire called `name`."""
@@ -358,16 +446,27 @@ class Line:
         k = np.unique(np.round(np.asarray(xs, float), 9))
         return k
 
-    def design_height(self, x: np.ndarray) -> np.ndarray:
-        """The contact wire's design height z(x) (m): the parabolic presag between consecutive supports."""
+    def design_height(self, x: np.ndarray, wire: Wire | None = None) -> np.ndarray:
+        """The design height z(x) (m) of the contact wire `wire` (default: the first): the parabolic presag between
+        consecutive supports on it, plus its `heights` profile."""
         x = np.asarray(x, float)
+        w = self.contact if wire is None else wire
+        if w.heights:
+            return self._presag(x, w) + w.height_at(x)
+        return self._presag(x, w)
+
+    def _presag(self, x: np.ndarray, w: Wire) -> np.ndarray:
         if self.presag == 0.0:
             return np.zeros_like(x)
-        sx = np.array([s.x for s in self.supports])
+        sx = np.array([s.x for s in self.supports if w.x0 - 1e-9 <= s.x <= w.x1 + 1e-9])
         i = np.clip(np.searchsorted(sx, x, side="right") - 1, 0, sx.size - 2)
         a, b = sx[i], sx[i + 1]
         inside = (x >= sx[0]) & (x <= sx[-1])
         return np.where(inside, -4.0 * self.presag * (x - a) * (b - x) / (b - a), 0.0)
+
+    def contacts_at(self, x: float) -> list[int]:
+        """The indices (in `contacts`) of the contact wires whose x-range holds x (m)."""
+        return [c for c, w in enumerate(self.contacts) if w.x0 <= x <= w.x1]
 
     @property
     def wave_speed(self) -> float:

@@ -4,10 +4,11 @@ Line file (model README, "A line of your own"; every length in m, mass in kg or 
 
     name = "my section"
     presag = 0.0005                      # mid-span presag / span length (parabolic), optional
-    [[wires]]                            # one table per wire; exactly one with role = "contact"
-    name = "contact"; role = "contact"; mass = 1.35; tension = 20000; EI = 195; x0 = 0; x1 = 600
+    [[wires]]                            # one table per wire; role = "contact": one spanning the line, or a route's
+    name = "contact"; role = "contact"; mass = 1.35; tension = 20000; EI = 195; x0 = 0; x1 = 600   # several
     ends = ["pinned", "pinned"]          # or "free" (held by clamps)
     tension_segments = [[51, 69, 12500]] # optional: T between x_a and x_b
+    heights = [[0, 0], [540, 0.1], [600, 0.5]]   # optional, a contact wire: design heights (x, z), linear
     [[supports]]                         # or supports_file = "supports.csv" (same keys as columns)
     x = 0; k_contact = 300; k_messenger = 5e4; m_contact = 1.0     # k_<wire>: ground spring, m_<wire>: mass
     [[droppers]]                         # or droppers_file = "droppers.csv"
@@ -37,7 +38,7 @@ from ...schema import Items, Rule, Section, of_dataclass, toml_error
 from .irregularity import SECTION as IRREGULARITY
 from .irregularity import check_irregularity
 from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, Support, Wire
-from .lines import CompoundParams, StitchParams
+from .lines import CompoundParams, OverlapParams, StitchParams
 from .mesh import line_of
 
 TABLES = ("supports", "droppers", "clamps", "masses")
@@ -48,7 +49,8 @@ MAX_WIRES = 64
 #: largest line file (bytes)
 MAX_FILE_BYTES = 16_000_000
 
-WIRE = of_dataclass(Wire, "wire", doc="a tensioned wire over [x0, x1]; exactly one has role = 'contact'")
+WIRE = of_dataclass(Wire, "wire", doc="a tensioned wire over [x0, x1]; the wires with role = 'contact' cover the "
+                                      "line (one, or a route's several overlapping ones)")
 SUPPORT = Section("support", {"x": limit_of(Support, "x")}, required=("x",),
                   prefixed={"k_": SUPPORT_K, "m_": SUPPORT_M},
                   doc="a support at x: k_<wire> ground springs and m_<wire> point masses on the named wires")
@@ -105,7 +107,8 @@ LINE_FILE = Section("line file", {
 }, required=("wires",), rules=(
     *(Rule(f"{t} inline or as {t}_file, not both", _one_source(t), given=True) for t in TABLES),
     Rule("supports are given (inline or as supports_file)", _supports_given, given=True),
-), doc="one tension section: wires, supports, droppers, clamps, point masses, presag and an irregularity",
+), doc="one tension section, or a route of several (their contact wires overlapping): wires, supports, droppers, "
+       "clamps, point masses, presag and an irregularity",
     example=EXAMPLE)
 
 
@@ -229,14 +232,14 @@ def is_line_file(path: str | Path) -> bool:
 
 
 # --- the scene's [line] section ----------------------------------------------------------------------------------
-LINE_KINDS = ("simple", "stitched", "compound", "file")
+LINE_KINDS = ("simple", "stitched", "compound", "overlap", "file")
 
 
 def _kind_matches(d: Mapping[str, Any]) -> str | None:
     kind = d.get("kind", "file" if "file" in d else "simple")
     if (kind == "file") != ("file" in d):
         return "file = ... goes with kind = 'file' (and only with it)"
-    for sub, owner in (("stitch", "stitched"), ("compound", "compound")):
+    for sub, owner in (("stitch", "stitched"), ("compound", "compound"), ("overlap", "overlap")):
         if sub in d and kind != owner:
             return f"[line.{sub}] is read only with kind = {owner!r} (kind is {kind!r})"
     return None
@@ -244,14 +247,16 @@ def _kind_matches(d: Mapping[str, Any]) -> str | None:
 
 #: the declaration of a scene's [line] section
 LINE_SECTION = Section("[line]", {
-    "kind": Limit(kind=str, choices=LINE_KINDS, doc="simple, stitched or compound (built from [params]), or file "
-                                                    "(absent: file with file = ..., else simple)"),
+    "kind": Limit(kind=str, choices=LINE_KINDS, doc="simple, stitched, compound or overlap (built from [params]), "
+                                                    "or file (absent: file with file = ..., else simple)"),
     "file": Limit(kind=str, doc="a line file, relative to the scene's folder"),
     "presag": PRESAG,
     "stitch": of_dataclass(StitchParams, "[line.stitch]", doc="the stitch wires of kind = 'stitched'"),
     "compound": of_dataclass(CompoundParams, "[line.compound]", doc="the auxiliary wire of kind = 'compound'"),
+    "overlap": of_dataclass(OverlapParams, "[line.overlap]", doc="the two sections of kind = 'overlap'"),
     "irregularity": IRREGULARITY,
-}, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] only with their kind", _kind_matches,
+}, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] / [line.overlap] only with their kind",
+               _kind_matches,
                given=True),), doc="the line of a catenary scene",
     example={"kind": "stitched", "presag": 0.0005, "stitch": {"half_length": 9.0, "k_clamp": 1e7},
              "irregularity": {"seed": 1, "psd": [[0.01, 1e-6], [0.5, 1e-8]], "dx": 0.05}})
@@ -265,7 +270,7 @@ def validate_line_section(value: Any, base: Path | None = None) -> dict[str, Any
     given = set(value) if isinstance(value, Mapping) else set()
     out = {k: v for k, v in LINE_SECTION.check(value, "[line]").items() if k in given}
     kind = out.setdefault("kind", "file" if "file" in out else "simple")
-    for sub, cls in (("stitch", StitchParams), ("compound", CompoundParams)):
+    for sub, cls in (("stitch", StitchParams), ("compound", CompoundParams), ("overlap", OverlapParams)):
         if sub in out:
             try:
                 cls(**out[sub])
@@ -334,6 +339,10 @@ def scene_params(scene) -> Any:
 
     section = scene.sections.get("line")
     given = dict(scene.params)
+    if section is not None and section["kind"] == "overlap":  # its length is its own: the run is checked against it
+        base = CatenaryParams(**{k: v for k, v in given.items() if k not in RUN_KEYS})
+        line = build_line(section, base, scene.params)
+        return _windowed(line, given, lambda **w: CatenaryParams(**{**given, **w}, line=line))
     if section is not None and section["kind"] == "file":
         line = build_line(section, None, scene.params)
         return _windowed(line, given, lambda **w: CatenaryParams(**{**given, **w}, line=line))
@@ -341,6 +350,10 @@ def scene_params(scene) -> Any:
     line = build_line(section, p, scene.params) or line_of(p)
     return _windowed(line, given, lambda **w: dataclasses.replace(
         p, **w, **({} if section is None else {"line": line})))
+
+
+#: the run's and the statistics' keys of [params] (checked against a line's length once it is built)
+RUN_KEYS = ("x_start", "x_end", "window_start", "window_end", "windows")
 
 
 def _provisional_window(given: Mapping[str, Any]) -> dict[str, Any]:

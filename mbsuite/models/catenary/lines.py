@@ -1,11 +1,15 @@
 """The shipped lines as `line.Line` builders: the EN 50318:2002 simple line from `CatenaryParams` (`simple`), its
-stitched variant (`stitched`, the scene `catenary/en50318_stitched`, model README "A stitched line") and a
-three-wire compound line (`compound`). `LINE_KINDS` maps the `kind` of a scene's `[line]` section to a builder and
-its parameter dataclass."""
+stitched variant (`stitched`, the scene `catenary/en50318_stitched`, model README "A stitched line"), a
+three-wire compound line (`compound`), a route of tension sections chained into one line (`route`) and the overlap
+of two EN 50318 sections (`overlap`, the scene `catenary/en50318_overlap`, model README "Overlaps and routes").
+`LINE_KINDS` maps the `kind` of a scene's `[line]` section to a builder and its parameter dataclass."""
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -147,5 +151,108 @@ def compound(p: CatenaryParams, c: CompoundParams | None = None, presag: float =
     return Line((cw, mw, aux), tuple(sup), tuple(drop), presag=presag, name="compound")
 
 
+def shifted(line: Line, dx: float) -> list[Any]:
+    """The parts of `line` moved by dx (m) along the track: wires (their heights profile and tension segments
+    too), supports, droppers, clamps, masses."""
+    wires = [dataclasses.replace(w, x0=w.x0 + dx, x1=w.x1 + dx,
+                                 tension_segments=tuple((a + dx, b + dx, T) for a, b, T in w.tension_segments),
+                                 heights=tuple((x + dx, z) for x, z in w.heights)) for w in line.wires]
+    return [wires, [Support(s.x + dx, dict(s.k), dict(s.m)) for s in line.supports],
+            [dataclasses.replace(d, x=d.x + dx) for d in line.droppers],
+            [dataclasses.replace(c, x=c.x + dx) for c in line.clamps],
+            [dataclasses.replace(m, x=m.x + dx) for m in line.masses]]
+
+
+def route(sections: Sequence[Line | tuple[float, Line]], name: str = "route") -> Line:
+    """Tension sections chained into one line (one FE system: the sections' wires are simply more wires). Each
+    section is a `Line` from x = 0, or (start, line): that line moved to start at `start` m (`shifted`). Their wires,
+    droppers, clamps and masses together, supports at the same x (to 1e-9 m) merged into one (each section's springs
+    and masses on its own wires). Wire names must differ between sections; the sections' presags must agree (the
+    route's), and an irregularity belongs to the route, not to a section. One section from 0: that section's line."""
+    if not sections:
+        raise ParameterError("a route needs at least one section")
+    placed = [(0.0, sec) if isinstance(sec, Line) else (float(sec[0]), sec[1]) for sec in sections]
+    if len(placed) == 1 and placed[0][0] == 0.0:
+        return placed[0][1]
+    sections = [sec for _, sec in placed]
+    names = [w.name for sec in sections for w in sec.wires]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ParameterError(f"route {name!r}: wire name(s) {dup} appear in more than one section; give each "
+                             "section's wires their own names")
+    presags = {sec.presag for sec in sections}
+    if len(presags) > 1:
+        raise ParameterError(f"route {name!r}: its sections' presags {sorted(presags)} differ; a route has one")
+    if any(sec.irregularity is not None for sec in sections):
+        raise ParameterError(f"route {name!r}: a section carries an irregularity; give it to the route")
+    parts = [shifted(sec, dx) if dx else [list(sec.wires), list(sec.supports), list(sec.droppers),
+                                          list(sec.clamps), list(sec.masses)] for dx, sec in placed]
+    merged: dict[float, Support] = {}
+    for part in parts:
+        for sup in part[1]:
+            key = round(sup.x, 9)
+            old = merged.get(key)
+            merged[key] = sup if old is None else Support(old.x, {**old.k, **sup.k}, {**old.m, **sup.m})
+    return Line(tuple(w for part in parts for w in part[0]), tuple(merged.values()),
+                tuple(d for part in parts for d in part[2]), tuple(c for part in parts for c in part[3]),
+                tuple(m for part in parts for m in part[4]), presag=sections[0].presag, name=name)
+
+
+@dataclass(frozen=True)
+class OverlapParams:
+    """The overlap of two EN 50318 tension sections (model README, "Overlaps and routes"): section A over `spans`
+    spans from x = 0, section B over `spans` spans from the start of the last `overlap_spans` spans of A. In the
+    overlap the wire that leaves rises out of the running plane: A's contact wire is at `rise_inner` at the overlap's
+    last interior support and at `rise_anchor` at its anchor (A's end), B's mirrored (`rise_anchor` at its start,
+    `rise_inner` at the overlap's first interior support), each at 0 elsewhere, linear between supports."""
+
+    spans: int = param(8, lo=3, hi=500, kind=int, unit="-", doc="spans of each section")
+    overlap_spans: int = param(3, lo=2, hi=50, kind=int, unit="-", doc="spans the two sections share")
+    rise_inner: float = param(0.10, lo=0.0, hi=2.0, unit="m", doc="height of the leaving contact wire at the "
+                                                                   "overlap's interior support next to its anchor")
+    rise_anchor: float = param(0.50, lo=0.0, lo_open=True, hi=2.0, unit="m",
+                               doc="height of the leaving contact wire at its anchor (the section's end)")
+
+    def __post_init__(self) -> None:
+        check_fields(self, "overlap parameter")
+        if not self.overlap_spans < self.spans:
+            raise ParameterError(f"overlap overlap_spans = {self.overlap_spans} must be below spans = {self.spans}")
+        if not self.rise_inner < self.rise_anchor:
+            raise ParameterError(f"overlap rise_inner = {self.rise_inner} m must lie below rise_anchor = "
+                                 f"{self.rise_anchor} m (the wire rises towards its anchor)")
+
+
+def section(p: CatenaryParams, n_spans: int, suffix: str, heights: Sequence[tuple[float, float]] = (),
+            presag: float = 0.0) -> Line:
+    """One EN 50318 tension section of `p`'s wires and springs over `n_spans` spans from x = 0, its wires named
+    contact_<suffix> and messenger_<suffix>: both pinned at its ends, steady arm and messenger support at every
+    interior support, `p.dropper_positions` in every span, the contact wire's design heights `heights` ((x, z))."""
+    L = p.span_length
+    x0, x1 = 0.0, n_spans * L
+    cw, mw = f"{CONTACT}_{suffix}", f"{MESSENGER}_{suffix}"
+    wires = (Wire(cw, CONTACT, p.cw_mass, p.cw_tension, p.cw_EI, x0, x1, heights=tuple(heights)),
+             Wire(mw, MESSENGER, p.mw_mass, p.mw_tension, p.mw_EI, x0, x1))
+    sup = [Support(x0 + s * L, {cw: p.k_steady_arm, mw: p.k_messenger_support} if 0 < s < n_spans else {})
+           for s in range(n_spans + 1)]
+    drop = [Dropper(x0 + s * L + d, mw, cw, p.k_dropper) for s in range(n_spans) for d in p.dropper_positions]
+    return Line(wires, tuple(sup), tuple(drop), presag=presag, name=f"section {suffix}")
+
+
+def overlap(p: CatenaryParams, o: OverlapParams | None = None, presag: float = 0.0) -> Line:
+    """Two EN 50318 sections A and B of `p` overlapping (`OverlapParams`; default: the scene
+    `catenary/en50318_overlap`, A over 0-480 m, B over 300-780 m, the overlap 300-480 m): a route of two sections,
+    each contact wire in the running plane (0) outside the overlap and rising to its anchor in it."""
+    o = o or OverlapParams()
+    L = p.span_length
+    xa1 = o.spans * L
+    xb0 = (o.spans - o.overlap_spans) * L
+    xb1 = xb0 + o.spans * L
+    ha = [(0.0, 0.0), (xa1 - 2 * L, 0.0), (xa1 - L, o.rise_inner), (xa1, o.rise_anchor)]
+    hb = [(0.0, o.rise_anchor), (L, o.rise_inner), (2 * L, 0.0), (xb1 - xb0, 0.0)]
+    return route([section(p, o.spans, "a", ha, presag), (xb0, section(p, o.spans, "b", hb, presag))],
+                 name="overlap")
+
+
 #: kind of a scene's [line] section -> (builder, parameter dataclass or None)
-LINE_KINDS = {"simple": (simple, None), "stitched": (stitched, StitchParams), "compound": (compound, CompoundParams)}
+LINE_KINDS = {"simple": (simple, None), "stitched": (stitched, StitchParams), "compound": (compound, CompoundParams),
+              "overlap": (overlap, OverlapParams)}

@@ -46,6 +46,8 @@ def line_label(p: CatenaryParams) -> str:
         return simple
     if p.line.name in _BUILT:
         return f"{p.line.name} line (on the {simple})"
+    if p.line.name == "overlap":
+        return f"overlap of two sections ({len(p.line.contacts)} contact wires)"
     return f"line {p.line.name!r}"
 
 

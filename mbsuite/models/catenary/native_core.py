@@ -31,7 +31,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 5
+ABI = 6
 
 
 class _Job(ctypes.Structure):
@@ -39,7 +39,7 @@ class _Job(ctypes.Structure):
         ("n", _I), ("bw", _I), ("nd", _I), ("nsup", _I), ("ncon", _I), ("nnode", _I), ("nnz", _I),
         ("slack", _I), ("unilateral", _I), ("max_iter", _I),
         ("h", _D), ("hh2", _D), ("c_ab", _D), ("inv_1ha", _D), ("c_kd", _D), ("two_hh", _D), ("kc", _D),
-        ("V", _D), ("dt", _D), ("max_disp", _D), ("cw_EI", _D),
+        ("V", _D), ("dt", _D), ("max_disp", _D),
         ("L", _P), ("invd", _P), ("Kp", _P), ("Ki", _P), ("Kx", _P), ("up", _P), ("lo", _P), ("dslack", _P),
         ("T0", _P), ("kdj", _P), ("Zg", _P), ("D", _P), ("xnode", _P), ("cwdof", _P), ("w0cw", _P), ("supidx", _P),
         ("esig", _P), ("pq", _P), ("pref", _P), ("ptk", _P), ("nirr", _I), ("irr_x0", _D), ("irr_dx", _D), ("irr", _P),
@@ -55,6 +55,7 @@ class _Job(ctypes.Structure):
         ("blocked", _I), ("fidx", _P), ("noff", _P), ("boff", _P), ("blk", _P), ("pw", _P), ("seg", _P),
         ("nseg_f", _I), ("nseg_b", _I),
         ("n_local", ctypes.c_long), ("err", _I), ("err_con", _I), ("err_port", _I), ("err_value", _D),
+        ("ncw", _I), ("own", _P), ("cwk", _P), ("erng", _P), ("onw", _P), ("xrng", _P), ("cwEI", _P), ("Nf", _P),
     ]
 
 
@@ -132,22 +133,30 @@ class NativeFactor:
 
 
 class NativeCore:
-    """The C twin of a passage of `sim` with `ncon` contact points (see the module docstring). Arrays are owned here
+    """The C twin of a passage of `sim` with `ncon` pantograph heads (see the module docstring). Arrays are owned here
     (numpy) and the C job points into them; the state arrays (`u`, `q`, `p`, `f`, `head`, ...) are views the
-    Python driver reads and writes between calls. Each contact's pantograph is stepped through its one-port
-    (`attach`)."""
+    Python driver reads and writes between calls. Each head's pantograph is stepped through its one-port
+    (`attach`).
+
+    On a line of several contact wires (a route, `line.Line`) each head has one contact point per contact wire
+    (`ncw`), contiguous: head k's are contacts k ncw .. k ncw + ncw - 1 (`contacts_of`), the first its owner (the
+    one-port, the head height); a contact exists only while the head is on its wire's x-range. With one contact wire
+    a contact is its head."""
 
     def __init__(self, sim, ncon: int, x_start: np.ndarray, x_end: np.ndarray):
         lib = self.lib = library()
         fe, p = sim.fe, sim.fe.params
-        n, nd, nc = fe.n, fe.T0.size, int(ncon)
+        ncw = self.ncw = fe.n_contact_wires
+        self.nheads = int(ncon)
+        n, nd, nc = fe.n, fe.T0.size, int(ncon) * ncw
         if nd and (np.min(fe.dropper_upper) < 0 or np.min(fe.dropper_lower) < 0):
             raise SolverError("a dropper hangs from a pinned DOF (fe.dropper_upper / dropper_lower hold -1)")
         self._keep: list[np.ndarray] = []
         K = sim.K.tocsr()
         K.sort_indices()
+        arm = fe.arm_cw
         j = self.job = _Job()
-        j.n, j.bw, j.nd, j.nsup, j.ncon, j.nnode = n, sim.lu.bandwidth, nd, fe.support_cw.size, nc, fe.x.size
+        j.n, j.bw, j.nd, j.nsup, j.ncon, j.nnode = n, sim.lu.bandwidth, nd, arm.size, nc, fe.x.size
         j.nnz = K.nnz
         j.slack, j.unilateral, j.max_iter = int(sim.slack), int(sim.unilateral), int(sim.max_active_iter)
         h = sim.h
@@ -156,30 +165,49 @@ class NativeCore:
         j.h, j.hh2, j.c_ab, j.inv_1ha = h, 0.5 * h, c_ab, inv_1ha
         j.c_kd, j.two_hh, j.kc = (c_ab - h * h) * inv_1ha, 2 * h * h, p.k_contact
         j.V, j.dt, j.max_disp = sim.V, sim.dt, sim.max_displacement
-        pc = fe.contact
-        j.cw_EI = pc.EI
         irr = fe.irregularity
         j.nirr = 0 if irr is None else int(np.size(irr.r))
         j.irr_x0, j.irr_dx = (0.0, 1.0) if irr is None else (float(irr.x0), float(irr.dx))
         zg = np.ascontiguousarray(sim.Zg.T) if sim.slack else np.zeros((max(nd, 1), n))
         dd = np.ascontiguousarray(sim.D) if sim.slack else np.zeros((max(nd, 1), max(nd, 1)))
         m = nc + nd
+        j.ncw = ncw
+        pcs = fe.contacts or (fe.contact,)
+        ranges = fe.contact_ranges or ((0, fe.x.size - 1),)
+        esig, pq, pref, ptk, base = [], [], [], [], 0
+        for pc, (i0, i1) in zip(pcs, ranges, strict=True):
+            sig = np.zeros(fe.x.size - 1, np.int32)
+            sig[i0:i1] = pc.sig + base
+            esig.append(sig)
+            pq.append(pc.Q.reshape(-1))
+            pref.append(pc.ref.reshape(-1))
+            ptk.append(np.full(pc.ref.shape[0], pc.T) if pc.Tk is None else np.asarray(pc.Tk, float))
+            base += pc.ref.shape[0]
+        wires = fe.line.contacts
+        cwk = np.tile(np.arange(ncw), int(ncon))
         arrays = {
             **_band_arrays(sim.S, j.bw, fe.node_offset, fe.free),
             "Kp": K.indptr.astype(np.int32), "Ki": K.indices.astype(np.int32),
             "Kx": K.data.astype(float), "up": fe.dropper_upper.astype(np.int32),
             "lo": fe.dropper_lower.astype(np.int32), "dslack": np.asarray(sim.slackable, np.int32),
             "T0": fe.T0.astype(float), "kdj": np.asarray(sim.kd, float) if nd else np.zeros(1), "Zg": zg, "D": dd,
-            "xnode": fe.x.astype(float), "cwdof": fe.cw_dof.astype(np.int32), "w0cw": fe.cw_w0.astype(float),
-            "supidx": fe.support_cw.astype(np.int32), "esig": pc.sig.astype(np.int32),
-            "pq": pc.Q.reshape(-1).astype(float), "pref": pc.ref.reshape(-1).astype(float),
-            "ptk": np.full(pc.ref.shape[0], pc.T) if pc.Tk is None else np.asarray(pc.Tk, float),
+            "xnode": fe.x.astype(float),
+            "cwdof": np.concatenate([fe.cw_dof_of(c).reshape(-1) for c in range(ncw)]).astype(np.int32),
+            "w0cw": np.concatenate([fe.cw_w0_of(c).reshape(-1) for c in range(ncw)]).astype(float),
+            "supidx": arm.astype(np.int32), "esig": np.concatenate(esig).astype(np.int32),
+            "pq": np.concatenate(pq).astype(float), "pref": np.concatenate(pref).astype(float),
+            "ptk": np.concatenate(ptk).astype(float), "cwEI": np.array([pc.EI for pc in pcs], dtype=float),
             "irr": np.zeros(1) if irr is None else np.asarray(irr.r, float).reshape(-1),
             "u": np.zeros(n), "q": np.zeros(n), "p": np.zeros(n), "R": np.zeros(n), "vbs": np.zeros(n),
             "vb": np.zeros(n), "slk": np.zeros(max(nd, 1), np.int32), "sS": np.zeros(max(nd, 1)),
             "present": np.zeros(nc, np.int32), "active": np.zeros(nc, np.int32), "elem": -np.ones(nc, np.int32),
-            "xc": np.zeros(nc), "xs": np.asarray(x_start, float).copy(), "xend": np.asarray(x_end, float).copy(),
-            "Nl": np.zeros(4 * nc), "dofs": np.zeros(4 * nc, np.int32), "w0d": np.zeros(4 * nc),
+            "xc": np.zeros(nc), "xs": np.repeat(np.asarray(x_start, float), ncw),
+            "xend": np.repeat(np.asarray(x_end, float), ncw),
+            "own": np.repeat(np.arange(int(ncon)) * ncw, ncw).astype(np.int32), "cwk": cwk.astype(np.int32),
+            "erng": np.array([[ranges[c][0], ranges[c][1] - 1] for c in cwk], np.int32).reshape(-1),
+            "xrng": np.array([[wires[c].x0, wires[c].x1] for c in cwk], float).reshape(-1),
+            "onw": np.zeros(nc, np.int32),
+            "Nl": np.zeros(4 * nc), "Nf": np.zeros(4 * nc), "dofs": np.zeros(4 * nc, np.int32), "w0d": np.zeros(4 * nc),
             "cols": np.zeros((nc, 4, n)), "crng": np.zeros(2 * nc, np.int32),
             "zrng": np.zeros(2 * max(nd, 1), np.int32), "f": np.zeros(nc), "kce": np.full(nc, float(p.k_contact)),
             "cbc": np.zeros(nc), "rirr": np.zeros(nc), "gv": np.zeros(4 * nc), "a": np.zeros(nc),
@@ -196,6 +224,18 @@ class NativeCore:
         if sim.slack:
             lib.mbs_cat_dropper_ranges(ctypes.byref(j))
         self.blocked = bool(j.blocked)
+
+    def contacts_of(self, head: int) -> range:
+        """The contact indices of pantograph head `head` (one per contact wire; the first owns the head)."""
+        return range(head * self.ncw, (head + 1) * self.ncw)
+
+    def head_force(self, head: int) -> float:
+        """The contact force on head `head`: its contacts' forces summed (N)."""
+        ks = self.contacts_of(head)
+        s = float(self.f[ks[0]])
+        for k in ks[1:]:
+            s += float(self.f[k])
+        return s
 
     def _bind(self, arrays: dict[str, np.ndarray]) -> None:
         """Point the job's fields at `arrays` (kept here, contiguous) and expose each as an attribute."""
@@ -214,7 +254,8 @@ class NativeCore:
 
     def place(self, k: int, x: float) -> None:
         """Place contact k at position x (m): its element, Hermite shape functions N(x), the contact wire's
-        point-load defect there (`cbc`) and the contact spring in series with it (`kce`)."""
+        point-load defect there (`cbc`) and the contact spring in series with it (`kce`); off its wire's x-range
+        (or not present) it has none (`onw` 0)."""
         self.lib.mbs_cat_place(ctypes.byref(self.job), k, float(x))
 
     def wire(self, k: int) -> float:
@@ -234,12 +275,14 @@ class NativeCore:
         return x
 
     def attach(self, ports: list[Any]) -> int:
-        """Couple each contact's pantograph through its one-port: `ports[k]` a `NativePort` (`pantographs.py`) whose
-        `.port` is a filled `mbs_port`; returns the width of a row of port outputs (each contact's at its offset)."""
-        if len(ports) != self.job.ncon:
-            raise SolverError(f"{len(ports)} one-ports for {self.job.ncon} contacts")
+        """Couple each head's pantograph through its one-port: `ports[k]` a `NativePort` (`pantographs.py`) whose
+        `.port` is a filled `mbs_port`, held by the head's owner contact; returns the width of a row of port outputs
+        (each head's at its owner's offset)."""
+        if len(ports) != self.nheads:
+            raise SolverError(f"{len(ports)} one-ports for {self.nheads} pantographs")
         off = 0
-        for k, np_ in enumerate(ports):
+        for h, np_ in enumerate(ports):
+            k = h * self.ncw
             self.native_ports[k] = np_
             self.ports[k] = ctypes.addressof(np_.port)
             self.ooff[k] = off
@@ -309,6 +352,7 @@ class NativeCore:
         j = self.job
         k = max(int(j.err_con), 0)
         xp, yh = float(self.xc[k]), float(self.head[k])
+        pan = k // self.ncw + 1  # the pantograph (head) of contact k
         if code == 4:
             t = float(j.err_value)
             return (f"contact/dropper active set did not settle in {int(j.max_iter)} iterations at t = {t:.6f} s "
@@ -317,13 +361,13 @@ class NativeCore:
             return f"non-finite state at x = {xp:.2f} m"
         if code == 6:
             port = self.native_ports[k]
-            return (f"pantograph {k + 1} failed at t = {float(j.err_value):.6f} s (x = {xp:.2f} m): "
+            return (f"pantograph {pan} failed at t = {float(j.err_value):.6f} s (x = {xp:.2f} m): "
                     + port.failure(int(j.err_port)))
         if code == 7:
             return (f"pantograph-catenary coupling did not converge at t = {float(j.err_value):.6f} s (time step "
                     f"{float(j.dt)} s); reduce solver.timestep")
         if code == 8:
-            return f"contact {k + 1} is on the line without a one-port (internal error of the compiled loop)"
+            return f"pantograph {pan} is on the line without a one-port (internal error of the compiled loop)"
         if code == 3:
             return (f"the pantograph lost the wire and moved {yh:+.3g} m away from it (x = {xp:.2f} m; static "
                     f"contact force {static_force:.4g} N): it cannot hold the wire")

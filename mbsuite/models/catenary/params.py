@@ -17,6 +17,8 @@ from .line import Line
 #: default of `max_element_steps`: about 10 minutes of one core at ~120 ns per element-step (0.5 m elements at
 #: dt 2e-4 s, 250 km/h: 7.3e7; 0.125 m at 5e-5 s: 1.2e9)
 MAX_ELEMENT_STEPS = 5e9
+#: most further statistics windows (`windows`)
+MAX_WINDOWS = 100
 
 #: EN 50318 reference dropper positions from the span's first support (m), catenary.md "Model data"
 EN50318_DROPPERS = (5.0, 10.5, 17.0, 23.5, 30.0, 36.5, 43.0, 49.5, 55.0)
@@ -67,6 +69,9 @@ class CatenaryParams:
     # --- analysis (EN 50318 statistics) -------------------------------------------------------------------------
     window_start: float = param(240.0, lo=0.0, hi=1e6, unit="m", doc="start of the statistics window", draw=POSITION)
     window_end: float = param(360.0, lo=0.0, hi=1e6, unit="m", doc="end of the statistics window", draw=POSITION)
+    #: further statistics windows [[start, end], ...] (m), each inside the run; checked below. Each gets the
+    #: statistics of the window above (`stats.window_statistics`; a route's contact wires their own too)
+    windows: list[list[float]] = field(default_factory=list)
     filter_cutoff: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz",
                                  doc="low-pass cut-off of the contact force")
     filter_order: int = param(4, lo=1, hi=10, kind=int, unit="-", doc="Butterworth order (forwards and backwards)")
@@ -102,6 +107,7 @@ class CatenaryParams:
                     f"dropper_positions must be strictly increasing; dropper_positions[{i}] = {dp[i]!r} "
                     f"<= dropper_positions[{i - 1}] = {dp[i - 1]!r}"
                 )
+        self._check_windows()
         if self.line is None and self.element_length > self.span_length:
             raise ParameterError(f"element_length ({self.element_length}) must not exceed span_length")
         L = self.length
@@ -126,6 +132,32 @@ class CatenaryParams:
                 f"{culprit}: the statistics window [window_start, window_end] must be non-empty and lie inside the "
                 f"run [x_start, x_end] = [{self.x_start}, {self.x_end}] m"
             )
+        self._check_windows_in_run()
+
+    def _check_windows(self) -> None:
+        ws = self.windows
+        if hasattr(ws, "tolist") and not isinstance(ws, str):  # a numpy array: its numbers
+            ws = ws.tolist()
+        if isinstance(ws, str) or not isinstance(ws, list | tuple) or len(ws) > MAX_WINDOWS:
+            raise ParameterError(f"windows must be a list of at most {MAX_WINDOWS} [start, end] pairs (m), got "
+                                 f"{ws!r}")
+        out = []
+        for i, w in enumerate(ws):
+            if hasattr(w, "tolist") and not isinstance(w, str):
+                w = w.tolist()
+            if isinstance(w, str) or not isinstance(w, list | tuple) or len(w) != 2 or any(real(v) is None for v in w):
+                raise ParameterError(f"windows[{i}] = {w!r} must be a [start, end] pair of numbers (m)")
+            a, b = (float(real(v)) for v in w)
+            if not (math.isfinite(a) and math.isfinite(b) and a < b):
+                raise ParameterError(f"windows[{i}] = [{a}, {b}] m: start must be finite and below end")
+            out.append([a, b])
+        object.__setattr__(self, "windows", out)
+
+    def _check_windows_in_run(self) -> None:
+        for i, (a, b) in enumerate(self.windows):
+            if not (self.x_start <= a and b <= self.x_end * (1.0 + 1e-9)):
+                raise ParameterError(f"windows[{i}] = [{a:g}, {b:g}] m must lie inside the run [x_start, x_end] = "
+                                     f"[{self.x_start:g}, {self.x_end:g}] m")
 
     @property
     def length(self) -> float:

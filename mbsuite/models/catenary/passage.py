@@ -78,6 +78,11 @@ class CoupledResult:
     dropper_elastic: np.ndarray | None = None  # (n, nd) T0 + k delta from the end-of-step state (diagnostics)
     dropper_slack: np.ndarray | None = None  # (n, nd) slack status of each dropper (diagnostics)
     energy: dict[str, np.ndarray] | None = None  # energy diagnostics (record_energy=True), see Passage.energy_terms
+    #: a line of several contact wires (a route): per contact wire (its name) its own contact force `force` (N), its
+    #: height under the head `wire` (m, static state included; 0 off the wire) and `on` (the head on its x-range)
+    wires: dict[str, dict[str, np.ndarray]] | None = None
+    #: the name of each uplift column (`fe.arm_names`; None: the support's x, "%g")
+    support_names: list[str] | None = None
 
 
 class Passage(Stepping):

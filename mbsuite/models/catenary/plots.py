@@ -59,10 +59,13 @@ def force_uplift_figure(runs: list[CatenaryRun]) -> MplFigure:
         axes[0].plot(res.x, res.force, lw=0.4, alpha=0.4, color=c, label=f"{lab}: F, unfiltered")
         axes[0].plot(res.x, r.filtered, lw=1.2, color=c, label=f"{lab}: F, 20 Hz low-pass")
         axes[1].plot(res.x, 1000 * res.wire, lw=1.0, color=c, label=lab)
-        inside = [(j, xs) for j, xs in enumerate(res.support_x) if p.window_start <= xs <= p.window_end]
-        for (j, xs), ls in zip(inside, (styles * len(inside))[:len(inside)], strict=True):
+        for (name, w), ls in zip((res.wires or {}).items(), (":", "-.", "--"), strict=False):  # a route's wires
+            axes[0].plot(res.x, w["force"], lw=0.6, ls=ls, color="0.3", label=f"{lab}: F on {name}, unfiltered")
+        names = res.support_names or [f"{xs:g}" for xs in res.support_x]
+        inside = [(j, names[j]) for j, xs in enumerate(res.support_x) if p.window_start <= xs <= p.window_end]
+        for (j, name), ls in zip(inside, (styles * len(inside))[:len(inside)], strict=True):
             axes[2].plot(res.x, 1000 * res.uplift[:, j], lw=1.0, color=c, ls=ls,
-                         label=f"{lab}: steady arm at x = {xs:g} m")
+                         label=f"{lab}: steady arm at x = {name} m")
     for ax in axes:
         ax.set_xlim(p.x_start, p.x_end)
         ax.axvspan(p.window_start, p.window_end, color="0.9", zorder=-3)

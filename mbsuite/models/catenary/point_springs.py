@@ -58,7 +58,7 @@ def _supports(line: Line, wi: dict[str, int], wslot: Callable[[str, float], tupl
         for name, k in s.k.items():
             d, _, dd = wslot(name, s.x)
             ground[d] += series(k, dd)
-            if wi[name] != 0:
+            if line.wires[wi[name]].role != "contact":  # a contact wire's steady arm is a hold there
                 ground_static[d] += series(k, dd)
         for name, m in s.m.items():
             point_mass[wslot(name, s.x)[0]] += m

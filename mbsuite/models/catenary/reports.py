@@ -46,6 +46,11 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
     stats = {**{k: v for k, v in run.timing.items() if k != "method"}, "warnings": dict(run.engine_warnings)}
     if run.aerodynamics is not None:  # the uplift the statistics include (N, at this speed)
         stats["aerodynamics"] = run.aerodynamics.as_dict()
+    if "windows" in run.stats:  # further windows: their statistics and a route's contact wires' own
+        stats["windows"] = {n: {"statistics": {k: s[k] for k in STAT_NAMES},
+                                "wires": {w: {k: v for k, v in d.items() if k != "loss_events"}
+                                          for w, d in s.get("wires", {}).items()}}
+                            for n, s in run.stats["windows"].items()}
     statistics = {**_scalar_stats(run), "static_contact_force": run.static_force, "quality_pass": q["pass"],
                   **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
                   "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
@@ -53,9 +58,10 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
                           statistics=statistics, health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))
     if "uplift" in scene.outputs:
         unit = scene.spec.outputs["uplift"]
-        for j, xs in enumerate(r.support_x):
-            res.signals[f"uplift_{xs:g}m"] = r.uplift[:, j]
-            res.units[f"uplift_{xs:g}m"] = unit
+        names = r.support_names or [f"{xs:g}" for xs in r.support_x]
+        for j, name in enumerate(names):
+            res.signals[f"uplift_{name}m"] = r.uplift[:, j]
+            res.units[f"uplift_{name}m"] = unit
     return res
 
 
@@ -137,6 +143,10 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
                                      "static_contact_force": r.static_force, "timing": r.timing} for r in runs}}
     if rng:
         data["all_inside_ranges"] = all(v["inside"] for v in run.ranges.values())
+    if "windows" in run.stats:  # further windows (a route: its sections alone and its overlaps)
+        lines += window_lines(run, quality)
+        data["overlaps"] = overlaps(run.params)
+        data["windows"] = window_data(run, quality)
     assessments = []
     if quality is not None:
         for r in runs:
@@ -159,6 +169,70 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
     return Report(data=data, table="\n".join(lines), write=write)
 
 
+def overlaps(p) -> list[list[float]]:
+    """The overlaps of the line of `p` (m): where two or more contact wires are under the pantograph."""
+    from .mesh import line_of
+
+    cws = line_of(p).contacts
+    out = []
+    for i, a in enumerate(cws):
+        for b in cws[i + 1:]:
+            lo, hi = max(a.x0, b.x0), min(a.x1, b.x1)
+            if lo < hi:
+                out.append([float(lo), float(hi)])
+    return sorted(out)
+
+
+def _overlap_of(p, a: float, b: float) -> bool:
+    return any(lo < b and a < hi for lo, hi in overlaps(p))
+
+
+def window_data(run: CatenaryRun, quality: QualityCriteria | None) -> dict[str, dict]:
+    """The JSON of each further window (`stats.window_statistics`): its statistics, whether it holds an overlap, its
+    contact wires' own records and (with `quality`) its current-collection quality."""
+    out = {}
+    for name, s in run.stats["windows"].items():
+        a, b = (float(v) for v in name.split("-"))
+        d = {"window": [a, b], "overlap": _overlap_of(run.params, a, b),
+             "statistics": {k: s[k] for k in STAT_NAMES}, "uplift_at_supports_mm": s["uplift_at_supports_mm"],
+             "loss_events": s["loss_events"], "wires": s.get("wires", {})}
+        if quality is not None:
+            d["quality"] = assess(s, run.speed_kmh, quality, window_time(s, run.dt))
+        out[name] = d
+    return out
+
+
+def window_lines(run: CatenaryRun, quality: QualityCriteria | None) -> list[str]:
+    """The table of the further windows (one column each; an overlap marked) and, per window, each contact wire's own
+    force through it; with `quality` each window's EN 50367 verdict, the overlap marked."""
+    ws = run.stats["windows"]
+    names = list(ws)
+    heads = [f"[{n}] m" + (" overlap" if _overlap_of(run.params, *(float(v) for v in n.split("-"))) else "")
+             for n in names]
+    rows = [[label] + [f"{ws[n][key]:.2f}" for n in names] for key, label in STAT_NAMES.items()]
+    out = ["statistics per window (the same filtered force; uplift at the steady arms of every contact wire at the "
+           "window's supports):", format_table(["statistic", *heads], rows)]
+    wrows = []
+    for n in names:
+        for wname, w in ws[n].get("wires", {}).items():
+            first = "-" if w["x_first_contact"] is None else f"{w['x_first_contact']:.1f}"
+            last = "-" if w["x_last_contact"] is None else f"{w['x_last_contact']:.1f}"
+            wrows.append([f"[{n}] m", wname, f"{w['Fm']:.2f}", f"{w['sigma']:.2f}", f"{w['max']:.2f}",
+                          f"{w['min']:.2f}", f"{w['contact_pct']:.1f}", f"{first} .. {last}",
+                          str(len(w["loss_events"]))])
+    if wrows:
+        out.append("each contact wire's own contact force (filtered, on the wire's samples in the window):")
+        out.append(format_table(["window", "wire", "Fm (N)", "sigma (N)", "max (N)", "min (N)", "in contact (%)",
+                                 "contact x (m)", "losses"], wrows))
+    if quality is not None:
+        for n, h in zip(names, heads, strict=True):
+            q = assess(ws[n], run.speed_kmh, quality, window_time(ws[n], run.dt))
+            out.append(f"current-collection quality, window {h}, {quality.system} criteria: "
+                       f"{'PASS' if q['pass'] else 'FAIL'}")
+            out.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
+    return out
+
+
 def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
     """Write each run's contact-force record (`contact_force_<pantograph>_<droppers>_<speed>kmh.csv`, SI units in
     the header) and the force/uplift figure of all of them (`force_uplift_<pantograph>_<speed>kmh.png`); return the
@@ -171,9 +245,11 @@ def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
     for r in runs:
         tag = f"{r.pantograph}_{r.dropper_law}_{r.speed_kmh:g}kmh"
         res = r.result
+        per_wire = [col for name, w in (res.wires or {}).items()
+                    for col in ((f"force_{name}", "N", w["force"]), (f"wire_height_{name}", "m", w["wire"]))]
         files.append(write_csv(out / f"contact_force_{tag}.csv", [
             ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force), ("force_filtered_20Hz", "N", r.filtered),
-            ("head_height", "m", res.head), ("wire_height", "m", res.wire)]))
+            ("head_height", "m", res.head), ("wire_height", "m", res.wire), *per_wire]))
     files.append(save(force_uplift_figure(runs),
                       out / f"force_uplift_{runs[0].pantograph}_{runs[0].speed_kmh:g}kmh.png"))
     return files

@@ -243,6 +243,9 @@ class CoupledSimulation:
         `record_energy` adds, at every recorded step, the energy terms of `Passage.energy_terms()`. `progress(n,
         nsteps)` is called every CHECK_EVERY steps and at the end. `native`: step in the compiled core
         (`native_core`, same scheme, equal to rounding); None = whenever `native_ok`, False = the Python path."""
+        if self.fe.n_contact_wires > 1:
+            raise SolverError(f"line {self.fe.line.name!r} has {self.fe.n_contact_wires} contact wires (a route): its "
+                              "passages run through train.run_passage (a head on several contact wires)")
         use_native = self.native_ok(record_every, record_droppers, record_energy) if native is None else native
         if use_native:
             if not self.native_ok(record_every, record_droppers, record_energy):
@@ -278,7 +281,7 @@ class CoupledSimulation:
         nrec = nsteps + 1
         T, X, F, H, W = (np.zeros(nrec) for _ in range(5))
         OUT = np.zeros((nrec, core.attach([port])))
-        U = np.zeros((nrec, fe.supports.size))
+        U = np.zeros((nrec, fe.arm_cw.size))
         NS = np.zeros(nrec, dtype=np.int32)
         core.set_records(t=T, x=X, f=F, head=H, wire=W, out=OUT, up=U, ns=NS)
         core.record(0, 0.0)
@@ -288,7 +291,7 @@ class CoupledSimulation:
         wall = time.perf_counter() - t0
         port.pull()
         return CoupledResult(t=T, x=X, force=F, head=H, wire=W, uplift=U, n_slack=NS, panto=port.signals(OUT),
-                             support_x=fe.x[fe.supports],
+                             support_x=fe.arm_x,
                              stats={"steps": nsteps, "wall_time_loop_s": wall, "dofs": fe.n,
                                     "half_bandwidth": self.lu.bandwidth, "local_solves": core.n_local,
                                     "native": True})

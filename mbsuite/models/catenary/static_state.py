@@ -47,8 +47,12 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
         j = int(np.nonzero(d_up == d_low)[0][0])
         raise ParameterError(f"line {line.name!r}: the dropper at x = {line.droppers[j].x} m joins wires that clamps "
                              "already join (a loop: it would hang a wire from itself)")
-    z = line.design_height(np.array([d.x for d in line.droppers], dtype=float))
+    ncw = len(line.contacts)
+    xd = np.array([d.x for d in line.droppers], dtype=float)
+    z = line.design_height(xd)
     z = np.where(d_low == group[0], z, 0.0)
+    for c in range(1, ncw):  # a route's further contact wires: each dropper on its group at that wire's heights
+        z = np.where(d_low == group[c], line.design_height(xd, line.wires[c]), z)
     u = np.zeros(K.shape[0])
     T0 = np.full(nd, np.nan)
     preload = np.zeros(supports.size)
@@ -67,7 +71,8 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
         pos = -np.ones(K.shape[0], dtype=int)
         pos[idx] = np.arange(idx.size)
         mine = np.nonzero(d_low == g)[0]
-        held = _holds(line, x, slot, supports, pinned, pos, low, z, mine, g == group[0])
+        held = _holds(line, x, slot, supports, pinned, pos, low, z, mine,
+                      [c for c in range(ncw) if group[c] == g])
         Kg = K[idx][:, idx].tocsr()
         Kg.eliminate_zeros()
         fg = f[idx]
@@ -81,9 +86,14 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
         T0[mine] = r[pos[low[mine]]]
         for j in mine:  # the dropper now loads the wire it hangs from
             f[up[j]] -= T0[j]
-        if g == group[0]:
-            arm = np.array([line.steady_arm(sp_) for sp_ in line.supports], dtype=bool)
-            preload = np.where(arm, r[pos[slot[0, supports]]], 0.0)
+        for c in range(ncw):
+            if group[c] != g:
+                continue
+            cw = line.wires[c]
+            arm = np.array([line.steady_arm(sp_, cw) and slot[c, i] >= 0
+                            for sp_, i in zip(line.supports, supports, strict=True)], dtype=bool)
+            here = np.where(arm, r[pos[np.maximum(slot[c, supports], 0)]], 0.0)
+            preload = here if c == 0 else preload + here
     return u, T0, preload
 
 
@@ -103,19 +113,21 @@ def wire_groups(line: Line) -> list[int]:
 
 
 def _holds(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarray, pinned: list[int], pos: np.ndarray,
-           low: np.ndarray, z: np.ndarray, mine: np.ndarray, contact_group: bool) -> dict[int, float]:
+           low: np.ndarray, z: np.ndarray, mine: np.ndarray, contacts: list[int]) -> dict[int, float]:
     """The held DOFs of one group (its local index -> height): pinned ends at 0, the lower end of each of its droppers
-    `mine` at its design height, and (the contact wire's group) the contact wire at each support with a steady arm."""
+    `mine` at its design height, and each contact wire of the group (`contacts`, indices of `line.wires`) at each
+    support with a steady arm on it (or its pinned end) at its design height."""
     held = {}
     for p in pinned:
         if pos[p] >= 0:
             held[int(pos[p])] = 0.0
     for j in mine:
         held[int(pos[low[j]])] = float(z[j])
-    if contact_group:  # the contact wire at each support with a steady arm (a ground spring on it)
-        zs = line.design_height(x[supports])
-        for i, s in enumerate(slot[0, supports]):
-            if line.steady_arm(line.supports[i]):
+    for c in contacts:  # the contact wire at each support with a steady arm (a ground spring on it)
+        cw = line.wires[c]
+        zs = line.design_height(x[supports], cw if c else None)
+        for i, s in enumerate(slot[c, supports]):
+            if s >= 0 and line.steady_arm(line.supports[i], cw):
                 held[int(pos[s])] = float(zs[i])
     return held
 

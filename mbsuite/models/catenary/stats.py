@@ -104,9 +104,11 @@ def supports_in_window(support_x: np.ndarray, p: CatenaryParams) -> np.ndarray:
 
 
 def en50318_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, uplift: np.ndarray, support_x: np.ndarray,
-                       dt: float, p: CatenaryParams) -> dict:
-    """The eight EN 50318 statistics plus loss events (module docstring). `uplift` is (n_samples, n_supports) (m)."""
-    ff = lowpass(force, dt, p.filter_cutoff, p.filter_order)
+                       dt: float, p: CatenaryParams, names: list[str] | None = None,
+                       ff: np.ndarray | None = None) -> dict:
+    """The eight EN 50318 statistics plus loss events (module docstring). `uplift` is (n_samples, n_supports) (m);
+    `names` names its columns (default: the support's x, "%g"); `ff` the filtered force if already at hand."""
+    ff = lowpass(force, dt, p.filter_cutoff, p.filter_order) if ff is None else ff
     w = in_window(x, p)
     if w.sum() < 2:
         raise SolverError(f"the statistics window [params.window_start, params.window_end] = [{p.window_start:g}, "
@@ -123,7 +125,8 @@ def en50318_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, uplift: 
         "max": float(fw.max()), "min": float(fw.min()),
         "uplift_mm": float(1000 * up.max()) if up.size else 0.0,
         "loss_pct": float(100.0 * np.mean(force[w] <= 0.0)),
-        "uplift_at_supports_mm": {f"{xs:g}": float(1000 * up[:, j].max()) for j, xs in enumerate(support_x[sup])},
+        "uplift_at_supports_mm": {(f"{xs:g}" if names is None else names[i]): float(1000 * up[:, j].max())
+                                  for j, (i, xs) in enumerate(zip(np.nonzero(sup)[0], support_x[sup], strict=True))},
         "loss_events": events, "loss_counts": counts,
         "n_samples_window": int(w.sum()),
     }, ff
@@ -139,3 +142,43 @@ def check_ranges(stats: dict, speed_kmh: float) -> dict[str, dict] | None:
         v = stats[name]
         out[name] = {"value": v, "low": lo, "high": hi, "inside": bool(lo - 1e-12 <= v <= hi + 1e-12)}
     return out
+
+
+def window_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, ff: np.ndarray, uplift: np.ndarray,
+                      support_x: np.ndarray, dt: float, p: CatenaryParams, names: list[str] | None = None,
+                      wires: dict[str, dict[str, np.ndarray]] | None = None) -> dict[str, dict]:
+    """The statistics of each window of `p.windows` ("<start>-<end>" m): the eight EN 50318 statistics of the same
+    filtered force `ff` (the uplift at the steady arms of every contact wire at the window's supports), and on a
+    route (`wires`: each contact wire's own record) each contact wire's own (`wire_statistics`) where it is under
+    the head in that window."""
+    import dataclasses
+
+    out = {}
+    for a, b in p.windows:
+        q = dataclasses.replace(p, window_start=float(a), window_end=float(b), windows=())
+        s, _ = en50318_statistics(t, x, force, uplift, support_x, dt, q, names, ff)
+        if wires:
+            s["wires"] = {n: wire_statistics(t, x, w["force"], w["on"], dt, q) for n, w in wires.items()
+                          if np.sum(w["on"] & in_window(x, q)) > 1}  # a wire whose end is the window's edge: not
+        out[f"{a:g}-{b:g}"] = s
+    return out
+
+
+def wire_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, on: np.ndarray, dt: float,
+                    p: CatenaryParams) -> dict:
+    """One contact wire's own contact force in the window of `p` (a route's wire through an overlap): its force
+    filtered as the head's (zero off its x-range), Fm, sigma, max, min of that filtered force over the window's
+    samples on the wire, `contact_pct` (share of those samples with force > 0, unfiltered), the loss events where the
+    wire had carried force before (its contact ends), where its contact starts and ends (`x_first_contact`,
+    `x_last_contact`, m) and its impulse over the window (N s)."""
+    ff = lowpass(force, dt, p.filter_cutoff, p.filter_order)
+    w = in_window(x, p) & on
+    fw = ff[w]
+    touched = np.maximum.accumulate(force > 0.0)  # contact losses count once the wire has carried the head
+    events = loss_events(t[w & touched], x[w & touched], force[w & touched], dt) if np.any(w & touched) else []
+    return {"Fm": float(fw.mean()), "sigma": float(fw.std()), "max": float(fw.max()), "min": float(fw.min()),
+            "contact_pct": float(100.0 * np.mean(force[w] > 0.0)), "loss_events": events,
+            "x_first_contact": float(x[w][np.argmax(force[w] > 0.0)]) if np.any(force[w] > 0.0) else None,
+            "x_last_contact": float(x[w][len(x[w]) - 1 - np.argmax(force[w][::-1] > 0.0)])
+            if np.any(force[w] > 0.0) else None,
+            "impulse_Ns": float(np.sum(force[w]) * dt)}

@@ -41,7 +41,7 @@ from .pantographs import build_train as build_pantographs
 from .params import CatenaryParams
 from .passage import CHECK_EVERY, CoupledResult, Passage, dropper_energy, irregularity_at, steps_to_cover
 from .sim import CoupledSimulation
-from .stats import en50318_statistics, supports_in_window
+from .stats import en50318_statistics, supports_in_window, window_statistics
 
 #: a steady arm's uplift is charged to a pantograph of a train while it is within this distance of it (m)
 UPLIFT_REACH = 30.0
@@ -98,14 +98,20 @@ class TrainPassage(Stepping):
         self.xs = np.array([p.x_start - s for s in offsets])
         xend = np.array([p.x_end + (offsets[-1] - s) for s in offsets])
         core = self.core = NativeCore(sim, nc, self.xs, xend)
+        line = sim.fe.line
+        if core.ncw > 1 and line.contacts_at(p.x_start) != [0]:
+            raise SceneError(f"line {line.name!r}: the pantographs start at x_start = {p.x_start:g} m, where the "
+                             f"contact wires {[line.contacts[c].name for c in line.contacts_at(p.x_start)]} are: on a "
+                             "route they start on the first contact wire alone (its static equilibrium)")
         core.u[:], core.q[:], core.p[:] = lead.u, lead.q, lead.p
         nrec = self.nsteps + 1
         nd = sim.fe.T0.size
+        ncon = nc * core.ncw
         self.DE = np.zeros((nrec, nd)) if record_droppers else None
         self.DS = np.zeros((nrec, nd), bool) if record_droppers else None
         self.T = np.zeros(nrec)
-        self.X, self.F, self.H, self.W = (np.zeros((nrec, nc)) for _ in range(4))
-        self.U = np.zeros((nrec, sim.fe.support_cw.size))
+        self.X, self.F, self.H, self.W = (np.zeros((nrec, ncon)) for _ in range(4))
+        self.U = np.zeros((nrec, sim.fe.arm_cw.size))
         self.NS = np.zeros(nrec, dtype=np.int32)
         self.psig: list[dict[str, np.ndarray]] = [{} for _ in range(nc)]
         self.static_forces = [0.0] * nc
@@ -134,17 +140,22 @@ class TrainPassage(Stepping):
         """Pantograph k enters at step n: placed where it stands, at its static equilibrium against the wire (through
         the contact spring in series with the contact wire's point-load defect there)."""
         sim, core, pan = self.sim, self.core, self.pans[k]
-        core.place(k, float(self.xs[k] + self.V * n * self.dt))
+        ks = core.contacts_of(k)
+        for c in ks:  # every contact of the head (one per contact wire; on its wire's x-range only)
+            core.present[c] = 1
+            core.place(c, float(self.xs[k] + self.V * n * self.dt))
+        o = ks[0]  # the owner: the first contact wire, where a pantograph enters (checked above)
         if k == 0:
             f, head = self.lead.force, self.lead.head
         else:
-            f = pan.static(core.wire(k), float(core.kce[k]))
+            f = pan.static(core.wire(o), float(core.kce[o]))
             if sim.unilateral and f < 0:
-                f = pan.static(core.wire(k), 0.0)
+                f = pan.static(core.wire(o), 0.0)
             head = pan.head()
-        core.present[k], core.active[k] = 1, int(f > 0 or not sim.unilateral)
-        core.set_force(k, f)
-        core.head[k] = head
+        core.active[o] = int(f > 0 or not sim.unilateral)
+        core.set_force(o, f)
+        for c in ks:
+            core.head[c] = head
         self.static_forces[k] = float(f)
         if self.compiled:
             self.ports[k].load()
@@ -202,20 +213,38 @@ class TrainPassage(Stepping):
         if self.compiled:
             for k, port in enumerate(self.ports):
                 port.pull()
-                off = int(self.core.ooff[k])
+                off = int(self.core.ooff[k * self.core.ncw])
                 self.psig[k] = port.signals(self.OUT[:, off:off + int(port.port.nout)])
 
     def results(self) -> list[CoupledResult]:
         """Each pantograph's record from its entry, on the time since its entry and its own position."""
-        sx = self.sim.fe.x[self.sim.fe.supports]
+        fe, core = self.sim.fe, self.core
+        sx = fe.arm_x
         out = []
         for k in range(len(self.pans)):
             e = self.entries[k]
             rows = slice(e, e + self.nsingle + 1)
-            out.append(CoupledResult(t=self.T[rows] - self.T[e], x=self.X[rows, k], force=self.F[rows, k],
-                                     head=self.H[rows, k], wire=self.W[rows, k], uplift=self.U[rows],
+            ks = list(core.contacts_of(k))
+            o = ks[0]
+            force, wire, wires = self.F[rows, o], self.W[rows, o], None
+            if len(ks) > 1:  # a route: the head's force is its contacts' sum; the wire it meets the lowest one on
+                x = self.X[rows, o]
+                wires = {}
+                for c, kc in enumerate(ks):
+                    w = fe.line.contacts[c]
+                    wires[w.name] = {"force": self.F[rows, kc].copy(), "wire": self.W[rows, kc].copy(),
+                                     "on": (x >= w.x0) & (x <= w.x1)}
+                force = self.F[rows, ks[0]].copy()
+                for kc in ks[1:]:
+                    force = force + self.F[rows, kc]
+                height = np.where(np.stack([v["on"] for v in wires.values()]),
+                                  np.stack([v["wire"] for v in wires.values()]), np.inf)
+                wire = np.min(height, axis=0)
+            out.append(CoupledResult(t=self.T[rows] - self.T[e], x=self.X[rows, o], force=force,
+                                     head=self.H[rows, o], wire=wire, uplift=self.U[rows],
                                      n_slack=self.NS[rows], panto={kk: v[rows] for kk, v in self.psig[k].items()},
-                                     support_x=sx, stats={"steps": self.nsingle}))
+                                     support_x=sx, stats={"steps": self.nsingle}, wires=wires,
+                                     support_names=fe.arm_names))
         return out
 
 
@@ -244,7 +273,7 @@ def run_passage(cfg: PassageConfig, progress: Callable[[int, int], None] | None 
                           "step without dropper/energy diagnostics; use native=False for this run")
     compiled = portable and native is not False and not diagnostics and not stepwise
     tp = None
-    if len(pans) == 1 and not compiled and not diagnostics and not stepwise:
+    if len(pans) == 1 and not compiled and not diagnostics and not stepwise and fe.n_contact_wires == 1:
         res = sim.run(p.x_start, p.x_end, progress=progress, native=False)
         results, static_forces, local_solves = [res], [float(res.force[0])], res.stats["local_solves"]
         T, X = res.t, res.x[:, None]
@@ -297,16 +326,25 @@ def apply_uplift(pans: Sequence[Pantograph], uplift: Sequence[Uplift]) -> None:
 def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -> tuple[dict, np.ndarray]:
     """The EN 50318 statistics of one pantograph's record; on a train of several, the uplift charged to it is only
     that while it is within UPLIFT_REACH of the steady arm."""
+    names = res.support_names
     if alone:
-        return en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p)
+        s, ff = en50318_statistics(res.t, res.x, res.force, res.uplift, res.support_x, dt, p, names)
+        if p.windows:
+            s["windows"] = window_statistics(res.t, res.x, res.force, ff, res.uplift, res.support_x, dt, p, names,
+                                             res.wires)
+        return s, ff
     sx, x = res.support_x, res.x
+    names = names or [f"{xsup:g}" for xsup in sx]
     near = np.abs(x[:, None] - sx[None, :]) <= UPLIFT_REACH
     up = np.where(near, res.uplift, -np.inf)
     s, ff = en50318_statistics(res.t, x, res.force, np.where(np.isfinite(up), up, 0.0), sx, dt, p)
     win = supports_in_window(sx, p)
-    per = {f"{xsup:g}": float(1000 * np.max(up[:, j])) for j, xsup in enumerate(sx) if win[j]}
+    per = {names[j]: float(1000 * np.max(up[:, j])) for j in range(sx.size) if win[j]}
     s["uplift_at_supports_mm"] = per
     s["uplift_mm"] = max(per.values()) if per else 0.0
+    if p.windows:
+        s["windows"] = window_statistics(res.t, x, res.force, ff, np.where(np.isfinite(up), up, 0.0), sx, dt, p,
+                                         names, res.wires)
     return s, ff
 
 
@@ -329,16 +367,20 @@ def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: 
 
 def _record_row(core: NativeCore, n: int, t: float, T, X, F, H, W, U, NS, pans, psig, nrec: int) -> None:
     T[n] = t
-    for k in range(len(pans)):
-        X[n, k] = core.xc[k]
-        if core.present[k]:
-            F[n, k] = core.f[k]
-            H[n, k] = core.head[k]
-            W[n, k] = core.wire(k) + core.cbc[k] * core.f[k]  # the height the contact spring meets
-            for key, v in pans[k].signals().items():
-                arr = psig[k].get(key)
+    for h in range(len(pans)):
+        ks = core.contacts_of(h)
+        for k in ks:
+            X[n, k] = core.xc[k]
+            if core.present[k]:
+                F[n, k] = core.f[k] if core.onw[k] else 0.0
+                H[n, k] = core.head[k]
+                # the height the contact spring meets
+                W[n, k] = core.wire(k) + core.cbc[k] * core.f[k] if core.onw[k] else 0.0
+        if core.present[ks[0]]:
+            for key, v in pans[h].signals().items():
+                arr = psig[h].get(key)
                 if arr is None:
-                    arr = psig[k][key] = np.zeros(nrec)
+                    arr = psig[h][key] = np.zeros(nrec)
                 arr[n] = v
     sup = core.supidx
     U[n] = np.where(sup >= 0, core.u[np.maximum(sup, 0)], 0.0)
@@ -355,37 +397,47 @@ class _Secant:
         self.gp: list[float | None] = [None] * len(pans)
 
     def couple(self, t: float) -> None:
+        """One step's coupling (class docstring); on a route a head's force is its contacts' sum (`head_force`)
+        and its head map is shared by its contacts."""
         core, dt, pans = self.core, self.dt, self.pans
         nc = len(pans)
-        fprev = core.f.copy()
+        fprev = [core.head_force(k) for k in range(nc)]
         nonlin = []
         ya, fa = {}, {}
+
+        def share(k: int) -> None:
+            for c in core.contacts_of(k)[1:]:
+                core.P[c], core.gp[c] = core.P[k * core.ncw], core.gp[k * core.ncw]
+
         for k in range(nc):
-            if not core.present[k]:
+            o = k * core.ncw
+            if not core.present[o]:
                 continue
             pan = pans[k]
             if pan.affine and hasattr(pan, "affine_map"):
-                core.P[k], core.gp[k] = pan.affine_map(dt, float(fprev[k]))
+                core.P[o], core.gp[o] = pan.affine_map(dt, float(fprev[k]))
             else:
                 y0 = pan.trial(t, dt, float(fprev[k]), float(fprev[k]))
                 if self.gp[k] is None:
                     self.gp[k] = y0 - pan.trial(t, dt, float(fprev[k]), float(fprev[k]) + 1.0)
-                core.gp[k] = self.gp[k]
-                core.P[k] = y0 + self.gp[k] * fprev[k]
+                core.gp[o] = self.gp[k]
+                core.P[o] = y0 + self.gp[k] * fprev[k]
                 ya[k], fa[k] = y0, float(fprev[k])
                 nonlin.append(k)
+            share(k)
         yh = {}
         for _it in range(30):
             core.local()
             done = True
             for k in nonlin:
-                f = float(core.f[k])
+                o = k * core.ncw
+                f = core.head_force(k)
                 pan = pans[k]
                 if f == fa[k]:
                     yh[k] = pan.trial(t, dt, float(fprev[k]), f)
                     continue
                 y = yh[k] = pan.trial(t, dt, float(fprev[k]), f)
-                err = y - (core.P[k] - core.gp[k] * f)
+                err = y - (core.P[o] - core.gp[o] * f)
                 if abs(err) < 1e-13 + 1e-11 * abs(y):
                     continue
                 done = False
@@ -393,21 +445,24 @@ class _Secant:
                     g_new = (ya[k] - y) / (f - fa[k])
                     if g_new > 0:
                         self.gp[k] = g_new
-                        core.gp[k] = g_new
-                core.P[k] = y + core.gp[k] * f
+                        core.gp[o] = g_new
+                core.P[o] = y + core.gp[o] * f
+                share(k)
                 fa[k], ya[k] = f, y
             if done:
                 break
         else:
             raise SolverError(f"pantograph-catenary coupling did not converge at t = {t + dt:.6f} s")
         for k in range(nc):
-            if not core.present[k]:
+            ks = core.contacts_of(k)
+            if not core.present[ks[0]]:
                 continue
             pan = pans[k]
             if k not in nonlin:
-                yh[k] = pan.trial(t, dt, float(fprev[k]), float(core.f[k]))
+                yh[k] = pan.trial(t, dt, float(fprev[k]), core.head_force(k))
             pan.commit()
-            core.head[k] = yh[k]
+            for c in ks:
+                core.head[c] = yh[k]
         core.job.n_local += 1
 
 
@@ -421,10 +476,12 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
     v = sim.mass().solve(0.5 * (core.q + core.p))
     E_c = 0.5 * v @ (fe.M @ v) + 0.5 * u @ (fe.K0 @ u) + dropper_energy(sim, u)
     E_p = E_k = P = 0.0
-    for k, pan in enumerate(pans):
-        if not core.present[k]:
+    for h, pan in enumerate(pans):
+        if core.present[h * core.ncw]:
+            E_p += pan.energy()
+    for k in range(len(pans) * core.ncw):
+        if not core.onw[k]:
             continue
-        E_p += pan.energy()
         f = float(core.f[k])
         E_k += 0.5 * f * f * (1.0 / fe.params.k_contact + float(core.cbc[k]))
         e = int(core.elem[k])
@@ -433,7 +490,7 @@ def _energy(core: NativeCore, sim: CoupledSimulation, pans: list) -> dict[str, f
         dN = np.array([(-6 * xi + 6 * xi * xi) / he, 1 - 4 * xi + 3 * xi * xi, (6 * xi - 6 * xi * xi) / he,
                        3 * xi * xi - 2 * xi])
         dofs = core.dofs[4 * k:4 * k + 4]
-        valid = core.cwdof.reshape(-1)[2 * e:2 * e + 4] >= 0
+        valid = fe.cw_dof_of(int(core.cwk[k])).reshape(-1)[2 * e:2 * e + 4] >= 0
         slope = (float(dN @ (np.where(valid, u[dofs], 0.0) + core.w0d[4 * k:4 * k + 4]))
                  + irregularity_at(fe.irregularity, float(core.xc[k]))[1])
         P += -f * sim.V * slope

@@ -17,13 +17,21 @@
  * `mbs_cat_run` loops these stages over a range of steps, every pantograph coupled through its one-port (mbsuite.h:
  * the 2-mass pantograph below, the linear and MuJoCo ports of engines/native/oneport.c, a model's own such as the
  * Eppinger pantograph's hand-derived ODE), an affine one by its exact head map, a nonlinear one by a secant
- * iteration (`couple`), recording every step; the stages are also exposed one by one for the Python-driven twin. No allocation: every array belongs to the caller (numpy). */
+ * iteration (`couple`), recording every step; the stages are also exposed one by one for the Python-driven twin. No allocation: every array belongs to the caller (numpy).
+ *
+ * Several contact wires (a route: tension sections chained into one line, overlapping): a contact point belongs to one
+ * contact wire (cwk_k: its DOFs, static state and point-load defect tables, its element range erng_k) and exists only
+ * while its position lies in that wire's x-range (xrng_k; onw_k). One pantograph head owns one contact point per
+ * contact wire, contiguous, the first its owner (own_k = the owner's index): the owner carries the head's one-port,
+ * the head height y_head = P - gp F with F the sum of the head's contact forces, so the local problem couples the
+ * contacts of one head through gp (C_kl + gp for k, l of one head). On a single contact wire every head has one
+ * contact point, its own owner, on the wire over the whole line: the arithmetic is the single-wire core's. */
 #include <math.h>
 #include <string.h>
 
 #include "mbsuite.h"
 
-#define CAT_ABI 5
+#define CAT_ABI 6
 /* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
  * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
  * rounding) */
@@ -35,7 +43,6 @@ typedef struct {
   int slack, unilateral, max_iter;
   /* scalars of the scheme */
   double h, hh2, c_ab, inv_1ha, c_kd, two_hh, kc, V, dt, max_disp;
-  double cw_EI;  /* contact wire bending stiffness (its point-load defect) */
   /* matrices (caller's arrays) */
   double *L;     /* n*(bw+1): on entry the lower band of S (L[i*(bw+1)+k] = S[i][i-k]), factorised in place */
   double *invd;  /* n: 1 / diagonal of the Cholesky factor */
@@ -48,10 +55,10 @@ typedef struct {
   double *Zg;    /* nd*n: row j = G B_j */
   double *D;     /* nd*nd: B^T G B */
   double *xnode; /* nnode node positions */
-  int *cwdof;    /* 2*nnode: free index of the CW (w, theta) of each node, -1 when pinned */
-  double *w0cw;  /* 2*nnode: static CW (w, theta) of each node */
-  int *supidx;   /* nsup: free index of the CW w at each support, -1 when pinned */
-  int *esig;     /* nnode-1: each CW element's entry in pq, pref (fe.PointCorrection) */
+  int *cwdof;    /* 2*nnode per contact wire: free index of its (w, theta) at each node, -1 when pinned or absent */
+  double *w0cw;  /* 2*nnode per contact wire: its static (w, theta) at each node */
+  int *supidx;   /* nsup: free index of the CW w at each uplift point (fe.arms), -1 when pinned */
+  int *esig;     /* nnode-1 per contact wire: each element's entry in pq, pref (fe.PointCorrection) */
   double *pq;    /* 16 per entry: the Hermite compliance Q of the element's DOFs on its reference beam */
   double *pref;  /* 3 per entry: a0, L (reference beam; L = 0: no correction), h */
   double *ptk;   /* per entry: the tension of its reference beam */
@@ -115,6 +122,15 @@ typedef struct {
   int err_con;
   int err_port;
   double err_value;
+  /* several contact wires (see the file's comment): cwdof, w0cw hold 2*nnode per contact wire, esig nnode-1 */
+  int ncw;       /* number of contact wires */
+  int *own;      /* ncon: the contact owning the head (its one-port, P, gp, head); own[k] == k for an owner */
+  int *cwk;      /* ncon: contact wire of each contact */
+  int *erng;     /* 2*ncon: first and last element of its wire */
+  int *onw;      /* ncon: 1 while the contact lies on its wire (present, position in xrng) */
+  double *xrng;  /* 2*ncon: the x-range of its wire */
+  double *cwEI;  /* ncw: bending stiffness of each contact wire (its point-load defect) */
+  double *Nf;    /* 4*ncon: the shape functions unmasked (the static height at a pinned end, which need not be 0) */
 } cat_job;
 
 int mbs_cat_abi(void) { return CAT_ABI; }
@@ -474,31 +490,35 @@ void mbs_cat_dropper_ranges(cat_job* J) {
 static void set_element(cat_job* J, int k, int e) {
   const int n = J->n;
   double* cols = J->cols + (long)k * 4 * n;
+  const int* cwdof = J->cwdof + (long)2 * J->nnode * J->cwk[k];
+  const double* w0cw = J->w0cw + (long)2 * J->nnode * J->cwk[k];
   const int old = J->elem[k];
   if (old == e) return;
   if (old >= 0 && e == old + 1) {
     memmove(cols, cols + 2 * (long)n, sizeof(double) * 2 * n);
   } else {
-    unit_column(J, J->cwdof[2 * e], cols);
-    unit_column(J, J->cwdof[2 * e + 1], cols + n);
+    unit_column(J, cwdof[2 * e], cols);
+    unit_column(J, cwdof[2 * e + 1], cols + n);
   }
-  unit_column(J, J->cwdof[2 * (e + 1)], cols + 2 * (long)n);
-  unit_column(J, J->cwdof[2 * (e + 1) + 1], cols + 3 * (long)n);
+  unit_column(J, cwdof[2 * (e + 1)], cols + 2 * (long)n);
+  unit_column(J, cwdof[2 * (e + 1) + 1], cols + 3 * (long)n);
   col_range(cols, n, 4, J->crng + 2 * k);
   for (int m = 0; m < 4; m++) {
-    const int d = J->cwdof[2 * e + m];
+    const int d = cwdof[2 * e + m];
     J->dofs[4 * k + m] = d >= 0 ? d : 0;
-    J->w0d[4 * k + m] = J->w0cw[2 * e + m];
+    J->w0d[4 * k + m] = w0cw[2 * e + m];
   }
   J->elem[k] = e;
 }
 
-static int locate(const cat_job* J, double xp, int e) {
+/* the element of contact k's wire holding xp, searched from e */
+static int locate(const cat_job* J, int k, double xp, int e) {
   const double* x = J->xnode;
-  const int last = J->nnode - 2;
-  if (e < 0) e = 0;
+  const int first = J->erng[2 * k], last = J->erng[2 * k + 1];
+  if (e < first) e = first;
+  if (e > last) e = last;
   while (e < last && xp > x[e + 1]) e++;
-  while (e > 0 && xp < x[e]) e--;
+  while (e > first && xp < x[e]) e--;
   return e;
 }
 
@@ -513,9 +533,9 @@ static double beam_compliance(double a, double L, double T, double EI) {
   return s / T;
 }
 
-/* the contact wire's point-load defect at xi of element e (fe.PointCorrection.defect, same order of operations) */
-static double point_defect(const cat_job* J, int e, double xi) {
-  const int k = J->esig[e];
+/* contact wire c's point-load defect at xi of element e (fe.PointCorrection.defect, same order of operations) */
+static double point_defect(const cat_job* J, int c, int e, double xi) {
+  const int k = J->esig[(long)(J->nnode - 1) * c + e];
   const double a0 = J->pref[3 * k], L = J->pref[3 * k + 1], h = J->pref[3 * k + 2];
   if (L == 0.0) return 0.0;
   const double x2 = xi * xi, x3 = x2 * xi;
@@ -523,7 +543,7 @@ static double point_defect(const cat_job* J, int e, double xi) {
   const double* Q = J->pq + 16 * k;
   double q = 0.0;
   for (int r = 0; r < 4; r++) q += N[r] * (((Q[4 * r] * N[0] + Q[4 * r + 1] * N[1]) + Q[4 * r + 2] * N[2]) + Q[4 * r + 3] * N[3]);
-  return beam_compliance(a0 + xi * h, L, J->ptk[k], J->cw_EI) - q;
+  return beam_compliance(a0 + xi * h, L, J->ptk[k], J->cwEI[c]) - q;
 }
 
 /* the contact wire's height irregularity at x (m): linear between the table's points, 0 outside the table
@@ -540,24 +560,43 @@ static double irregularity(const cat_job* J, double x) {
 
 /* element, shape functions and geometry of contact k at position xp; its contact stiffness with the defect */
 void mbs_cat_place(cat_job* J, int k, double xp) {
-  const int e = locate(J, xp, J->elem[k]);
+  J->xc[k] = xp;
+  J->onw[k] = J->present[k] && xp >= J->xrng[2 * k] && xp <= J->xrng[2 * k + 1];
+  if (!J->onw[k]) { /* off its wire: no contact point (a head beyond this wire's section) */
+    for (int m = 0; m < 4; m++) J->Nl[4 * k + m] = J->Nf[4 * k + m] = 0.0;
+    J->cbc[k] = 0.0;
+    J->kce[k] = J->kc;
+    J->rirr[k] = 0.0;
+    return;
+  }
+  const int* cwdof = J->cwdof + (long)2 * J->nnode * J->cwk[k];
+  const int e = locate(J, k, xp, J->elem[k]);
   set_element(J, k, e);
   const double he = J->xnode[e + 1] - J->xnode[e];
   const double xi = (xp - J->xnode[e]) / he;
   const double x2 = xi * xi, x3 = x2 * xi;
   const double N[4] = {1 - 3 * x2 + 2 * x3, he * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, he * (x3 - x2)};
-  for (int m = 0; m < 4; m++) J->Nl[4 * k + m] = J->cwdof[2 * e + m] >= 0 ? N[m] : 0.0;
-  J->xc[k] = xp;
-  const double d = point_defect(J, e, xi);
+  for (int m = 0; m < 4; m++) {
+    J->Nl[4 * k + m] = cwdof[2 * e + m] >= 0 ? N[m] : 0.0;
+    J->Nf[4 * k + m] = N[m];
+  }
+  const double d = point_defect(J, J->cwk[k], e, xi);
   J->cbc[k] = d;
   J->kce[k] = d != 0.0 ? J->kc / (1.0 + J->kc * d) : J->kc;
   J->rirr[k] = irregularity(J, xp);
 }
 
-/* CW height at contact k from the current u (static sag and the irregularity under it included) */
+/* CW height at contact k from the current u (static sag and the irregularity under it included; at a pinned end
+ * its static height alone) */
 double mbs_cat_wire(const cat_job* J, int k) {
   double s = 0.0;
-  for (int m = 0; m < 4; m++) s += J->Nl[4 * k + m] * (J->w0d[4 * k + m] + J->u[J->dofs[4 * k + m]]);
+  for (int m = 0; m < 4; m++) {
+    if (J->Nl[4 * k + m] != 0.0 || J->Nf[4 * k + m] == 0.0) {
+      s += J->Nl[4 * k + m] * (J->w0d[4 * k + m] + J->u[J->dofs[4 * k + m]]);
+    } else {
+      s += J->Nf[4 * k + m] * J->w0d[4 * k + m];
+    }
+  }
   return s + J->rirr[k];
 }
 
@@ -586,21 +625,22 @@ void mbs_cat_predict(cat_job* J, double t_new) {
     double xp = J->xs[k] + J->V * t_new;
     if (xp > J->xend[k]) xp = J->xend[k];
     mbs_cat_place(J, k, xp);
+    if (!J->onw[k]) continue;
     const double* N = J->Nl + 4 * k;
     const int* dk = J->dofs + 4 * k;
     double s = 0.0, s0 = 0.0;
     for (int m = 0; m < 4; m++) {
       s += N[m] * (u[dk[m]] + h2 * vbs[dk[m]]);
-      s0 += N[m] * J->w0d[4 * k + m];
+      s0 += J->Nf[4 * k + m] * J->w0d[4 * k + m];
     }
     J->a[k] = (s + s0) + J->rirr[k];
   }
   for (int k = 0; k < nc; k++) {
-    if (!J->present[k]) continue;
+    if (!J->onw[k]) continue;
     const double* N = J->Nl + 4 * k;
     const int* dk = J->dofs + 4 * k;
     for (int l = 0; l < nc; l++) {
-      if (!J->present[l]) {
+      if (!J->onw[l]) {
         J->Cm[k * nc + l] = 0.0;
         continue;
       }
@@ -682,7 +722,7 @@ int mbs_cat_local(cat_job* J) {
   for (int it = 0; it < J->max_iter; it++) {
     int na = 0;
     for (int k = 0; k < nc; k++) {
-      if (J->present[k] && J->active[k]) act_idx[na++] = k;
+      if (J->onw[k] && J->active[k]) act_idx[na++] = k;
     }
     const int ms = J->nslack, m = na + ms;
     double* A = J->work;
@@ -692,6 +732,9 @@ int mbs_cat_local(cat_job* J) {
       const double kc = J->kce[k];
       for (int j = 0; j < na; j++) A[i * m + j] = kc * J->Cm[k * nc + act_idx[j]];
       A[i * m + i] += 1.0 + kc * J->gp[k];
+      for (int j = 0; j < na; j++) { /* another contact of the same head: y_head = P - gp (f_k + f_l + ...) */
+        if (j != i && J->own[act_idx[j]] == J->own[k]) A[i * m + j] += kc * J->gp[k];
+      }
       for (int b = 0; b < ms; b++) A[i * m + na + b] = -kc * J->bz[k * nd + S[b]];
       r[i] = kc * (J->P[k] - J->a[k]);
     }
@@ -712,7 +755,7 @@ int mbs_cat_local(cat_job* J) {
     int changed = 0;
     if (J->unilateral) {
       for (int k = 0; k < nc; k++) {
-        if (!J->present[k]) continue;
+        if (!J->onw[k]) continue;
         if (J->active[k]) {
           if (f[k] < 0) {
             J->active[k] = 0;
@@ -722,6 +765,9 @@ int mbs_cat_local(cat_job* J) {
           double gap = J->P[k] - J->a[k];
           for (int l = 0; l < nc; l++) gap -= J->Cm[k * nc + l] * f[l];
           for (int b = 0; b < ms; b++) gap += J->bz[k * nd + S[b]] * s[b];
+          for (int l = 0; l < nc; l++) {
+            if (l != k && J->own[l] == J->own[k] && f[l] != 0.0) gap -= J->gp[k] * f[l];
+          }
           if (gap > 0) {
             J->active[k] = 1;
             changed = 1;
@@ -774,7 +820,7 @@ void mbs_cat_advance(cat_job* J) {
   double *vb = J->vb, *R = J->R, *u = J->u, *q = J->q, *p = J->p;
   memcpy(vb, J->vbs, sizeof(double) * n);
   for (int k = 0; k < nc; k++) {
-    if (!J->present[k] || J->f[k] == 0.0) continue;
+    if (!J->onw[k] || J->f[k] == 0.0) continue;
     const double* ck = J->cols + (long)k * 4 * n;
     const double* N = J->Nl + 4 * k;
     const double w0 = N[0] * J->f[k] * inv2h, w1 = N[1] * J->f[k] * inv2h, w2 = N[2] * J->f[k] * inv2h,
@@ -791,7 +837,7 @@ void mbs_cat_advance(cat_job* J) {
   for (int i = 0; i < n; i++) u[i] += h2 * vb[i];
   for (int k = 0; k < nc; k++) {
     for (int m = 0; m < 4; m++) {
-      const double g = J->present[k] ? J->Nl[4 * k + m] * J->f[k] : 0.0;
+      const double g = J->onw[k] ? J->Nl[4 * k + m] * J->f[k] : 0.0;
       J->gv[4 * k + m] = g;
       if (g != 0.0) R[J->dofs[4 * k + m]] += hh2 * g;
     }
@@ -915,10 +961,10 @@ static void record(cat_job* J, long row, double t) {
   if (J->rec_t) J->rec_t[row] = t;
   for (int k = 0; k < nc; k++) {
     if (J->rec_x) J->rec_x[row * nc + k] = J->xc[k];
-    if (J->rec_f) J->rec_f[row * nc + k] = J->present[k] ? J->f[k] : 0.0;
+    if (J->rec_f) J->rec_f[row * nc + k] = J->onw[k] ? J->f[k] : 0.0;
     if (J->rec_head) J->rec_head[row * nc + k] = J->head[k];
-    if (J->rec_wire) J->rec_wire[row * nc + k] = J->present[k] ? mbs_cat_wire(J, k) + J->cbc[k] * J->f[k] : 0.0;
-    if (J->rec_out && J->present[k] && J->ports[k]) {
+    if (J->rec_wire) J->rec_wire[row * nc + k] = J->onw[k] ? mbs_cat_wire(J, k) + J->cbc[k] * J->f[k] : 0.0;
+    if (J->rec_out && J->present[k] && J->own[k] == k && J->ports[k]) {
       const mbs_port* pt = J->ports[k];
       pt->outputs(pt->self, J->rec_out + row * J->nout + J->ooff[k]);
     }
@@ -946,6 +992,21 @@ static int port_failed(cat_job* J, int k, int code, double t_end) {
   return 6;
 }
 
+/* the force on head k (an owner): the sum of its contacts' forces in v, the owner's first */
+static inline double head_sum(const cat_job* J, const double* v, int k) {
+  double s = v[k];
+  for (int l = k + 1; l < J->ncon && J->own[l] == k; l++) s += v[l];
+  return s;
+}
+
+/* the owner's head map and head height handed to the head's other contacts */
+static inline void share_map(cat_job* J, int k) {
+  for (int l = k + 1; l < J->ncon && J->own[l] == k; l++) {
+    J->P[l] = J->P[k];
+    J->gp[l] = J->gp[k];
+  }
+}
+
 static int couple(cat_job* J, double t) {
   const int nc = J->ncon;
   const double dt = J->dt;
@@ -953,11 +1014,15 @@ static int couple(cat_job* J, double t) {
   int* nonlin = J->nl;
   int nn = 0;
   for (int k = 0; k < nc; k++) {
-    fprev[k] = J->f[k];
-    if (!J->present[k]) continue;
+    if (!J->present[k] || J->own[k] != k) continue;
+    fprev[k] = head_sum(J, J->f, k);
+  }
+  for (int k = 0; k < nc; k++) {
+    if (!J->present[k] || J->own[k] != k) continue;
     mbs_port* pt = J->ports[k];
     if (pt->affine) {
       pt->map(pt->self, t, dt, fprev[k], J->P + k, J->gp + k);
+      share_map(J, k);
       continue;
     }
     double y0, y1;
@@ -969,6 +1034,7 @@ static int couple(cat_job* J, double t) {
     if (code) return port_failed(J, k, code, t + dt);
     J->gp[k] = J->gs[k];
     J->P[k] = y0 + J->gs[k] * fprev[k];
+    share_map(J, k);
     ya[k] = y0;
     fa[k] = fprev[k];
     nonlin[nn++] = k;
@@ -983,7 +1049,7 @@ static int couple(cat_job* J, double t) {
     for (int i = 0; i < nn; i++) {
       const int k = nonlin[i];
       mbs_port* pt = J->ports[k];
-      const double f = J->f[k];
+      const double f = head_sum(J, J->f, k);
       const int code = pt->trial(pt->self, t, dt, fprev[k], f, yh + k);
       if (code) return port_failed(J, k, code, t + dt);
       if (f == fa[k]) continue;
@@ -999,6 +1065,7 @@ static int couple(cat_job* J, double t) {
         }
       }
       J->P[k] = y + J->gp[k] * f;
+      share_map(J, k);
       fa[k] = f;
       ya[k] = y;
     }
@@ -1009,14 +1076,15 @@ static int couple(cat_job* J, double t) {
     return 7;
   }
   for (int k = 0; k < nc; k++) {
-    if (!J->present[k]) continue;
+    if (!J->present[k] || J->own[k] != k) continue;
     mbs_port* pt = J->ports[k];
     if (pt->affine) {
-      const int code = pt->trial(pt->self, t, dt, fprev[k], J->f[k], yh + k);
+      const int code = pt->trial(pt->self, t, dt, fprev[k], head_sum(J, J->f, k), yh + k);
       if (code) return port_failed(J, k, code, t + dt);
     }
     pt->commit(pt->self);
     J->head[k] = yh[k];
+    for (int l = k + 1; l < nc && J->own[l] == k; l++) J->head[l] = yh[k];
   }
   J->n_local++;
   return 0;
@@ -1027,7 +1095,7 @@ static int couple(cat_job* J, double t) {
 int mbs_cat_run(cat_job* J, long n0, long n1, int check_every) {
   const int nc = J->ncon;
   for (int k = 0; k < nc; k++) {
-    if (J->present[k] && !J->ports[k]) {
+    if (J->present[k] && J->own[k] == k && !J->ports[k]) {
       J->err = 8;
       J->err_con = k;
       return 8;

@@ -139,4 +139,16 @@ MUTATIONS: tuple[Mutation, ...] = (
              "    sup = [60.0 * k for k in range(int(b // 60.0) + 1) if a <= 60.0 * k <= b]",
              "the figures mark supports every 60 m (the reference line's) whatever the line's own spans",
              "tests/catenary/test_line_shown.py"),
+    Mutation("catenary_overlap_heights_stepwise", "mbsuite/models/catenary/line.py",
+             "        return np.interp(x, px, pz)",
+             "        return pz[np.clip(np.searchsorted(px, x, side=\"right\") - 1, 0, pz.size - 1)]",
+             "a contact wire's design heights held constant from each profile point to the next instead of linear "
+             "between them (an overlap's droppers hung at the wrong heights)",
+             "tests/catenary/test_overlap.py"),
+    Mutation("catenary_overlap_contact_on_first_wire_only", "mbsuite/models/catenary/line.py",
+             "        return [c for c, w in enumerate(self.contacts) if w.x0 <= x <= w.x1]",
+             "        return [c for c, w in enumerate(self.contacts) if w.x0 <= x <= w.x1][:1]",
+             "the head in contact with only the first contact wire it reaches (the incoming wire of an overlap "
+             "ignored)",
+             "tests/catenary/test_overlap.py"),
 )

@@ -145,9 +145,9 @@ MUTATIONS: tuple[Mutation, ...] = (
              "a contact wire's design heights held constant from each profile point to the next instead of linear "
              "between them (an overlap's droppers hung at the wrong heights)",
              "tests/catenary/test_overlap.py"),
-    Mutation("catenary_overlap_contact_on_first_wire_only", "mbsuite/models/catenary/line.py",
-             "        return [c for c, w in enumerate(self.contacts) if w.x0 <= x <= w.x1]",
-             "        return [c for c, w in enumerate(self.contacts) if w.x0 <= x <= w.x1][:1]",
+    Mutation("catenary_overlap_contact_on_first_wire_only", "mbsuite/models/catenary/native/catenary.c",
+             "  J->onw[k] = J->present[k] && xp >= J->xrng[2 * k] && xp <= J->xrng[2 * k + 1];",
+             "  J->onw[k] = J->present[k] && J->own[k] == k && xp >= J->xrng[2 * k] && xp <= J->xrng[2 * k + 1];",
              "the head in contact with only the first contact wire it reaches (the incoming wire of an overlap "
              "ignored)",
              "tests/catenary/test_overlap.py"),

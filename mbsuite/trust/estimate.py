@@ -258,14 +258,19 @@ class ErrorEstimate:
                      "-" if r.order is None else f"{r.order:.2f}", r.check.partition(":")[0] if r.passed else "FAILED",
                      ("ok" if r.ok else "EXCEEDED") if r.passed else "-"] for r in self.rows]
             text = head + "\n" + format_table(["headline", "unit", "value", "est. error", "tol", "d0 (coarse 1 - run)",
-                                               "d1 (coarse 2 - coarse 1)", "observed order", "check", ""], rows, ".4g")
+                                               "d1 (coarse 2 - coarse 1)", "observed order", "check", "verdict"], rows,
+                                              ".4g")
             failed = [f"  {r.name}: {r.check}" for r in self.rows if r.check not in ("asymptotic", "converged")]
             return text + ("\n" + "\n".join(failed) if failed else "")
         rows = [[r.name, r.unit, r.value, r.error, "-" if r.tol is None else r.tol,
                  "-" if r.order is None else f"{r.order:.2f}", "yes" if r.asymptotic else "no",
                  "ok" if r.ok else "EXCEEDED"] for r in self.rows]
         text = head + "\n" + format_table(["headline", "unit", "value", "est. error", "tol", "observed order",
-                                           "asymptotic", ""], rows, ".4g")
+                                           "asymptotic", "verdict"], rows, ".4g")
+        if any(not r.asymptotic for r in self.rows):
+            text += ("\nasymptotic no: the differences oscillate or the observed order is below half the nominal "
+                     "one, so the estimate is the cautious 3 x the larger difference (not Richardson's); verdict ok: "
+                     "that estimate is within the tolerance")
         if self.fallback:
             text += "\n" + self.fallback
             if self.coarse is not None:

@@ -150,3 +150,10 @@ def test_a_scene_run_away_from_its_design_record_is_refused_naming_both_keys():
     with pytest.raises(SceneError, match=r"input\.value = 30[01][.\d]* is not the design's \[design\.derived\] "
                                          r"w_op = 300"):
         scene_from_dict(edited)
+
+
+def test_scene_out_makes_its_directory(tmp_path):
+    """--scene-out into a directory that does not exist yet makes it, as --out does."""
+    path = tmp_path / "new" / "drive200.toml"
+    assert main(["drive", "design", "cadjs", *ARGS, "--scene-out", str(path)]) == 0
+    assert path.is_file()

@@ -322,8 +322,11 @@ def _design_scene(a: argparse.Namespace) -> dict:
     out = Path(a.scene_out)
     if out.suffix != ".toml":
         raise MbsuiteError(f"--scene-out {a.scene_out}: a scene file ends in .toml")
-    if not out.parent.is_dir():
-        raise MbsuiteError(f"--scene-out {a.scene_out}: directory {out.parent} does not exist")
+    try:  # made like --out's directory
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MbsuiteError(f"--scene-out {a.scene_out}: directory {out.parent} cannot be made ({exc.strerror or exc})"
+                           ) from None
     inp = DesignInputs(P=a.P, Sr_min=a.srmin[0], w_min=a.wmin, w_max=a.wmax, V_m=a.vm, tau_c=a.tau_c,
                        J_s=a.js[0] if a.tau_c is None else None, J_l=a.Jl, w_op=a.wop, tau_l=a.taul,
                        P_motor=a.pmotor, base=a.base, duration=a.scene_duration)

@@ -214,6 +214,29 @@ class Study:
             if self.budget is not None and total > self.budget and not self.confirmed:
                 raise OverBudget(self.over_budget(plan, took, total))
 
+    def nested(self, n: int, parallel: int) -> Callable[..., None]:
+        """What a sweep of `n` points run inside a run of the plan (a frequency response at a point of a `--vary`
+        study) reports to: not runs of the plan, but while the plan's first run is not finished, the first of its
+        own points gives the estimate of the whole (`n` points `parallel` at a time per run of the plan), said and
+        judged against the budget then, not only after the plan's first run."""
+        plan, started, said = self.plan, time.perf_counter(), []
+
+        def report(k: int, results: list[Any] | None = None, indices: list[int] | None = None) -> None:
+            if said or plan is None or plan is not self.plan or plan.done > 0:
+                return
+            said.append(True)
+            took = time.perf_counter() - started
+            if parallel <= 1:
+                took /= max(k, 1)
+            one = took * math.ceil(n / max(parallel, 1))
+            total = one * math.ceil(plan.runs / max(plan.parallel, 1))
+            self.say(f"{plan.what}: each run is {n} runs of its own; the first of them finished after "
+                     f"{duration(took)}: about {duration(one)} a run, {duration(total)} for {plan.runs} runs")
+            if self.budget is not None and total > self.budget and not self.confirmed:
+                raise OverBudget(self.over_budget(plan, one, total))
+
+        return report
+
     def over_budget(self, plan: Plan, took: float, total: float) -> str:
         """The `OverBudget` message: the estimate, the budget, --yes and a cheaper setting where known."""
         fits = max(int(self.budget / took) * max(plan.parallel, 1), 1) if took > 0 else plan.runs
@@ -302,7 +325,7 @@ def sweep_progress(desc: str, n: int, parallel: int, enabled: bool | None) -> It
             yield lambda k, results=None, indices=None: bar.update(k)
         return
     if s.depth > 0:
-        yield lambda k, results=None, indices=None: None
+        yield s.nested(n, parallel)
         return
     own = s.plan is None
     if own:

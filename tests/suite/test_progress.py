@@ -156,6 +156,23 @@ def test_weighted_estimate_scales_the_first_run_by_its_share_of_the_work():
     assert plan.estimate(1.0, index=2) == pytest.approx(16.0 * (1 + 0.25 + 0.0625))
 
 
+def test_a_sweep_inside_the_first_run_of_a_study_gives_its_estimate_and_budget(monkeypatch):
+    """A study of 3 runs one at a time, each a sweep of 59 points one at a time: the first point after 5 s makes a
+    run 59 x 5 = 295 s and the study 885 s, said and stopped over a 300 s budget before the study's first run ends."""
+    out = io.StringIO()
+    t0 = progress.time.perf_counter()
+    with progress.study("freqresp", budget=300.0, stream=out, bar=False) as st, \
+            progress.sweep_progress("study", 3, 1, None):  # the study's sweep: its runs are the plan's
+        monkeypatch.setattr(progress.time, "perf_counter", lambda: t0)
+        with progress.sweep_progress("frequency response", 59, 1, None) as report:
+            monkeypatch.setattr(progress.time, "perf_counter", lambda: t0 + 5.0)
+            with pytest.raises(progress.OverBudget) as exc:
+                report(1)
+    assert "about 4.9 min a run, 14.8 min for 3 runs" in _lines(out)[-1]
+    assert "14.8 min" in str(exc.value) and "--yes" in str(exc.value)
+    assert st.last.done == 0
+
+
 def test_error_estimate_with_the_run_timed_is_judged_before_its_companions():
     """Refined companions after a run of 50 s: 16 + 4 times its work on two workers, at least the 16x one alone:
     800 s, said before any companion starts and over a 300 s budget stopped there (nothing of theirs has run)."""

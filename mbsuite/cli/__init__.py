@@ -63,6 +63,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not getattr(exc, "shown", False):  # not raised by `emit` after printing the result: nothing was shown
             return fail(str(exc), as_json, type(exc).__name__)
         return inaccurate(str(exc))
+    except progress.OverBudget as exc:  # the runs finished before the stop are kept, as on Ctrl-C
+        st = progress.last_study()
+        kept = st.keep_partial() if st is not None and st.last is not None and st.last.finished else ""
+        return fail(f"{exc}{'; ' + kept if kept else ''}", as_json, type(exc).__name__)
     except MbsuiteError as exc:
         return fail(str(exc), as_json, type(exc).__name__)
     except KeyboardInterrupt:

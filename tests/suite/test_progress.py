@@ -173,6 +173,17 @@ def test_a_sweep_inside_the_first_run_of_a_study_gives_its_estimate_and_budget(m
     assert st.last.done == 0
 
 
+def test_a_study_stopped_over_budget_keeps_its_finished_runs(tmp_path, capsys):
+    """The budget stops a sweep after its first run: that run is in a partial summary under --out, and the one-line
+    error says where."""
+    code = main(["sweep", "pantograph", "--vary", "input.frequency=2,4,6,8", "--workers", "1", "--budget", "0.001",
+                 "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and "--yes" in err and "partial_summary.json" in err
+    saved = json.loads((tmp_path / "partial_summary.json").read_text())
+    assert saved["finished_runs"] >= 1 and saved["planned_runs"] == 4
+
+
 def test_error_estimate_with_the_run_timed_is_judged_before_its_companions():
     """Refined companions after a run of 50 s: 16 + 4 times its work on two workers, at least the 16x one alone:
     800 s, said before any companion starts and over a 300 s budget stopped there (nothing of theirs has run)."""

@@ -445,6 +445,19 @@ def input_attempts() -> Iterator[Attempt]:
     for v in ("0.0", "-100.0", "nan", "1e6", '"fast"', "inf"):
         yield scene(f"catenary-speed={v.strip(chr(34))}", a, f"catenary passage speed = {v} km/h",
                     ca.replace("speed = 250.0", f"speed = {v}"), culprit="speed")
+    aero = '\n[aerodynamics]\nrunning = "knuckle-leading"\nknuckle_leading = {{ head = {h}, frame = 0.0037 }}\n'
+    for v, culprit in (("-0.002", "head"), ("nan", "head"), ('"high"', "head"), ("2.0", "head")):
+        yield scene(f"catenary-aero-head={v.strip(chr(34))}", a, f"aerodynamic head coefficient = {v}",
+                    ca + aero.format(h=v), culprit=culprit)
+    yield scene("catenary-aero-missing-case", a, "running knuckle-trailing without its coefficients",
+                ca + aero.format(h="0.0024").replace('running = "knuckle-leading"', 'running = "knuckle-trailing"'),
+                culprit="knuckle_trailing")
+    yield scene("catenary-aero-unknown-key", a, "an unknown key in [aerodynamics]",
+                ca + aero.format(h="0.0024") + "drag = 0.1\n", culprit="drag")
+    ov = ca.replace("[params]\n", '[params]\nwindows = [[120.0, 300.0], [300.0, 480.0]]\n')
+    yield scene("catenary-windows-outside-run", a, "statistics windows outside the run", ov, culprit="windows")
+    yield scene("catenary-windows-reversed", a, "a statistics window ending before it starts",
+                ca.replace("[params]\n", '[params]\nwindows = [[300.0, 240.0]]\n'), culprit="windows")
     api = {
         "sine-nan-frequency": ("Sine(frequency=float('nan'))", "frequency"),
         "sine-inf-amplitude": ("Sine(amplitude=float('inf'))", "amplitude"),

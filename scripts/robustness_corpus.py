@@ -458,6 +458,12 @@ def input_attempts() -> Iterator[Attempt]:
     yield scene("catenary-windows-outside-run", a, "statistics windows outside the run", ov, culprit="windows")
     yield scene("catenary-windows-reversed", a, "a statistics window ending before it starts",
                 ca.replace("[params]\n", '[params]\nwindows = [[300.0, 240.0]]\n'), culprit="windows")
+    yield scene("catenary-step-sections-unknown", a, "a route's stepped sections named by an unknown word",
+                ca.replace("[params]\n", '[params]\nstep_sections = "some"\n'), culprit="step_sections")
+    route = ca.replace("[params]\n", '[line]\nkind = "overlap"\n\n[line.overlap]\nsections = 3\nspans = 5\n'
+                       'overlap_spans = 3\n\n[params]\n')
+    yield scene("catenary-route-overlaps-cross", a, "three sections whose inner one's two overlaps would cross", route,
+                culprit="overlap_spans")
     api = {
         "sine-nan-frequency": ("Sine(frequency=float('nan'))", "frequency"),
         "sine-inf-amplitude": ("Sine(amplitude=float('inf'))", "amplitude"),

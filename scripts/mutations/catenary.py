@@ -84,8 +84,8 @@ MUTATIONS: tuple[Mutation, ...] = (
              "        \"max\": float(ff.max()), \"min\"",
              "the actual maximum taken over the whole record instead of the statistics window",
              "tests/catenary/test_statistics.py"),
-    Mutation("catenary_uplift_last_sample", _STATS, "float(1000 * up.max()) if up.size",
-             "float(1000 * up[-1].max()) if up.size",
+    Mutation("catenary_uplift_last_sample", _STATS, "float(1000 * np.nanmax(up)) if up.size",
+             "float(1000 * np.nanmax(up[-1])) if up.size",
              "the uplift at the steady arms read at the end of the run instead of its maximum",
              "tests/catenary/test_statistics.py"),
     Mutation("catenary_loss_needs_negative_force", _STATS, "    lost = force <= 0.0", "    lost = force < 0.0",
@@ -150,5 +150,17 @@ MUTATIONS: tuple[Mutation, ...] = (
              "  J->onw[k] = J->present[k] && J->own[k] == k && xp >= J->xrng[2 * k] && xp <= J->xrng[2 * k + 1];",
              "the head in contact with only the first contact wire it reaches (the incoming wire of an overlap "
              "ignored)",
+             "tests/catenary/test_overlap.py"),
+    Mutation("catenary_section_left_early", "mbsuite/models/catenary/native/catenary.c",
+             "    if (J->retire && xmin > x1) {",
+             "    if (J->retire && xmin > x1 - 30.0) {",
+             "a route's section no longer stepped 30 m before the last pantograph has left it (its wire frozen under "
+             "the pantograph)",
+             "tests/catenary/test_overlap.py"),
+    Mutation("catenary_section_woken_late", "mbsuite/models/catenary/native/catenary.c",
+             "    if (!(x0 <= x1) || xmax < x0) continue;",
+             "    if (!(x0 <= x1) || xmax < x0 + 30.0) continue;",
+             "a route's section stepped only from 30 m after a pantograph reached it (its wire frozen under the "
+             "pantograph)",
              "tests/catenary/test_overlap.py"),
 )

@@ -5,6 +5,7 @@ statistics within their tolerances of a 4x finer run, and the error estimate bra
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -96,6 +97,28 @@ def test_train_values_against_statistics_computed_from_the_signals():
         for s in STATS[:6] + ("loss_pct",):
             assert vals[f"p{k}_{s}"] == pytest.approx(ref[s], abs=3e-6), (k, s)
     assert vals["p1_sigma"] != vals["p2_sigma"]  # two records, not one read twice
+
+
+def test_window_values_against_statistics_computed_from_the_signals():
+    """Further windows are headlines too (`w<a>-<b>_<stat>`, a train's `p<k>_w...`; the headline window's own
+    statistics only once): their force statistics and loss from each pantograph's record in each window, computed
+    here. Bound 3e-6 N as above."""
+    sc = _short().replace(train={"pantographs": ["reference2mass", "reference2mass"], "spacings": [30.0]},
+                          params={"n_spans": 3, "x_end": 110.0, "windows": [[10.004, 60.004], [60.004, 109.004],
+                                                                           [25.004, 95.004]]})
+    names = [h.name for h in declared(sc)]
+    assert names == [f"p{k}_{w}{s}" for k in (1, 2) for w in ("", "w10.004-60.004_", "w60.004-109.004_")
+                     for s in STATS]
+    res = mbsuite.run(sc)
+    vals = accuracy.values(sc, res)
+    p = sc.build_params()
+    for k in (1, 2):
+        for a, b in ((10.004, 60.004), (60.004, 109.004)):  # edges between samples, as SHORT's
+            q = dataclasses.replace(p, window_start=a, window_end=b)
+            ref = _independent_stats(res.t, res[f"position_p{k}"], res[f"contact_force_p{k}"], q, None)
+            for s in STATS[:6] + ("loss_pct",):
+                assert vals[f"p{k}_w{a:g}-{b:g}_{s}"] == pytest.approx(ref[s], abs=3e-6), (k, a, s)
+    assert vals["p1_w10.004-60.004_sigma"] != vals["p1_w60.004-109.004_sigma"]
 
 
 def test_refinement_halves_element_length_and_timestep_together():

@@ -209,6 +209,70 @@ def test_compiled_loop_equals_the_stage_loop_through_the_overlap():
     assert a.stats[0]["windows"]["60-240"]["wires"]["contact_b"]["x_first_contact"] > 60.0
 
 
+#: a short route of three sections: 4 spans each, 2 shared (A 0-240 m, B 120-360 m, C 240-480 m)
+P_ROUTE = CatenaryParams(n_spans=8, x_end=400.0, window_start=120.0, window_end=240.0,
+                         windows=[[0.0, 120.0], [120.0, 240.0], [240.0, 360.0], [360.0, 400.0]])
+ROUTE = OverlapParams(sections=3, spans=4, overlap_spans=2)
+
+
+def test_a_route_steps_only_the_sections_in_play_and_its_pantographs_see_no_difference():
+    """The short three-section route under two pantographs 60 m apart, stepped three ways (`step_sections`): every
+    section always ("all"), each from the step the leading pantograph reaches it ("reached") and, further, only until
+    every pantograph has passed its end ("in play", the default). Sections hang from their own wires: nothing but a
+    pantograph joins them, so a section not yet reached is exactly static (its steady arms' uplift 0.0 in the run
+    that steps it) and one both pantographs have left moves nothing they meet. Measured: both pantographs' forces,
+    head and wire heights bit-equal in the three runs (asserted equal); the uplift records of "reached" equal to
+    "all"; those of "in play" equal up to the time the trailing contact point passed the section's end (from x(t)
+    = x_start - s + V t, computed here) and NaN from there on, the statistics reading the stepped part."""
+    p = _with(P_ROUTE, ROUTE)
+    runs = {m: simulate_train(dataclasses.replace(p, step_sections=m), 250.0, 2e-4,
+                              ["reference2mass", "reference2mass"], [60.0]) for m in ("all", "reached", "in play")}
+    a = runs["all"]
+    for m in ("reached", "in play"):
+        for ra, rb in zip(a.results, runs[m].results, strict=True):
+            for key in ("force", "head", "wire", "x"):
+                assert np.array_equal(getattr(ra, key), getattr(rb, key)), (m, key)
+    for ra, rb in zip(a.results, runs["reached"].results, strict=True):
+        assert np.array_equal(ra.uplift, rb.uplift)
+    fe = assemble(p)
+    comp = dict(zip([w.name for w in p.line.wires], p.line.wire_components(), strict=True))
+    si, ci = fe.arms
+    arm_comp = np.array([comp[p.line.contacts[c].name] for c in ci])
+    lead = a.results[0]
+    V, dt = 250.0 / 3.6, 2e-4
+    for w in p.line.contacts:
+        mine = (arm_comp == comp[w.name]) & (fe.arm_cw >= 0)
+        before = lead.x < w.x0 - V * dt  # the leading head not yet on this section: its arms exactly static
+        assert np.all(lead.uplift[np.ix_(before, mine)] == 0.0) and np.any(lead.uplift[:, mine] != 0.0)
+        t_left = (w.x1 - (p.x_start - 60.0)) / V  # the trailing contact point passes the section's end
+        rin = runs["in play"].results[0]
+        gone = np.isnan(rin.uplift[:, mine]).all(axis=1)
+        if t_left < lead.t[-1] - dt:
+            first = int(np.argmax(gone))
+            assert abs(lead.t[first] - t_left) <= dt + 1e-9 and np.all(gone[first:]) and not np.any(gone[:first])
+            assert np.array_equal(rin.uplift[:first][:, mine], lead.uplift[:first][:, mine])
+        else:
+            assert not np.any(gone)
+    assert runs["in play"].stats[0]["windows"]["0-120"]["uplift_mm"] > 0.0
+
+
+def test_a_section_entered_in_the_running_plane_is_stepped_from_its_first_contact():
+    """Two sections whose coming contact wire starts in the running plane (B at 0 from its anchor at 120 m, A rising
+    from 0 there to +0.5 m at its anchor at 240 m: they meet at 120 m only): the head presses on B from the step it
+    reaches it. The passage stepping only the sections in play against the one stepping all: forces bit-equal
+    (asserted equal), and B carries force within 1 m of its anchor (a section stepped late would be frozen there)."""
+    p = dataclasses.replace(P_ROUTE, n_spans=6, x_end=340.0, windows=[])
+    ha = [(0.0, 0.0), (120.0, 0.0), (180.0, 0.1), (240.0, 0.5)]
+    line = route([section(p, 4, "a", ha), (120.0, section(p, 4, "b", [(0.0, 0.0), (240.0, 0.0)]))], name="flat")
+    p = dataclasses.replace(p, line=line)
+    runs = {m: simulate_train(dataclasses.replace(p, step_sections=m), 250.0, 2e-4, ["reference2mass"], [])
+            for m in ("all", "in play")}
+    a, b = (runs[m].results[0] for m in ("all", "in play"))
+    assert np.array_equal(a.force, b.force) and np.array_equal(a.head, b.head)
+    fb = a.wires["contact_b"]["force"]
+    assert np.any(fb[(a.x > 120.0) & (a.x < 121.0)] > 1.0)
+
+
 def test_energy_balance_through_the_overlap_closes():
     """Undamped, weightless overlap at 300 km/h (linear droppers: without weight the droppers of a straight stretch
     carry nothing in the static state): the total energy (catenary with the exact dropper law, pantograph,

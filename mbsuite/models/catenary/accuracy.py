@@ -4,6 +4,9 @@ Headlines: the eight EN 50318 statistics of every pantograph (`stats.STAT_NAMES`
 Fm - 3 sigma, the actual max and min of the 20 Hz filtered force in N, the largest steady-arm uplift in mm, the
 percentage of contact loss). A single pantograph's are named as its SimResult's statistics (`Fm`, ..., `uplift_mm`,
 `loss_pct`); those of a train's pantograph k = 1, 2, ... (leading first) as the train's (`p1_Fm`, `p2_max`, ...).
+The further statistics windows of `params.windows` (a route's sections and overlaps) add the same eight per window
+and pantograph, the window named by its ends in m (`w300-480_sigma`, `p2_w300-480_sigma`; the headline window's are
+the headlines).
 
 Tolerances (absolute, at the scene's default settings): 1 N on every force statistic and 0.5 mm on the uplift (the
 accuracy an EN 50318 / EN 50367 assessment reads its statistics to: the accepted ranges are 5-35 N wide, the uplift
@@ -61,41 +64,76 @@ def pantograph_count(scene: Scene) -> int:
     return len(train["pantographs"]) if train else 1
 
 
-def names(n_pantographs: int) -> tuple[str, ...]:
-    """The headline names of a passage of `n_pantographs` (module docstring)."""
+def window_keys(scene: Scene) -> tuple[str, ...]:
+    """The keys of the scene's further statistics windows ("<start>-<end>", m; `stats.window_statistics`) but the
+    headline window's (its statistics are the headlines already)."""
+    p = scene.build_params()
+    return tuple(f"{a:g}-{b:g}" for a, b in p.windows if (a, b) != (p.window_start, p.window_end))
+
+
+def names(n_pantographs: int, windows: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The headline names of a passage of `n_pantographs` with the further windows `windows` (module docstring)."""
+    stats = STATS + tuple(f"w{w}_{s}" for w in windows for s in STATS)
     if n_pantographs == 1:
-        return STATS
-    return tuple(f"p{k}_{s}" for k in range(1, n_pantographs + 1) for s in STATS)
+        return stats
+    return tuple(f"p{k}_{s}" for k in range(1, n_pantographs + 1) for s in stats)
+
+
+def _parts(name: str) -> tuple[int, str | None, str]:
+    """(pantograph index from 0, window key or None, statistic) of a headline name (`p2_w300-480_max`)."""
+    k, window = 0, None
+    head, _, tail = name.partition("_")
+    if head[:1] == "p" and head[1:].isdigit():
+        k, name = int(head[1:]) - 1, tail
+    head, _, tail = name.partition("_")
+    if head[:1] == "w" and "-" in head:
+        window, name = head[1:], tail
+    return k, window, name
 
 
 def _stat_of(name: str) -> str:
-    """The statistic a headline name reads (`p2_max` -> `max`)."""
-    head, _, tail = name.partition("_")
-    return tail if head[:1] == "p" and head[1:].isdigit() else name
+    """The statistic a headline name reads (`p2_w300-480_max` -> `max`)."""
+    return _parts(name)[2]
 
 
 def headlines(scene: Scene) -> tuple[Headline, ...]:
     """The eight statistics of every pantograph of the scene's passage with their tolerances."""
     n = pantograph_count(scene)
     out = []
-    for name in names(n):
-        stat = _stat_of(name)
-        who = "" if n == 1 else f"pantograph {name.partition('_')[0][1:]}: "
-        out.append(Headline(name, UNITS[stat], TOL[stat], who + STAT_NAMES[stat],
+    for name in names(n, window_keys(scene)):
+        k, window, stat = _parts(name)
+        who = "" if n == 1 else f"pantograph {k + 1}: "
+        where = "" if window is None else f"window {window} m: "
+        out.append(Headline(name, UNITS[stat], TOL[stat], who + where + STAT_NAMES[stat],
                             rtol=LOSS_RTOL if stat == "loss_pct" else 0.0))
     return tuple(out)
 
 
 def values(scene: Scene, res: Any) -> dict[str, float]:
-    """The headline values of a passage's SimResult (its `statistics`)."""
-    return {name: float(res.statistics[name]) for name in names(pantograph_count(scene))}
+    """The headline values of a passage's SimResult (its `statistics`; a further window's from its `stats["windows"]`,
+    a train's pantograph's under "p<k>")."""
+    n = pantograph_count(scene)
+    out = {}
+    for name in names(n, window_keys(scene)):
+        k, window, stat = _parts(name)
+        if window is None:
+            out[name] = float(res.statistics[name])
+        else:
+            w = res.stats["windows"] if n == 1 else res.stats["windows"][f"p{k + 1}"]
+            out[name] = float(w[window]["statistics"][stat])
+    return out
 
 
 def stats_values(stats: list[dict]) -> dict[str, float]:
-    """The headline values from the per-pantograph statistics of a passage (`TrainRun.stats`, leading first)."""
-    n = len(stats)
-    return {name: float(stats[0 if n == 1 else int(name.partition("_")[0][1:]) - 1][_stat_of(name)])
-            for name in names(n)}
+    """The headline values from the per-pantograph statistics of a passage (`TrainRun.stats`, leading first; the
+    further windows' from each one's "windows")."""
+    keys = tuple(stats[0].get("windows", {}))
+    out = {}
+    for name in names(len(stats), keys):
+        k, window, stat = _parts(name)
+        s = stats[k] if window is None else stats[k]["windows"][window]
+        out[name] = float(s[stat])
+    return out
 
 
 def refine(scene: Scene, level: int) -> Scene:

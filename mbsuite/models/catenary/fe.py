@@ -61,9 +61,12 @@ __all__ = [
 class CatenaryFE:
     """Assembled catenary matrices on the free DOFs (pinned end w's removed) and its static state.
 
-    DOF layout: at node i (position `x[i]`) each wire present there has two DOFs (w, theta), in the line's wire order
-    (the contact wire first); node i's DOFs are `node_offset[i] .. node_offset[i + 1] - 1` of the full vector (the
-    simple line: 4 per node, [w_cw, theta_cw, w_mw, theta_mw]). `free` lists the full index of each free DOF.
+    DOF layout (`mesh.layout`): at node i (position `x[i]`) each wire present there has two DOFs (w, theta), in
+    blocks of a mechanical component (wires joined by droppers or clamps) and node, in the line's wire order (the
+    contact wire first); block b's DOFs are `node_offset[b] .. node_offset[b + 1] - 1` of the full vector. A line of
+    one component has a block per node (the simple line: 4 DOFs per node, [w_cw, theta_cw, w_mw, theta_mw]); a
+    route's sections follow one another, each over its nodes (`component_blocks`: each one's block range). `slot`
+    gives every wire's w at every node; `free` lists the full index of each free DOF.
 
     `M`, `K0` (beams, ground springs, clamps), `Kd` (droppers as linear springs) are CSR on free DOFs. `B`
     (n_free x n_droppers) maps DOFs to dropper elongations delta = B^T u (upper wire up minus lower wire up); a
@@ -80,7 +83,7 @@ class CatenaryFE:
     x: np.ndarray
     supports: np.ndarray
     droppers: np.ndarray
-    node_offset: np.ndarray  # (nnode + 1,) full index of each node's first DOF
+    node_offset: np.ndarray  # (nblock + 1,) full index of each block's first DOF (a block per node on one section)
     slot: np.ndarray  # (n_wires, nnode) full index of each wire's w at each node, -1 where the wire is absent
     free: np.ndarray  # full DOF index of each free DOF
     full_to_free: np.ndarray  # free index of each full DOF, -1 if pinned
@@ -101,6 +104,8 @@ class CatenaryFE:
     #: range [i0, i1]
     contacts: tuple[PointCorrection, ...] = ()
     contact_ranges: tuple[tuple[int, int], ...] = ()
+    #: (ncomp, 2) each mechanical component's block range [first, end) (`mesh.layout`)
+    component_blocks: np.ndarray | None = None
 
     @property
     def n_contact_wires(self) -> int:
@@ -228,7 +233,7 @@ def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
     spring gets its wires' point-load defect in series (module docstring); False gives the plain Hermite wires."""
     line = line_of(p)
     x, supports, droppers = build_nodes(line, p.element_length)
-    offset, slot, ranges = layout(line, x)
+    offset, slot, ranges, cblocks = layout(line, x)
     nfull = int(offset[-1])
     defect, pcs = wire_defects(line, x, ranges, point_correction)
     Kf, Mf, qload = beam_matrices(line, x, slot, ranges, nfull, p.g)  # qload: gravity on the wires, then the points
@@ -258,7 +263,7 @@ def assemble(p: CatenaryParams, point_correction: bool = True) -> CatenaryFE:
                       dropper_upper=full_to_free[ps.up], dropper_lower=full_to_free[ps.low], dropper_slack=slack,
                       w0_full=w0_full, T0=T0, support_preload=preload, k_drop=ps.k_drop, contact=pcs[0],
                       irregularity=line.irregularity, contacts=tuple(pcs[:len(line.contacts)]),
-                      contact_ranges=tuple(ranges[:len(line.contacts)]))
+                      contact_ranges=tuple(ranges[:len(line.contacts)]), component_blocks=cblocks)
 
 
 def _free_dofs(line: Line, slot: np.ndarray, ranges: list[tuple[int, int]], ps: PointSprings,

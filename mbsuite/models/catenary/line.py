@@ -45,7 +45,8 @@ from ...trust.perturbation import POSITION
 WIRE_ROLES = ("contact", "messenger", "stitch", "auxiliary", "other")
 END_KINDS = ("pinned", "free")
 DROPPER_LAWS = ("", "slack", "linear")
-#: most wires at one position: the compiled core's node blocks hold at most 8 DOFs (w, theta per wire)
+#: most wires of one mechanical component (wires joined by droppers or clamps) at one position: the compiled core's
+#: blocks (a component at a node) hold at most 8 DOFs (w, theta per wire)
 MAX_WIRES_AT_A_NODE = 4
 #: the contact wire's mid-span presag / span length (parabolic between supports)
 PRESAG = Limit(lo=0.0, hi=0.05, hi_open=True, unit="", doc="mid-span presag / span length (absent: 0, level)")
@@ -364,33 +365,28 @@ class Line:
         if self.irregularity is not None and not isinstance(self.irregularity, Irregularity):
             raise ParameterError(f"line {self.name!r}: irregularity must be an Irregularity, got "
                                  f"{type(self.irregularity).__name__}")
+        group = self.wire_components()
         for x in self.key_points():
-            n = sum(w.x0 <= x <= w.x1 for w in self.wires)
+            here = [g for w, g in zip(self.wires, group, strict=True) if w.x0 <= x <= w.x1]
+            n = max(here.count(g) for g in set(here)) if here else 0
             if n > MAX_WIRES_AT_A_NODE:
-                raise ParameterError(f"line {self.name!r}: {n} wires at x = {x} m; at most {MAX_WIRES_AT_A_NODE}")
+                raise ParameterError(f"line {self.name!r}: {n} wires joined by droppers or clamps at x = {x} m; at "
+                                     f"most {MAX_WIRES_AT_A_NODE}")
         if len(contact) > 1:
             self._check_apart(contact)
 
     def _check_apart(self, contact: list[Wire]) -> None:
         """Overlapping contact wires never touch (module docstring): not joined by droppers or clamps, directly or
         through other wires; their design heights not equal (to `TOUCH`) at two consecutive key points both have."""
+        group = self.wire_components()
         wi = {w.name: k for k, w in enumerate(self.wires)}
-        parent = list(range(len(self.wires)))
-
-        def root(a: int) -> int:
-            while parent[a] != a:
-                a = parent[a]
-            return a
-
-        for a, b in [(d.upper, d.lower) for d in self.droppers] + [(c.a, c.b) for c in self.clamps]:
-            parent[root(wi[a])] = root(wi[b])
         keys = self.key_points()
         for i, a in enumerate(contact):
             for b in contact[i + 1:]:
                 lo, hi = max(a.x0, b.x0), min(a.x1, b.x1)
                 if not lo < hi:
                     continue
-                if root(wi[a.name]) == root(wi[b.name]):
+                if group[wi[a.name]] == group[wi[b.name]]:
                     raise ParameterError(f"line {self.name!r}: the contact wires {a.name!r} and {b.name!r} overlap on "
                                          f"[{lo}, {hi}] m and are joined by droppers or clamps: overlapping contact "
                                          "wires must not touch (each section hangs from its own wires)")
@@ -402,6 +398,26 @@ class Line:
                     raise ParameterError(f"line {self.name!r}: the contact wires {a.name!r} and {b.name!r} are at the "
                                          f"same design height from x = {xs[j]:g} to {xs[j + 1]:g} m: overlapping "
                                          "contact wires must not touch (they may cross at a point); change heights")
+
+    def wire_components(self) -> list[int]:
+        """The mechanical component of each wire (in `wires` order): wires joined by droppers or clamps, directly or
+        through other wires, share one (numbered 0, 1, ... in the order of their first wire). The sections of a route
+        are its components: nothing but a pantograph joins them."""
+        wi = {w.name: k for k, w in enumerate(self.wires)}
+        parent = list(range(len(self.wires)))
+
+        def root(a: int) -> int:
+            while parent[a] != a:
+                a = parent[a]
+            return a
+
+        for a, b in [(d.upper, d.lower) for d in self.droppers] + [(c.a, c.b) for c in self.clamps]:
+            ra, rb = root(wi[a]), root(wi[b])
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+        roots = [root(k) for k in range(len(self.wires))]
+        number = {r: i for i, r in enumerate(dict.fromkeys(roots))}
+        return [number[r] for r in roots]
 
     @staticmethod
     def pinned_end(wire: Wire, x: float) -> bool:

@@ -253,7 +253,7 @@ LINE_SECTION = Section("[line]", {
     "presag": PRESAG,
     "stitch": of_dataclass(StitchParams, "[line.stitch]", doc="the stitch wires of kind = 'stitched'"),
     "compound": of_dataclass(CompoundParams, "[line.compound]", doc="the auxiliary wire of kind = 'compound'"),
-    "overlap": of_dataclass(OverlapParams, "[line.overlap]", doc="the two sections of kind = 'overlap'"),
+    "overlap": of_dataclass(OverlapParams, "[line.overlap]", doc="the sections and overlaps of kind = 'overlap'"),
     "irregularity": IRREGULARITY,
 }, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] / [line.overlap] only with their kind",
                _kind_matches,

@@ -200,12 +200,15 @@ def route(sections: Sequence[Line | tuple[float, Line]], name: str = "route") ->
 
 @dataclass(frozen=True)
 class OverlapParams:
-    """The overlap of two EN 50318 tension sections (model README, "Overlaps and routes"): section A over `spans`
-    spans from x = 0, section B over `spans` spans from the start of the last `overlap_spans` spans of A. In the
-    overlap the wire that leaves rises out of the running plane: A's contact wire is at `rise_inner` at the overlap's
-    last interior support and at `rise_anchor` at its anchor (A's end), B's mirrored (`rise_anchor` at its start,
-    `rise_inner` at the overlap's first interior support), each at 0 elsewhere, linear between supports."""
+    """EN 50318 tension sections chained by overlaps (model README, "Overlaps and routes"): `sections` sections (the
+    scene `catenary/en50318_overlap`: two, A and B; the route `catenary/en50318_route`: three) of `spans` spans each,
+    each next one starting at the start of the last `overlap_spans` spans of the one before. In an overlap the wire
+    that leaves rises out of the running plane: its contact wire is at `rise_inner` at the overlap's last interior
+    support and at `rise_anchor` at its anchor (its section's end), the coming one's mirrored (`rise_anchor` at its
+    start, `rise_inner` at the overlap's first interior support), each at 0 elsewhere, linear between supports."""
 
+    sections: int = param(2, lo=2, hi=100, kind=int, unit="-", doc="tension sections, each next one overlapping the "
+                                                                     "one before")
     spans: int = param(8, lo=3, hi=500, kind=int, unit="-", doc="spans of each section")
     overlap_spans: int = param(3, lo=2, hi=50, kind=int, unit="-", doc="spans the two sections share")
     rise_inner: float = param(0.10, lo=0.0, hi=2.0, unit="m", doc="height of the leaving contact wire at the "
@@ -217,6 +220,10 @@ class OverlapParams:
         check_fields(self, "overlap parameter")
         if not self.overlap_spans < self.spans:
             raise ParameterError(f"overlap overlap_spans = {self.overlap_spans} must be below spans = {self.spans}")
+        if self.sections > 2 and not 2 * self.overlap_spans <= self.spans:
+            raise ParameterError(f"overlap spans = {self.spans} must be at least twice overlap_spans = "
+                                 f"{self.overlap_spans} with {self.sections} sections: an inner section's two "
+                                 "overlaps would cross")
         if not self.rise_inner < self.rise_anchor:
             raise ParameterError(f"overlap rise_inner = {self.rise_inner} m must lie below rise_anchor = "
                                  f"{self.rise_anchor} m (the wire rises towards its anchor)")
@@ -239,18 +246,22 @@ def section(p: CatenaryParams, n_spans: int, suffix: str, heights: Sequence[tupl
 
 
 def overlap(p: CatenaryParams, o: OverlapParams | None = None, presag: float = 0.0) -> Line:
-    """Two EN 50318 sections A and B of `p` overlapping (`OverlapParams`; default: the scene
-    `catenary/en50318_overlap`, A over 0-480 m, B over 300-780 m, the overlap 300-480 m): a route of two sections,
-    each contact wire in the running plane (0) outside the overlap and rising to its anchor in it."""
+    """EN 50318 sections of `p` chained by overlaps (`OverlapParams`; default: the scene `catenary/en50318_overlap`,
+    A over 0-480 m, B over 300-780 m, the overlap 300-480 m): a route of `o.sections` sections named a, b, c, ...,
+    each contact wire in the running plane (0) outside its overlaps, coming down from its anchor in the overlap at
+    its start and rising to its anchor in the overlap at its end."""
     o = o or OverlapParams()
     L = p.span_length
-    xa1 = o.spans * L
-    xb0 = (o.spans - o.overlap_spans) * L
-    xb1 = xb0 + o.spans * L
-    ha = [(0.0, 0.0), (xa1 - 2 * L, 0.0), (xa1 - L, o.rise_inner), (xa1, o.rise_anchor)]
-    hb = [(0.0, o.rise_anchor), (L, o.rise_inner), (2 * L, 0.0), (xb1 - xb0, 0.0)]
-    return route([section(p, o.spans, "a", ha, presag), (xb0, section(p, o.spans, "b", hb, presag))],
-                 name="overlap")
+    Ls = o.spans * L
+    step = (o.spans - o.overlap_spans) * L
+    placed = []
+    for i in range(o.sections):
+        pts = [(0.0, o.rise_anchor), (L, o.rise_inner)] if i > 0 else [(0.0, 0.0)]
+        pts += [(2 * L, 0.0)] if i > 0 else []
+        pts += [(Ls - 2 * L, 0.0), (Ls - L, o.rise_inner), (Ls, o.rise_anchor)] if i < o.sections - 1 else [(Ls, 0.0)]
+        pts = [q for j, q in enumerate(pts) if j == 0 or q[0] > pts[j - 1][0]]  # 2 L = Ls - 2 L: one point
+        placed.append((i * step, section(p, o.spans, chr(ord("a") + i) if i < 26 else f"s{i + 1}", pts, presag)))
+    return route(placed, name="overlap" if o.sections == 2 else f"route of {o.sections} sections")
 
 
 #: kind of a scene's [line] section -> (builder, parameter dataclass or None)

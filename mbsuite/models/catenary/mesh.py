@@ -80,8 +80,15 @@ def line_of(p: CatenaryParams) -> Line:
     return simple(p)
 
 
-def layout(line: Line, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[tuple[int, int]]]:
-    """Node offsets, the w slot of every wire at every node (-1 absent) and each wire's node range [i0, i1]."""
+def layout(line: Line, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[tuple[int, int]], np.ndarray]:
+    """The DOF layout of `line` on the nodes `x`: DOFs in blocks, a block per mechanical component
+    (`Line.wire_components`) and node, holding (w, theta) of each of the component's wires present there in the line's
+    wire order; the components one after the other (ordered by where their first contact wire starts, components
+    without a contact wire last), each over its nodes in order. Returns the blocks' offsets (nblock + 1), the w slot
+    of every wire at every node (-1 absent), each wire's node range [i0, i1] and each component's block range
+    (ncomp x 2, [first, end)). A line of one component (a tension section) has a block per node, the node-by-node
+    order [w_cw, theta_cw, w_mw, theta_mw, ...]; a route's sections are contiguous and uncoupled, so its step
+    matrix is block diagonal, one banded block per section (`native/catenary.c` steps only the sections in play)."""
     at = node_index(x)
     nw, nn = len(line.wires), x.size
     present = np.zeros((nw, nn), bool)
@@ -90,8 +97,26 @@ def layout(line: Line, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[tupl
         i0, i1 = at(w.x0), at(w.x1)
         present[k, i0:i1 + 1] = True
         ranges.append((i0, i1))
-    counts = 2 * present.sum(axis=0)
-    offset = np.concatenate([[0], np.cumsum(counts)])
-    rank = np.cumsum(present, axis=0) - 1
-    slot = np.where(present, offset[:-1][None, :] + 2 * rank, -1)
-    return offset, slot, ranges
+    comp = np.asarray(line.wire_components())
+    first_contact = {}
+    for k, w in enumerate(line.wires):
+        if w.role == "contact":
+            first_contact.setdefault(int(comp[k]), w.x0)
+    order = sorted(range(int(comp.max()) + 1), key=lambda c: (c not in first_contact, first_contact.get(c, 0.0), c))
+    slot = -np.ones((nw, nn), dtype=np.int64)
+    sizes, cblocks = [], []
+    start = 0
+    for c in order:
+        mine = np.nonzero(comp == c)[0]
+        here = present[mine]
+        nodes = np.nonzero(here.any(axis=0))[0]
+        counts = 2 * here[:, nodes].sum(axis=0)
+        offs = start + np.concatenate([[0], np.cumsum(counts)])
+        rank = np.cumsum(here[:, nodes], axis=0) - 1
+        slot[mine[:, None], nodes[None, :]] = np.where(here[:, nodes], offs[:-1][None, :] + 2 * rank, -1)
+        b0 = len(sizes)
+        sizes.extend(counts.tolist())
+        cblocks.append((b0, len(sizes)))
+        start = int(offs[-1])
+    offset = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    return offset, slot, ranges, np.array(cblocks, dtype=np.int64).reshape(-1, 2)

@@ -31,7 +31,7 @@ from ...errors import SolverError
 _P = ctypes.c_void_p
 _I = ctypes.c_int
 _D = ctypes.c_double
-ABI = 6
+ABI = 7
 
 
 class _Job(ctypes.Structure):
@@ -56,6 +56,8 @@ class _Job(ctypes.Structure):
         ("nseg_f", _I), ("nseg_b", _I),
         ("n_local", ctypes.c_long), ("err", _I), ("err_con", _I), ("err_port", _I), ("err_value", _D),
         ("ncw", _I), ("own", _P), ("cwk", _P), ("erng", _P), ("onw", _P), ("xrng", _P), ("cwEI", _P), ("Nf", _P),
+        ("nblk", _I), ("ncomp", _I), ("cmpb", _P), ("cmpd", _P), ("cmpx", _P), ("retire", _I), ("cmpt", _P),
+        ("lb0", _I), ("lb1", _I), ("ld0", _I), ("ld1", _I),
     ]
 
 
@@ -117,6 +119,7 @@ class NativeFactor:
         r, c = S.nonzero()
         j = self.job = _Job()
         j.n, j.nnode = S.shape[0], np.size(node_offset) - 1
+        j.nblk = j.nnode
         j.bw = int(np.max(np.abs(r - c))) if r.size else 0
         self._arrays = _band_arrays(S, j.bw, node_offset, free)
         for name, arr in self._arrays.items():
@@ -132,6 +135,29 @@ class NativeFactor:
         return x
 
 
+#: which sections (mechanical components) of a line the core steps: "in play" (from the step a contact point first
+#: reaches one to the step every contact point has passed it; exact for the pantographs), "reached" (from the first
+#: reach on: every record exact) or "all"
+SECTIONS = ("in play", "reached", "all")
+
+
+def section_ranges(fe) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per mechanical component of `fe` (`mesh.layout`, in DOF order): its block range, its free-DOF range (both
+    [first, end)) and the x-range of its contact wires ([inf, -inf]: none)."""
+    cb = np.asarray(fe.component_blocks, dtype=np.int64).reshape(-1, 2)
+    start = np.asarray(fe.node_offset)[cb]  # full index of each range's ends
+    cd = np.searchsorted(np.asarray(fe.free), start)
+    cx = np.tile([np.inf, -np.inf], (cb.shape[0], 1))
+    slots = np.asarray(fe.slot)
+    for k, w in enumerate(fe.line.wires):
+        if w.role != "contact":
+            continue
+        first = int(slots[k][slots[k] >= 0].min())  # the component's DOFs are contiguous: its range holds this one
+        c = int(np.searchsorted(start[:, 0], first, side="right") - 1)
+        cx[c] = (min(cx[c, 0], w.x0), max(cx[c, 1], w.x1))
+    return cb, cd, cx
+
+
 class NativeCore:
     """The C twin of a passage of `sim` with `ncon` pantograph heads (see the module docstring). Arrays are owned here
     (numpy) and the C job points into them; the state arrays (`u`, `q`, `p`, `f`, `head`, ...) are views the
@@ -143,11 +169,15 @@ class NativeCore:
     one-port, the head height); a contact exists only while the head is on its wire's x-range. With one contact wire
     a contact is its head."""
 
-    def __init__(self, sim, ncon: int, x_start: np.ndarray, x_end: np.ndarray):
+    def __init__(self, sim, ncon: int, x_start: np.ndarray, x_end: np.ndarray, sections: str | None = None):
+        sections = getattr(sim, "sections", "in play") if sections is None else sections
+        if sections not in SECTIONS:
+            raise SolverError(f"sections = {sections!r} is invalid; valid: {', '.join(map(repr, SECTIONS))}")
         lib = self.lib = library()
         fe, p = sim.fe, sim.fe.params
         ncw = self.ncw = fe.n_contact_wires
         self.nheads = int(ncon)
+        self.sim_fe = fe
         n, nd, nc = fe.n, fe.T0.size, int(ncon) * ncw
         if nd and (np.min(fe.dropper_upper) < 0 or np.min(fe.dropper_lower) < 0):
             raise SolverError("a dropper hangs from a pinned DOF (fe.dropper_upper / dropper_lower hold -1)")
@@ -158,6 +188,10 @@ class NativeCore:
         j = self.job = _Job()
         j.n, j.bw, j.nd, j.nsup, j.ncon, j.nnode = n, sim.lu.bandwidth, nd, arm.size, nc, fe.x.size
         j.nnz = K.nnz
+        j.nblk = np.size(fe.node_offset) - 1
+        cb, cd, cx = section_ranges(fe)
+        j.ncomp = 0 if sections == "all" else cb.shape[0]
+        j.retire = int(sections == "in play")
         j.slack, j.unilateral, j.max_iter = int(sim.slack), int(sim.unilateral), int(sim.max_active_iter)
         h = sim.h
         c_ab = h * sim.beta + h * h
@@ -216,6 +250,8 @@ class NativeCore:
             "work": np.zeros(m * (m + 1) + m + 1), "iwork": np.zeros(2 * m + 2, np.int32),
             "ports": np.zeros(nc, np.uintp), "gs": np.full(nc, np.nan), "cw": np.zeros(4 * nc),
             "nl": np.zeros(nc, np.int32), "ooff": np.zeros(nc, np.int32),
+            "cmpb": cb.astype(np.int32).reshape(-1), "cmpd": cd.astype(np.int32).reshape(-1),
+            "cmpx": cx.astype(float).reshape(-1), "cmpt": np.full(max(cb.shape[0], 1), np.nan),
         }
         self.native_ports: list[Any] = [None] * nc
         self._bind(arrays)
@@ -224,6 +260,18 @@ class NativeCore:
         if sim.slack:
             lib.mbs_cat_dropper_ranges(ctypes.byref(j))
         self.blocked = bool(j.blocked)
+
+    def left_at(self) -> np.ndarray:
+        """Per uplift point (`fe.arms`): the time (s) from which its section was no longer stepped, every pantograph
+        having passed it (`CatenaryParams.step_sections` "in play"; inf: stepped to the end)."""
+        fe = self.sim_fe
+        d = fe.arm_cw
+        cd = self.cmpd.reshape(-1, 2)
+        out = np.full(d.size, np.inf)
+        for c, t in enumerate(self.cmpt[:cd.shape[0]]):
+            if np.isfinite(t):
+                out[(d >= cd[c, 0]) & (d < cd[c, 1])] = t
+        return out
 
     def contacts_of(self, head: int) -> range:
         """The contact indices of pantograph head `head` (one per contact wire; the first owns the head)."""

@@ -78,6 +78,12 @@ class CatenaryParams:
     # --- size guard -------------------------------------------------------------------------------------------
     max_element_steps: float = param(MAX_ELEMENT_STEPS, lo=1.0, hi=1e15, unit="-",
                                      doc="size guard: FE elements x time steps a passage may take")
+    # --- the sections of a route the compiled core steps -----------------------------------------------------------
+    step_sections: str = param("in play", kind=str, choices=("in play", "reached", "all"),
+                          doc="a route's sections the compiled core steps: 'in play' (from the step a pantograph "
+                              "reaches one until every pantograph has passed it: the pantographs' forces exact, a "
+                              "section's records end when it is left), 'reached' (from then on: every record "
+                              "exact) or 'all'")
     # --- the line ------------------------------------------------------------------------------------------------
     #: a line of its own (`line.Line`: a scene's [line] section, `lines.py`, `linefile.py`); None: the simple line of
     #: the fields above (n_spans ... k_messenger_support, the EN 50318:2002 line by default)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 from ...results import Report, SimResult, format_table, write_csv
@@ -224,6 +225,9 @@ def window_lines(run: CatenaryRun, quality: QualityCriteria | None) -> list[str]
         out.append("each contact wire's own contact force (filtered, on the wire's samples in the window):")
         out.append(format_table(["window", "wire", "Fm (N)", "sigma (N)", "max (N)", "min (N)", "in contact (%)",
                                  "contact x (m)", "losses"], wrows))
+        out.append("(a wire's force is 0 off contact: its 20 Hz low-pass dips below 0 next to where its contact begins "
+                   "and ends, the min column; losses: its own contact losses once it has carried the head, the "
+                   "last where it leaves for good)")
     if quality is not None:
         for n, h in zip(names, heads, strict=True):
             q = assess(ws[n], run.speed_kmh, quality, window_time(ws[n], run.dt))
@@ -311,6 +315,13 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
                          f"{'PASS' if q['pass'] else 'FAIL'}")
             lines.append(format_table(["criterion", "value", "limit", "verdict"], quality_table_rows(q)))
         data["quality_pass"] = all(q["pass"] for q in qs)
+    if "windows" in run.stats[0]:  # further windows (a route: its sections alone and its overlaps), per pantograph
+        data["overlaps"] = overlaps(run.params)
+        for k in range(len(run.names)):
+            one = SimpleNamespace(stats=run.stats[k], params=run.params, speed_kmh=run.speed_kmh, dt=run.dt)
+            lines.append(f"{labels[k]}:")
+            lines += window_lines(one, quality)
+            data["pantographs"][k]["windows"] = window_data(one, quality)
 
     def write(out: Path) -> list[Path]:
         out = Path(out)
@@ -318,10 +329,12 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
         files = []
         for k, res in enumerate(run.results):
             tag = f"p{k + 1}_{run.names[k]}_{run.speed_kmh:g}kmh"
+            per_wire = [col for name, w in (res.wires or {}).items()
+                        for col in ((f"force_{name}", "N", w["force"]), (f"wire_height_{name}", "m", w["wire"]))]
             files.append(write_csv(out / f"contact_force_{tag}.csv", [
                 ("t", "s", res.t), ("x", "m", res.x), ("force", "N", res.force),
                 ("force_filtered_20Hz", "N", run.filtered[k]), ("head_height", "m", res.head),
-                ("wire_height", "m", res.wire)]))
+                ("wire_height", "m", res.wire), *per_wire]))
         files.append(save(train_figure(run, labels), out / f"train_force_{run.speed_kmh:g}kmh.png"))
         if qs:
             files.append(quality_plot(list(zip(labels, qs, strict=True)),
@@ -346,6 +359,9 @@ def train_to_simresult(run: TrainRun, scene) -> SimResult:
         statistics.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})
         statistics[f"p{k + 1}_static_contact_force"] = run.static_forces[k]
         statistics[f"p{k + 1}_quality_pass"] = qs[k]["pass"]
+    if "windows" in run.stats[0]:  # each pantograph's further windows (`accuracy.values`)
+        stats["windows"] = {f"p{k + 1}": {n: {"statistics": {key: w[key] for key in STAT_NAMES}}
+                                          for n, w in s["windows"].items()} for k, s in enumerate(run.stats)}
     events = [{**e, "pantograph": k + 1} for k, s in enumerate(run.stats) for e in s["loss_events"]]
     res = assemble_result(scene, lead.t, signals, engine=run.engines[-1], events=events, stats=stats,
                           statistics=statistics, health=health_of_regime(run.speed_kmh / 3.6, run.params, run.dt))

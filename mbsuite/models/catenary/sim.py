@@ -86,6 +86,8 @@ class CoupledSimulation:
         if contact not in ("unilateral", "bilateral"):
             raise SolverError(f"contact must be 'unilateral' or 'bilateral', got {contact!r}")
         self.fe, self.panto, self.V, self.dt = fe, pantograph, float(speed), float(dt)
+        #: the sections of a route the compiled core steps (`CatenaryParams.step_sections`; one section: all of it)
+        self.sections = fe.params.step_sections
         #: per dropper: tension-only (may go slack; `fe.slack_mask`); `slack`: any of them is
         self.slackable = np.asarray(fe.slack_mask(dropper_law), dtype=bool)
         self.slack = bool(np.any(self.slackable))

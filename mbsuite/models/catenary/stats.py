@@ -107,7 +107,8 @@ def en50318_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, uplift: 
                        dt: float, p: CatenaryParams, names: list[str] | None = None,
                        ff: np.ndarray | None = None) -> dict:
     """The eight EN 50318 statistics plus loss events (module docstring). `uplift` is (n_samples, n_supports) (m);
-    `names` names its columns (default: the support's x, "%g"); `ff` the filtered force if already at hand."""
+    `names` names its columns (default: the support's x, "%g"; NaN where its section was no longer stepped, every
+    pantograph having passed it, `CatenaryParams.step_sections`); `ff` the filtered force if already at hand."""
     ff = lowpass(force, dt, p.filter_cutoff, p.filter_order) if ff is None else ff
     w = in_window(x, p)
     if w.sum() < 2:
@@ -123,9 +124,9 @@ def en50318_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, uplift: 
     return {
         "Fm": fm, "sigma": sd, "stat_max": fm + 3 * sd, "stat_min": fm - 3 * sd,
         "max": float(fw.max()), "min": float(fw.min()),
-        "uplift_mm": float(1000 * up.max()) if up.size else 0.0,
+        "uplift_mm": float(1000 * np.nanmax(up)) if up.size else 0.0,
         "loss_pct": float(100.0 * np.mean(force[w] <= 0.0)),
-        "uplift_at_supports_mm": {(f"{xs:g}" if names is None else names[i]): float(1000 * up[:, j].max())
+        "uplift_at_supports_mm": {(f"{xs:g}" if names is None else names[i]): float(1000 * np.nanmax(up[:, j]))
                                   for j, (i, xs) in enumerate(zip(np.nonzero(sup)[0], support_x[sup], strict=True))},
         "loss_events": events, "loss_counts": counts,
         "n_samples_window": int(w.sum()),

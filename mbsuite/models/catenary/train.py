@@ -220,6 +220,9 @@ class TrainPassage(Stepping):
         """Each pantograph's record from its entry, on the time since its entry and its own position."""
         fe, core = self.sim.fe, self.core
         sx = fe.arm_x
+        left = core.left_at()
+        if np.any(np.isfinite(left)):  # a section no longer stepped: its steady arms' records end there
+            self.U[self.T[:, None] >= left[None, :]] = np.nan
         out = []
         for k in range(len(self.pans)):
             e = self.entries[k]
@@ -339,7 +342,7 @@ def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -
     up = np.where(near, res.uplift, -np.inf)
     s, ff = en50318_statistics(res.t, x, res.force, np.where(np.isfinite(up), up, 0.0), sx, dt, p)
     win = supports_in_window(sx, p)
-    per = {names[j]: float(1000 * np.max(up[:, j])) for j in range(sx.size) if win[j]}
+    per = {names[j]: float(1000 * np.nanmax(up[:, j])) for j in range(sx.size) if win[j]}
     s["uplift_at_supports_mm"] = per
     s["uplift_mm"] = max(per.values()) if per else 0.0
     if p.windows:

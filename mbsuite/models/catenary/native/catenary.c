@@ -31,7 +31,7 @@
 
 #include "mbsuite.h"
 
-#define CAT_ABI 6
+#define CAT_ABI 7
 /* G = h^2 S^-1 decays geometrically away from a load (S is dominated by the mass matrix at these steps): the
  * advance adds a column only where it is above this fraction of its largest entry (the rest is below the sums'
  * rounding) */
@@ -131,6 +131,17 @@ typedef struct {
   double *xrng;  /* 2*ncon: the x-range of its wire */
   double *cwEI;  /* ncw: bending stiffness of each contact wire (its point-load defect) */
   double *Nf;    /* 4*ncon: the shape functions unmasked (the static height at a pinned end, which need not be 0) */
+  /* sections in play (update_live): the factor's blocks, and per mechanical component (wires joined by droppers or
+   * clamps: a route's tension section) its blocks, its free DOFs (both contiguous, fe.component_blocks) and the
+   * x-range of its contact wires (x0 > x1: none) */
+  int nblk;      /* blocks of the factor (nblk + 1 entries in noff, boff; a block per node on one section) */
+  int ncomp;     /* components; 0: every DOF is stepped */
+  int *cmpb;     /* 2*ncomp: block range [first, end) */
+  int *cmpd;     /* 2*ncomp: free-DOF range [first, end) */
+  double *cmpx;  /* 2*ncomp: x-range of its contact wires */
+  int retire;    /* 1: a component every contact point has passed is no longer stepped */
+  double *cmpt;  /* ncomp: the time of the first step it was not stepped after being in play (NaN: none yet) */
+  int lb0, lb1, ld0, ld1; /* the blocks and free DOFs stepped: the components in play and any between them */
 } cat_job;
 
 int mbs_cat_abi(void) { return CAT_ABI; }
@@ -176,7 +187,7 @@ static inline __attribute__((always_inline)) double tree_dot(const double* F, co
 }
 
 static int build_blocks(cat_job* J) {
-  const int n = J->n, bw = J->bw, w = bw + 1, nn = J->nnode;
+  const int n = J->n, bw = J->bw, w = bw + 1, nn = J->nblk;
   J->blocked = 0;
   if (!J->blk || !J->pw || !J->fidx || !J->noff || !J->boff) return 0;
   for (int I = 0; I < nn; I++) {
@@ -361,7 +372,7 @@ static void fwd_any(const cat_job* J, double* y, int I) {
 }
 
 static void bwd_any(const cat_job* J, double* y, int I) {
-  const int s = NSIZE(J, I), q = I < J->nnode - 1 ? NSIZE(J, I + 1) : 0;
+  const int s = NSIZE(J, I), q = I < J->nblk - 1 ? NSIZE(J, I + 1) : 0;
   const double* G = J->blk + J->boff[I + 1] - s * q;
   double* v = y + J->noff[I];
   const double* a = q ? y + J->noff[I + 1] : y;
@@ -373,32 +384,42 @@ static void bwd_any(const cat_job* J, double* y, int I) {
 #undef GENERIC
 }
 
-static void block_solve(const cat_job* J, double* x) {
-  const int n = J->n;
+/* x <- S^-1 x on the free DOFs [d0, d1) = the blocks [b0, b1) (whole components: S couples nothing outside them,
+ * its factor neither, so the entries outside are neither read into nor written; the sweeps' stretches clipped) */
+static void block_solve(const cat_job* J, double* x, int d0, int d1, int b0, int b1) {
   double* y = J->pw;
   const int* fi = J->fidx;
-  memset(y, 0, sizeof(double) * (size_t)J->noff[J->nnode]);
-  for (int i = 0; i < n; i++) y[fi[i]] = x[i];
+  memset(y + J->noff[b0], 0, sizeof(double) * (size_t)(J->noff[b1] - J->noff[b0]));
+  for (int i = d0; i < d1; i++) y[fi[i]] = x[i];
   const int* sg = J->seg;
   for (int g = 0; g < J->nseg_f; g++, sg += 3) {
-    switch (sg[2]) {
-      case 2: fwd_run(J, y, sg[0], sg[1], 2); break;
-      case 4: fwd_run(J, y, sg[0], sg[1], 4); break;
-      case 6: fwd_run(J, y, sg[0], sg[1], 6); break;
-      case 8: fwd_run(J, y, sg[0], sg[1], 8); break;
-      default: fwd_any(J, y, sg[0]);
+    const int a = sg[0] > b0 ? sg[0] : b0, e = sg[1] < b1 ? sg[1] : b1;
+    if (a >= e) continue;
+    switch (sg[2]) { /* a run starting inside the range still has a previous block of its size */
+      case 2: fwd_run(J, y, a, e, 2); break;
+      case 4: fwd_run(J, y, a, e, 4); break;
+      case 6: fwd_run(J, y, a, e, 6); break;
+      case 8: fwd_run(J, y, a, e, 8); break;
+      default: fwd_any(J, y, a);
     }
   }
   for (int g = 0; g < J->nseg_b; g++, sg += 3) {
+    const int top = sg[0] < b1 - 1 ? sg[0] : b1 - 1, bot = sg[1] > b0 - 1 ? sg[1] : b0 - 1;
+    if (top <= bot) continue;
     switch (sg[2]) {
-      case 2: bwd_run(J, y, sg[0], sg[1], 2); break;
-      case 4: bwd_run(J, y, sg[0], sg[1], 4); break;
-      case 6: bwd_run(J, y, sg[0], sg[1], 6); break;
-      case 8: bwd_run(J, y, sg[0], sg[1], 8); break;
-      default: bwd_any(J, y, sg[0]);
+      case 2: bwd_run(J, y, top, bot, 2); break;
+      case 4: bwd_run(J, y, top, bot, 4); break;
+      case 6: bwd_run(J, y, top, bot, 6); break;
+      case 8: bwd_run(J, y, top, bot, 8); break;
+      default: bwd_any(J, y, top);
     }
   }
-  for (int i = 0; i < n; i++) x[i] = y[fi[i]];
+  for (int i = d0; i < d1; i++) x[i] = y[fi[i]];
+}
+
+/* step every DOF */
+static void full_range(cat_job* J) {
+  J->lb0 = 0, J->lb1 = J->nblk, J->ld0 = 0, J->ld1 = J->n;
 }
 
 int mbs_cat_factor(cat_job* J) {
@@ -421,18 +442,21 @@ int mbs_cat_factor(cat_job* J) {
     L[i * w] = sqrt(d);
     J->invd[i] = 1.0 / L[i * w];
   }
+  full_range(J);
   return build_blocks(J);
 }
 
-/* x <- S^-1 x; the forward sweep starts at `first` (entries before it are zero) */
+/* x <- S^-1 x on the stepped range [ld0, ld1) (whole components, see block_solve); the forward sweep starts at
+ * `first` (entries before it are zero) */
 static void band_solve(const cat_job* J, double* x, int first) {
   if (J->blocked) {
-    block_solve(J, x);
+    block_solve(J, x, J->ld0, J->ld1, J->lb0, J->lb1);
     return;
   }
-  const int n = J->n, bw = J->bw, w = bw + 1;
+  const int n = J->ld1, bw = J->bw, w = bw + 1;
   const double* L = J->L;
   const double* invd = J->invd;
+  if (first < J->ld0) first = J->ld0;
   for (int i = first; i < n; i++) {
     double s = x[i];
     const int mmax = (i - first < bw ? i - first : bw);
@@ -440,7 +464,7 @@ static void band_solve(const cat_job* J, double* x, int first) {
     for (int m = 1; m <= mmax; m++) s -= Li[m] * x[i - m];
     x[i] = s * invd[i];
   }
-  for (int i = n - 1; i >= 0; i--) {
+  for (int i = n - 1; i >= J->ld0; i--) {
     double s = x[i];
     const int mmax = (n - 1 - i < bw ? n - 1 - i : bw);
     for (int m = 1; m <= mmax; m++) s -= L[(long)(i + m) * w + m] * x[i + m];
@@ -448,7 +472,12 @@ static void band_solve(const cat_job* J, double* x, int first) {
   }
 }
 
-void mbs_cat_solve(cat_job* J, double* x) { band_solve(J, x, 0); }
+void mbs_cat_solve(cat_job* J, double* x) {
+  const int b0 = J->lb0, b1 = J->lb1, d0 = J->ld0, d1 = J->ld1;
+  full_range(J);
+  band_solve(J, x, 0);
+  J->lb0 = b0, J->lb1 = b1, J->ld0 = d0, J->ld1 = d1;
+}
 
 /* ----------------------------------------------------------------------------------------- contacts */
 /* G e_d into col (n), zero for a pinned DOF */
@@ -458,7 +487,7 @@ static void unit_column(const cat_job* J, int d, double* col) {
   col[d] = 1.0;
   band_solve(J, col, d);
   const double hh = J->h * J->h;
-  for (int i = 0; i < J->n; i++) col[i] *= hh;
+  for (int i = J->ld0; i < J->ld1; i++) col[i] *= hh;
 }
 
 /* [lo, hi) of the m columns of length n at col (contiguous) outside which every entry is below RANGE_EPS of the
@@ -601,12 +630,60 @@ double mbs_cat_wire(const cat_job* J, int k) {
 }
 
 /* ------------------------------------------------------------------------------------------ stages */
-/* R = q + h/2 g_n and vb* = S^-1 R; contact quantities a, Cm, bz and the dropper elongations dstar */
+/* 1 when dropper j hangs in the stepped range (both its ends are in one component) */
+static inline int dropper_live(const cat_job* J, int j) { return J->up[j] >= J->ld0 && J->up[j] < J->ld1; }
+
+/* The components in play at t_new: component c from the step its contact wires' x-range begins under the foremost
+ * contact point (before, nothing has touched it: its state is exactly the static one, zero, as stepping it would
+ * keep it) until every contact point has passed its end (with `retire`; after, nothing it does reaches a
+ * pantograph: only pantographs join sections). The stepped range runs from the first component in play to the
+ * last; a slack dropper left outside it leaves the slack set. Without components, or none in play, everything. */
+static void update_live(cat_job* J, double t_new) {
+  if (J->ncomp <= 0) {
+    full_range(J);
+    return;
+  }
+  double xmax = -INFINITY, xmin = INFINITY;
+  for (int k = 0; k < J->ncon; k++) {
+    double xp = J->xs[k] + J->V * t_new;
+    if (xp > J->xend[k]) xp = J->xend[k];
+    xmax = xp > xmax ? xp : xmax;
+    xmin = xp < xmin ? xp : xmin;
+  }
+  int lo = -1, hi = -1;
+  for (int c = 0; c < J->ncomp; c++) {
+    const double x0 = J->cmpx[2 * c], x1 = J->cmpx[2 * c + 1];
+    if (!(x0 <= x1) || xmax < x0) continue;
+    if (J->retire && xmin > x1) {
+      if (isnan(J->cmpt[c])) J->cmpt[c] = t_new;
+      continue;
+    }
+    if (lo < 0) lo = c;
+    hi = c;
+  }
+  if (lo < 0) {
+    full_range(J);
+    return;
+  }
+  J->lb0 = J->cmpb[2 * lo], J->lb1 = J->cmpb[2 * hi + 1];
+  J->ld0 = J->cmpd[2 * lo], J->ld1 = J->cmpd[2 * hi + 1];
+  int c = 0;
+  for (int b = 0; b < J->nslack; b++) {
+    if (!dropper_live(J, J->slk[b])) continue;
+    J->slk[c] = J->slk[b];
+    J->sS[c++] = J->sS[b];
+  }
+  J->nslack = c;
+}
+
+/* R = q + h/2 g_n and vb* = S^-1 R; contact quantities a, Cm, bz and the dropper elongations dstar (the components in
+ * play, update_live) */
 void mbs_cat_predict(cat_job* J, double t_new) {
-  const int n = J->n, nc = J->ncon, nd = J->nd;
+  update_live(J, t_new);
+  const int d0 = J->ld0, n = J->n, nl = J->ld1 - J->ld0, nc = J->ncon, nd = J->nd;
   const double hh2 = J->hh2, h2 = 2 * J->h;
   double *R = J->R, *vbs = J->vbs, *u = J->u;
-  memcpy(R, J->q, sizeof(double) * n);
+  memcpy(R + d0, J->q + d0, sizeof(double) * nl);
   for (int k = 0; k < nc; k++) {
     for (int m = 0; m < 4; m++) {
       const double g = J->gv[4 * k + m];
@@ -618,7 +695,7 @@ void mbs_cat_predict(cat_job* J, double t_new) {
     R[J->up[j]] -= hh2 * J->sS[a];
     R[J->lo[j]] += hh2 * J->sS[a];
   }
-  memcpy(vbs, R, sizeof(double) * n);
+  memcpy(vbs + d0, R + d0, sizeof(double) * nl);
   band_solve(J, vbs, 0);
   for (int k = 0; k < nc; k++) {
     if (!J->present[k]) continue;
@@ -659,13 +736,16 @@ void mbs_cat_predict(cat_job* J, double t_new) {
       for (int j = 0; j < nd; j++) {
         const int im = J->up[j], ic = J->lo[j];
         double z = 0.0;
-        for (int r = 0; r < 4; r++) z += (ck[(long)r * n + im] - ck[(long)r * n + ic]) * N[r];
+        if (dropper_live(J, j)) {
+          for (int r = 0; r < 4; r++) z += (ck[(long)r * n + im] - ck[(long)r * n + ic]) * N[r];
+        }
         J->bz[k * nd + j] = z;
       }
     }
   }
   if (J->slack) {
     for (int j = 0; j < nd; j++) {
+      if (!dropper_live(J, j)) continue;
       const int im = J->up[j], ic = J->lo[j];
       J->dstar[j] = (u[im] - u[ic]) + h2 * (vbs[im] - vbs[ic]);
     }
@@ -786,7 +866,7 @@ int mbs_cat_local(cat_job* J) {
         }
       }
       for (int j = 0; j < nd; j++) {
-        if (!J->dslack[j]) continue; /* a bilateral dropper never goes slack */
+        if (!J->dslack[j] || !dropper_live(J, j)) continue; /* bilateral: never slack; outside: not stepped */
         double d = J->dstar[j];
         for (int k = 0; k < nc; k++) d += J->bz[k * nd + j] * f[k];
         for (int b = 0; b < ms; b++) d -= J->D[j * nd + S[b]] * s[b];
@@ -815,10 +895,10 @@ int mbs_cat_local(cat_job* J) {
 
 /* the end-of-step state from f and the slack corrections; the new local forces g_{n+1} */
 void mbs_cat_advance(cat_job* J) {
-  const int n = J->n, nc = J->ncon, nd = J->nd;
+  const int n = J->n, d0 = J->ld0, d1 = J->ld1, nc = J->ncon, nd = J->nd;
   const double inv2h = 1.0 / (2 * J->h), h2 = 2 * J->h, hh2 = J->hh2;
   double *vb = J->vb, *R = J->R, *u = J->u, *q = J->q, *p = J->p;
-  memcpy(vb, J->vbs, sizeof(double) * n);
+  memcpy(vb + d0, J->vbs + d0, sizeof(double) * (d1 - d0));
   for (int k = 0; k < nc; k++) {
     if (!J->onw[k] || J->f[k] == 0.0) continue;
     const double* ck = J->cols + (long)k * 4 * n;
@@ -834,7 +914,7 @@ void mbs_cat_advance(cat_job* J) {
     const double c = J->sS[b] * inv2h;
     for (int i = J->zrng[2 * j]; i < J->zrng[2 * j + 1]; i++) vb[i] -= z[i] * c;
   }
-  for (int i = 0; i < n; i++) u[i] += h2 * vb[i];
+  for (int i = d0; i < d1; i++) u[i] += h2 * vb[i];
   for (int k = 0; k < nc; k++) {
     for (int m = 0; m < 4; m++) {
       const double g = J->onw[k] ? J->Nl[4 * k + m] * J->f[k] : 0.0;
@@ -850,7 +930,7 @@ void mbs_cat_advance(cat_job* J) {
   const double c_ab = J->c_ab, inv = J->inv_1ha, thh = J->two_hh;
   const int *Kp = J->Kp, *Ki = J->Ki;
   const double* Kx = J->Kx;
-  for (int i = 0; i < n; i++) {
+  for (int i = d0; i < d1; i++) {
     double kv = 0.0;
     for (int a = Kp[i]; a < Kp[i + 1]; a++) kv += Kx[a] * vb[Ki[a]];
     const double A2 = 2.0 * ((R[i] - c_ab * kv) * inv);
@@ -860,6 +940,7 @@ void mbs_cat_advance(cat_job* J) {
     q[i] = qn;
   }
   for (int j = 0; j < nd; j++) {
+    if (!dropper_live(J, j)) continue;
     const int im = J->up[j], ic = J->lo[j];
     const double dv = 2.0 * J->kdj[j] * J->c_kd * (vb[im] - vb[ic]);
     q[im] += dv;
@@ -872,7 +953,7 @@ void mbs_cat_advance(cat_job* J) {
 /* finite state, displacements inside the small-displacement model, a pantograph not flying away */
 int mbs_cat_check(cat_job* J) {
   double umax = 0.0;
-  for (int i = 0; i < J->n; i++) {
+  for (int i = J->ld0; i < J->ld1; i++) { /* outside: static, or as checked when last stepped */
     const double a = fabs(J->u[i]);
     if (!(a <= umax)) umax = a; /* NaN propagates */
   }

@@ -464,6 +464,19 @@ def input_attempts() -> Iterator[Attempt]:
                        'overlap_spans = 3\n\n[params]\n')
     yield scene("catenary-route-overlaps-cross", a, "three sections whose inner one's two overlaps would cross", route,
                 culprit="overlap_spans")
+    from mbsuite.models.catenary.linefile import EXAMPLE  # a line file with a section insulator on [69, 71] m
+
+    for tag, what, change, culprit in (
+            ("off-the-wire", "a section insulator reaching past the contact wire's end", {"x": 99.5}, "insulator"),
+            ("negative-length", "a section insulator of negative length", {"length": -2.0}, "length"),
+            ("overlapping", "two section insulators overlapping on one wire", None, "overlap")):
+        data = copy.deepcopy(EXAMPLE)
+        if change is None:
+            data["insulators"].append({**data["insulators"][0], "x": 70.5})
+        else:
+            data["insulators"][0].update(change)
+        yield Attempt(f"catenary-line-insulator-{tag}", a, what, "error", ("catenary", f"{DIR}/input.toml", "--json"),
+                      culprit=culprit, files=(("input.toml", toml_text(data).encode()),))
     api = {
         "sine-nan-frequency": ("Sine(frequency=float('nan'))", "frequency"),
         "sine-inf-amplitude": ("Sine(amplitude=float('inf'))", "amplitude"),

@@ -163,4 +163,17 @@ MUTATIONS: tuple[Mutation, ...] = (
              "a route's section stepped only from 30 m after a pantograph reached it (its wire frozen under the "
              "pantograph)",
              "tests/catenary/test_overlap.py"),
+    # --- section insulators
+    Mutation("catenary_insulator_mass_not_in_mass_matrix", "mbsuite/models/catenary/wire_assembly.py",
+             "            ke, me = beam_stiffness(EI, float(groups[gi, 1]), he), beam_mass(rho, he)",
+             "            ke, me = beam_stiffness(EI, float(groups[gi, 1]), he), beam_mass(w.mass, he)",
+             "a section insulator's mass left out of the wire's consistent mass matrix (its weight still loads the "
+             "static state)",
+             "tests/catenary/test_insulators.py"),
+    Mutation("catenary_insulator_defect_closed_form", "mbsuite/models/catenary/point_correction.py",
+             "            if EIe is not None and np.any(EIe[lo:hi] != EI):",
+             "            if False:",
+             "the point-load defect next to a section insulator taken from the uniform wire's closed form (the "
+             "stiffened elements' entries not tabulated)",
+             "tests/catenary/test_insulators.py"),
 )

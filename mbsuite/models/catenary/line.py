@@ -23,6 +23,10 @@ Conventions (SI units, x along the track from the first pinned end, heights up):
   (b - x) / (b - a) with s = ratio (mid-span presag / span length; 0: level), plus the wire's `heights` profile.
 - Overlapping contact wires never touch: no dropper or clamp joins them (directly or through other wires), and their
   design heights may meet at single points (the crossing of an overlap) but not run together over an interval.
+- a `SectionInsulator` centred at x on a wire (any wire; typically the contact wire) over [x - length/2,
+  x + length/2] adds its mass spread uniformly over its length (mass/length per m: consistent mass and weight) and its
+  bending stiffness EI to the wire's there; its ends are nodes. Insulators on one wire do not overlap (they may
+  touch). The wire's point-load correction accounts for the stiffened elements (`point_correction.py`).
 - `Irregularity`: a height profile r(x) of the contact wire (m) on a uniform grid, piecewise linear, 0 outside; it
   enters the contact gap (y_wire = N . (w0 + u) + r), the wire-height signal and the pantograph's static state.
 """
@@ -228,6 +232,36 @@ class PointMass:
 
 
 @dataclass(frozen=True)
+class SectionInsulator:
+    """A section insulator (or any stiffening mass) centred at x on `wire` over [x - length/2, x + length/2]: its
+    mass spread uniformly over its length, its bending stiffness EI added to the wire's there (module docstring)."""
+
+    x: float = param(lo=0.0, hi=1e6, unit="m", doc="position of the insulator's centre", draw=POSITION)
+    wire: str = param(kind=str, doc="the wire it sits on (typically the contact wire)")
+    length: float = param(lo=0.0, lo_open=True, hi=100.0, unit="m", doc="its length along the wire")
+    mass: float = param(lo=0.0, hi=1e4, unit="kg", doc="its total mass (spread uniformly over its length)")
+    EI: float = param(lo=0.0, hi=1e7, unit="N m^2", doc="bending stiffness added to the wire's over its length")
+
+    def __post_init__(self) -> None:
+        check_fields(self, f"insulator at x = {self.x!r} m")
+
+    @property
+    def xa(self) -> float:
+        """Its start (m)."""
+        return self.x - 0.5 * self.length
+
+    @property
+    def xb(self) -> float:
+        """Its end (m)."""
+        return self.x + 0.5 * self.length
+
+    @property
+    def mass_per_length(self) -> float:
+        """The mass it adds per length of the wire (kg/m)."""
+        return self.mass / self.length
+
+
+@dataclass(frozen=True)
 class Irregularity:
     """The contact wire's height irregularity r(x) = r[i] at x0 + i dx, piecewise linear between, 0 outside."""
 
@@ -278,9 +312,10 @@ class Line:
     presag: float = 0.0
     irregularity: Irregularity | None = None
     name: str = "line"
+    insulators: tuple[SectionInsulator, ...] = ()
 
     def __post_init__(self) -> None:
-        for what in ("wires", "supports", "droppers", "clamps", "masses"):
+        for what in ("wires", "supports", "droppers", "clamps", "masses", "insulators"):
             object.__setattr__(self, what, tuple(getattr(self, what)))
         names = [w.name for w in self.wires]
         dup = sorted({n for n in names if names.count(n) > 1})
@@ -360,6 +395,7 @@ class Line:
             on(c.b, c.x, f"clamp at x = {c.x} m")
         for m in self.masses:
             on(m.wire, m.x, f"point mass at x = {m.x} m")
+        self._check_insulators(wires)
         object.__setattr__(self, "presag", PRESAG.check("presag", self.presag, ParameterError,
                                                         f" of the line {self.name!r}"))
         if self.irregularity is not None and not isinstance(self.irregularity, Irregularity):
@@ -374,6 +410,41 @@ class Line:
                                      f"most {MAX_WIRES_AT_A_NODE}")
         if len(contact) > 1:
             self._check_apart(contact)
+
+    def _check_insulators(self, wires: dict[str, Wire]) -> None:
+        """Each insulator on a wire of the line, within its x-range, none overlapping another on the same wire."""
+        for s in self.insulators:
+            if not isinstance(s, SectionInsulator):
+                raise ParameterError(f"line {self.name!r}: insulators must be SectionInsulator, got "
+                                     f"{type(s).__name__}")
+            what = f"insulator at x = {s.x} m [{s.xa:g}, {s.xb:g}] m"
+            w = wires.get(s.wire)
+            if w is None:
+                raise ParameterError(f"line {self.name!r}: {what} names wire {s.wire!r}; wires: {list(wires)}")
+            if not (w.x0 - 1e-9 <= s.xa and s.xb <= w.x1 + 1e-9):
+                raise ParameterError(f"line {self.name!r}: {what} lies off wire {s.wire!r} [{w.x0}, {w.x1}] m; valid: "
+                                     f"x - length/2 >= {w.x0} and x + length/2 <= {w.x1}")
+        by = sorted(self.insulators, key=lambda s: (s.wire, s.xa))
+        for a, b in zip(by, by[1:], strict=False):
+            if a.wire == b.wire and b.xa < a.xb - 1e-9:
+                raise ParameterError(f"line {self.name!r}: the insulators at x = {a.x} m [{a.xa:g}, {a.xb:g}] m and "
+                                     f"x = {b.x} m [{b.xa:g}, {b.xb:g}] m on wire {a.wire!r} overlap")
+
+    def beam_properties(self, wire: Wire, xm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The bending stiffness (N m^2) and mass per length (kg/m) of `wire` at the element midpoints `xm`: the
+        wire's own plus its insulators' (`SectionInsulator`) where a midpoint lies inside one."""
+        xm = np.asarray(xm, float)
+        EI, rho = np.full(xm.shape, wire.EI), np.full(xm.shape, wire.mass)
+        for s in self.insulators:
+            if s.wire == wire.name:
+                inside = (xm > s.xa) & (xm < s.xb)
+                EI[inside] = wire.EI + s.EI
+                rho[inside] = wire.mass + s.mass_per_length
+        return EI, rho
+
+    def insulators_on(self, wire: Wire) -> tuple[SectionInsulator, ...]:
+        """The insulators on `wire`, in the order they start."""
+        return tuple(sorted((s for s in self.insulators if s.wire == wire.name), key=lambda s: s.xa))
 
     def _check_apart(self, contact: list[Wire]) -> None:
         """Overlapping contact wires never touch (module docstring): not joined by droppers or clamps, directly or
@@ -453,10 +524,12 @@ class Line:
         raise ParameterError(f"line {self.name!r} has no wire {name!r}; wires: {[w.name for w in self.wires]}")
 
     def key_points(self) -> np.ndarray:
-        """Every position that must be a node (supports, droppers, clamps, masses, wire ends and tension changes),
+        """Every position that must be a node (supports, droppers, clamps, masses, insulator ends, wire ends and
+        tension changes),
         sorted, equal to 1e-9 m merged."""
         xs = [s.x for s in self.supports] + [d.x for d in self.droppers] + [c.x for c in self.clamps]
         xs += [m.x for m in self.masses]
+        xs += [v for s in self.insulators for v in (s.xa, s.xb)]
         for w in self.wires:
             xs += [w.x0, w.x1] + [v for s in w.tension_segments for v in s[:2]]
         k = np.unique(np.round(np.asarray(xs, float), 9))

@@ -15,6 +15,8 @@ Line file (model README, "A line of your own"; every length in m, mass in kg or 
     x = 5; upper = "messenger"; lower = "contact"; k = 1e5; law = "slack"; mass = 0.2; clamp_upper = 0.1
     [[clamps]]                           # or clamps_file: x, a, b, k
     [[masses]]                           # or masses_file: x, wire, m
+    [[insulators]]                       # or insulators_file: x, wire, length, mass, EI (section insulators)
+    x = 30; wire = "contact"; length = 2.0; mass = 12.0; EI = 2000.0
     [irregularity]                       # optional, see `irregularity.py`
 
 Relative file names are read from the line file's folder. Every key is checked: an unknown one is an error naming it
@@ -37,11 +39,11 @@ from ...limits import Limit, limit_of
 from ...schema import Items, Rule, Section, of_dataclass, toml_error
 from .irregularity import SECTION as IRREGULARITY
 from .irregularity import check_irregularity
-from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, Support, Wire
+from .line import PRESAG, SUPPORT_K, SUPPORT_M, Clamp, Dropper, Line, PointMass, SectionInsulator, Support, Wire
 from .lines import CompoundParams, OverlapParams, StitchParams
 from .mesh import line_of
 
-TABLES = ("supports", "droppers", "clamps", "masses")
+TABLES = ("supports", "droppers", "clamps", "masses", "insulators")
 #: most rows of one table (a tension section of 1 600 m has ~30 supports and ~250 droppers)
 MAX_ROWS = 100_000
 #: most wires of one line
@@ -57,7 +59,10 @@ SUPPORT = Section("support", {"x": limit_of(Support, "x")}, required=("x",),
 DROPPER = of_dataclass(Dropper, "dropper", doc="a dropper from wire upper to wire lower")
 CLAMP = of_dataclass(Clamp, "clamp", doc="a bilateral spring between the w displacements of wires a and b")
 MASS = of_dataclass(PointMass, "point mass", doc="a point mass on a wire (a connector, a registration clamp)")
-ROWS = {"supports": SUPPORT, "droppers": DROPPER, "clamps": CLAMP, "masses": MASS}
+INSULATOR = of_dataclass(SectionInsulator, "insulator", doc="a section insulator (or other stiffening mass) centred "
+                         "at x on a wire over [x - length/2, x + length/2]: its mass spread over its length, its EI "
+                         "added to the wire's")
+ROWS = {"supports": SUPPORT, "droppers": DROPPER, "clamps": CLAMP, "masses": MASS, "insulators": INSULATOR}
 
 
 def _one_source(table: str):
@@ -73,7 +78,7 @@ def _supports_given(d: Mapping[str, Any]) -> str | None:
 
 
 #: an example line file with every kind of row and key (the docs show it, the generated input tests move each key):
-#: two 50 m spans, a stitch wire, tension segments, masses, presag and a random irregularity
+#: two 50 m spans, a stitch wire, tension segments, masses, a section insulator, presag and a random irregularity
 EXAMPLE: dict[str, Any] = {
     "name": "two spans", "presag": 0.0005,
     "wires": [
@@ -93,6 +98,7 @@ EXAMPLE: dict[str, Any] = {
     "clamps": [{"x": 42.0, "a": "stitch", "b": "messenger", "k": 1e7},
                {"x": 58.0, "a": "stitch", "b": "messenger", "k": 1e7}],
     "masses": [{"x": 30.0, "wire": "contact", "m": 0.6}],
+    "insulators": [{"x": 70.0, "wire": "contact", "length": 2.0, "mass": 12.0, "EI": 2000.0}],
     "irregularity": {"seed": 3, "rms": 0.002, "wavelength_min": 2.0, "wavelength_max": 40.0, "n_waves": 200},
 }
 
@@ -108,7 +114,7 @@ LINE_FILE = Section("line file", {
     *(Rule(f"{t} inline or as {t}_file, not both", _one_source(t), given=True) for t in TABLES),
     Rule("supports are given (inline or as supports_file)", _supports_given, given=True),
 ), doc="one tension section, or a route of several (their contact wires overlapping): wires, supports, droppers, "
-       "clamps, point masses, presag and an irregularity",
+       "clamps, point masses, section insulators, presag and an irregularity",
     example=EXAMPLE)
 
 
@@ -150,7 +156,8 @@ def line_from_dict(data: Mapping[str, Any], base: Path, where: str) -> Line:
     profile names, `where` names the file in errors."""
     raw, data = data, LINE_FILE.check(data, where)
     built: dict[str, list[Any]] = {}
-    for table, make in (("supports", _support), ("droppers", Dropper), ("clamps", Clamp), ("masses", PointMass)):
+    for table, make in (("supports", _support), ("droppers", Dropper), ("clamps", Clamp), ("masses", PointMass),
+                        ("insulators", SectionInsulator)):
         built[table] = []
         for row, at in _rows(data, table, base, where):
             try:
@@ -167,7 +174,8 @@ def line_from_dict(data: Mapping[str, Any], base: Path, where: str) -> Line:
         check_irregularity(_resolved(raw["irregularity"], base), f"{where} [irregularity]")
     try:
         return Line(tuple(wires), tuple(built["supports"]), tuple(built["droppers"]), tuple(built["clamps"]),
-                    tuple(built["masses"]), presag=data["presag"], name=data.get("name", Path(where).stem))
+                    tuple(built["masses"]), presag=data["presag"], name=data.get("name", Path(where).stem),
+                    insulators=tuple(built["insulators"]))
     except ParameterError as exc:
         raise SceneError(f"{where}: {exc}") from None
 

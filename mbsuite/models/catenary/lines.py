@@ -15,7 +15,7 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...limits import check_fields, param
-from .line import Clamp, Dropper, Line, Support, Wire
+from .line import Clamp, Dropper, Line, SectionInsulator, Support, Wire
 from .params import CatenaryParams
 
 CONTACT, MESSENGER, STITCH, AUXILIARY = "contact", "messenger", "stitch", "auxiliary"
@@ -153,22 +153,24 @@ def compound(p: CatenaryParams, c: CompoundParams | None = None, presag: float =
 
 def shifted(line: Line, dx: float) -> list[Any]:
     """The parts of `line` moved by dx (m) along the track: wires (their heights profile and tension segments
-    too), supports, droppers, clamps, masses."""
+    too), supports, droppers, clamps, masses, insulators."""
     wires = [dataclasses.replace(w, x0=w.x0 + dx, x1=w.x1 + dx,
                                  tension_segments=tuple((a + dx, b + dx, T) for a, b, T in w.tension_segments),
                                  heights=tuple((x + dx, z) for x, z in w.heights)) for w in line.wires]
     return [wires, [Support(s.x + dx, dict(s.k), dict(s.m)) for s in line.supports],
             [dataclasses.replace(d, x=d.x + dx) for d in line.droppers],
             [dataclasses.replace(c, x=c.x + dx) for c in line.clamps],
-            [dataclasses.replace(m, x=m.x + dx) for m in line.masses]]
+            [dataclasses.replace(m, x=m.x + dx) for m in line.masses],
+            [dataclasses.replace(s, x=s.x + dx) for s in line.insulators]]
 
 
 def route(sections: Sequence[Line | tuple[float, Line]], name: str = "route") -> Line:
     """Tension sections chained into one line (one FE system: the sections' wires are simply more wires). Each
     section is a `Line` from x = 0, or (start, line): that line moved to start at `start` m (`shifted`). Their wires,
-    droppers, clamps and masses together, supports at the same x (to 1e-9 m) merged into one (each section's springs
-    and masses on its own wires). Wire names must differ between sections; the sections' presags must agree (the
-    route's), and an irregularity belongs to the route, not to a section. One section from 0: that section's line."""
+    droppers, clamps, masses and insulators together, supports at the same x (to 1e-9 m) merged into one (each
+    section's springs and masses on its own wires). Wire names must differ between sections; the sections' presags
+    must agree (the route's), and an irregularity belongs to the route, not to a section. One section from 0: that
+    section's line."""
     if not sections:
         raise ParameterError("a route needs at least one section")
     placed = [(0.0, sec) if isinstance(sec, Line) else (float(sec[0]), sec[1]) for sec in sections]
@@ -186,7 +188,8 @@ def route(sections: Sequence[Line | tuple[float, Line]], name: str = "route") ->
     if any(sec.irregularity is not None for sec in sections):
         raise ParameterError(f"route {name!r}: a section carries an irregularity; give it to the route")
     parts = [shifted(sec, dx) if dx else [list(sec.wires), list(sec.supports), list(sec.droppers),
-                                          list(sec.clamps), list(sec.masses)] for dx, sec in placed]
+                                          list(sec.clamps), list(sec.masses), list(sec.insulators)]
+             for dx, sec in placed]
     merged: dict[float, Support] = {}
     for part in parts:
         for sup in part[1]:
@@ -195,7 +198,14 @@ def route(sections: Sequence[Line | tuple[float, Line]], name: str = "route") ->
             merged[key] = sup if old is None else Support(old.x, {**old.k, **sup.k}, {**old.m, **sup.m})
     return Line(tuple(w for part in parts for w in part[0]), tuple(merged.values()),
                 tuple(d for part in parts for d in part[2]), tuple(c for part in parts for c in part[3]),
-                tuple(m for part in parts for m in part[4]), presag=sections[0].presag, name=name)
+                tuple(m for part in parts for m in part[4]), presag=sections[0].presag, name=name,
+                insulators=tuple(s for part in parts for s in part[5]))
+
+
+def with_insulators(line: Line, insulators: Sequence[SectionInsulator]) -> Line:
+    """`line` with `insulators` added to its own (`SectionInsulator`: section insulators or other stiffening masses
+    on its wires), checked as a new `Line`."""
+    return dataclasses.replace(line, insulators=(*line.insulators, *insulators))
 
 
 @dataclass(frozen=True)

@@ -24,9 +24,9 @@ def build_nodes(p: CatenaryParams | Line, element_length: float | None = None
     """Node coordinates (m), indices of the support nodes and of the dropper nodes (in the line's dropper order) of
     the line of `p` (its `line`, else the simple line of its fields) or of a `Line` (then `element_length` is needed).
 
-    Key points (`Line.key_points`: supports, droppers, clamps, masses, wire ends) are nodes; each interval between key
-    points is split into ceil(length / element_length) equal elements (a length within 1e-6 of itself above a whole
-    number of element lengths counts as that number)."""
+    Key points (`Line.key_points`: supports, droppers, clamps, masses, insulator ends, wire ends) are nodes; each
+    interval between key points is split into ceil(length / element_length) equal elements (a length within 1e-6 of
+    itself above a whole number of element lengths counts as that number)."""
     if isinstance(p, CatenaryParams):
         line, element_length = line_of(p), p.element_length
     else:

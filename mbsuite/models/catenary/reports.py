@@ -52,6 +52,8 @@ def to_simresult(run: CatenaryRun, scene) -> SimResult:
                                 "wires": {w: {k: v for k, v in d.items() if k != "loss_events"}
                                           for w, d in s.get("wires", {}).items()}}
                             for n, s in run.stats["windows"].items()}
+    if "insulators" in run.stats:  # the contact force at the line's section insulators
+        stats["insulators"] = run.stats["insulators"]
     statistics = {**_scalar_stats(run), "static_contact_force": run.static_force, "quality_pass": q["pass"],
                   **{f"quality_{k}_pass": r["pass"] for k, r in q["rows"].items()},
                   "quality_nq_pct": q["rows"]["arcing_nq"]["value"]}
@@ -144,6 +146,10 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
                                      "static_contact_force": r.static_force, "timing": r.timing} for r in runs}}
     if rng:
         data["all_inside_ranges"] = all(v["inside"] for v in run.ranges.values())
+    if any("insulators" in r.stats for r in runs):  # the contact force at the line's section insulators
+        lines += insulator_lines([(f"{r.dropper_law} droppers", r.stats) for r in runs])
+        for r in runs:
+            data["runs"][r.dropper_law]["insulators"] = r.stats.get("insulators", {})
     if "windows" in run.stats:  # further windows (a route: its sections alone and its overlaps)
         lines += window_lines(run, quality)
         data["overlaps"] = overlaps(run.params)
@@ -237,6 +243,24 @@ def window_lines(run: CatenaryRun, quality: QualityCriteria | None) -> list[str]
     return out
 
 
+def insulator_lines(runs: list[tuple[str, dict]]) -> list[str]:
+    """The table of the contact force at each section insulator on a contact wire (`stats.insulator_statistics`),
+    one row per run ((label, its statistics)) and insulator."""
+    rows = []
+    for label, stats in runs:
+        for name, d in stats.get("insulators", {}).items():
+            a, b = d["x_range"]
+            if not d["n_samples"]:
+                rows.append([label, name, f"{a:g} .. {b:g}", "0", *["-"] * 6])
+                continue
+            rows.append([label, name, f"{a:g} .. {b:g}", str(d["n_samples"]), f"{d['Fm']:.2f}", f"{d['max']:.2f}",
+                         f"{d['min']:.2f}", f"{d['raw_max']:.2f} / {d['raw_min']:.2f}", f"{d['loss_pct']:.1f}",
+                         str(d["n_losses"])])
+    return ["insulators: the contact force while the head is on each one (filtered at 20 Hz; raw: unfiltered):",
+            format_table(["run", "insulator", "x (m)", "samples", "Fm (N)", "max (N)", "min (N)",
+                                              "raw max / min (N)", "loss (%)", "losses"], rows)]
+
+
 def write_run_files(runs: list[CatenaryRun], out: Path) -> list[Path]:
     """Write each run's contact-force record (`contact_force_<pantograph>_<droppers>_<speed>kmh.csv`, SI units in
     the header) and the force/uplift figure of all of them (`force_uplift_<pantograph>_<speed>kmh.png`); return the
@@ -293,6 +317,8 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
                      f">20 ms: {c['power_loss_gt_20ms']})")
         if run.aerodynamics is not None:
             lines.append(f"{labels[k]}: {run.aerodynamics[k].describe()}")
+    if any("insulators" in s for s in run.stats):  # the contact force at the line's section insulators
+        lines += insulator_lines(list(zip(labels, run.stats, strict=True)))
     for w in run.warnings:
         lines.append(f"WARNING: {w}")
     data = {"speed_kmh": run.speed_kmh, "element_length": run.params.element_length, "timestep": run.dt,
@@ -303,7 +329,8 @@ def train_report(run: TrainRun, quality: QualityCriteria | None = None, scene_di
                              "statistics": {key: run.stats[k][key] for key in STAT_KEYS},
                              "uplift_at_supports_mm": run.stats[k]["uplift_at_supports_mm"],
                              "loss_events": run.stats[k]["loss_events"],
-                             "aerodynamics": None if run.aerodynamics is None else run.aerodynamics[k].as_dict()}
+                             "aerodynamics": None if run.aerodynamics is None else run.aerodynamics[k].as_dict(),
+                             **({"insulators": run.stats[k]["insulators"]} if "insulators" in run.stats[k] else {})}
                             for k in range(len(run.names))],
             "warnings": run.warnings}
     qs = []
@@ -354,6 +381,8 @@ def train_to_simresult(run: TrainRun, scene) -> SimResult:
                "head_height": lead.head, "wire_height": lead.wire, "slack_droppers": lead.n_slack.astype(float)}
     qs = train_assessments(run, criteria_from(scene.sections.get("quality")))
     stats = {"steps": run.timing["steps"], "cpu_s": run.timing["cpu_s"], "total_s": run.timing["total_s"]}
+    if any("insulators" in s for s in run.stats):  # per pantograph (p<k>) the contact force at the insulators
+        stats["insulators"] = {f"p{k + 1}": s.get("insulators", {}) for k, s in enumerate(run.stats)}
     statistics: dict[str, Any] = {}
     for k, s in enumerate(run.stats):
         statistics.update({f"p{k + 1}_{key}": s[key] for key in STAT_KEYS})

@@ -7,6 +7,8 @@
   duration as the thesis quotes Peters: short arcs < 5 ms, damaging 5-20 ms, power loss > 20 ms.
 - Uplift: the largest CW displacement from its static position at the steady arms inside the window (x = 240, 300,
   360 m), over the whole run.
+- Section insulators (`insulator_statistics`, only on a line with some on a contact wire): the filtered force's mean,
+  max and min and the unfiltered force's max, min and losses while the head is on each one.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from ...errors import SolverError
 from ...statistics import Statistic
+from .mesh import line_of
 from .params import CatenaryParams
 
 #: EN 50318:2002 accepted ranges (catenary.md), speed (km/h) -> statistic -> (low, high); units N, mm, %
@@ -183,3 +186,36 @@ def wire_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, on: np.ndar
             "x_last_contact": float(x[w][len(x[w]) - 1 - np.argmax(force[w][::-1] > 0.0)])
             if np.any(force[w] > 0.0) else None,
             "impulse_Ns": float(np.sum(force[w]) * dt)}
+
+
+def insulator_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, ff: np.ndarray, dt: float,
+                         p: CatenaryParams, wires: dict[str, dict[str, np.ndarray]] | None = None) -> dict[str, dict]:
+    """The contact force at each section insulator on a contact wire (`line.SectionInsulator`, model README "Section
+    insulators and point masses"), keyed "<wire>@<x>" (x its centre, "%g" m): over the samples whose head position x
+    lies on [x_a, x_b] (`x_range`), the mean, max and min of the 20 Hz filtered force `ff` (`Fm`, `max`, `min`), the
+    max and min of the unfiltered force (`raw_max`, `raw_min`), the share of those samples with zero unfiltered force
+    (`loss_pct`), the loss events there (`n_losses`) and `n_samples` (0, and None values, where the run does not pass
+    it). On a route (`wires`: each contact wire's own record) the insulator's own wire's force, filtered as the head's.
+    Empty for a line without insulators on its contact wires."""
+    line = line_of(p)
+    contact = {w.name for w in line.contacts}
+    out = {}
+    for s in line.insulators:
+        if s.wire not in contact:
+            continue
+        f, fl = force, ff
+        if wires and s.wire in wires:
+            f = wires[s.wire]["force"]
+            fl = lowpass(f, dt, p.filter_cutoff, p.filter_order)
+        on = (x >= s.xa) & (x <= s.xb)
+        d: dict = {"wire": s.wire, "x": s.x, "x_range": [s.xa, s.xb], "n_samples": int(on.sum())}
+        if on.any():
+            fo = fl[on]
+            events = loss_events(t[on], x[on], f[on], dt)
+            d.update({"Fm": float(fo.mean()), "max": float(fo.max()), "min": float(fo.min()),
+                      "raw_max": float(f[on].max()), "raw_min": float(f[on].min()),
+                      "loss_pct": float(100.0 * np.mean(f[on] <= 0.0)), "n_losses": len(events)})
+        else:
+            d.update(dict.fromkeys(("Fm", "max", "min", "raw_max", "raw_min", "loss_pct", "n_losses")))
+        out[f"{s.wire}@{s.x:g}"] = d
+    return out

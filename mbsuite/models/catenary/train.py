@@ -41,7 +41,7 @@ from .pantographs import build_train as build_pantographs
 from .params import CatenaryParams
 from .passage import CHECK_EVERY, CoupledResult, Passage, dropper_energy, irregularity_at, steps_to_cover
 from .sim import CoupledSimulation
-from .stats import en50318_statistics, supports_in_window, window_statistics
+from .stats import en50318_statistics, insulator_statistics, supports_in_window, window_statistics
 
 #: a steady arm's uplift is charged to a pantograph of a train while it is within this distance of it (m)
 UPLIFT_REACH = 30.0
@@ -335,6 +335,7 @@ def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -
         if p.windows:
             s["windows"] = window_statistics(res.t, res.x, res.force, ff, res.uplift, res.support_x, dt, p, names,
                                              res.wires)
+        _insulators(s, res, ff, dt, p)
         return s, ff
     sx, x = res.support_x, res.x
     names = names or [f"{xsup:g}" for xsup in sx]
@@ -348,7 +349,16 @@ def _statistics(res: CoupledResult, dt: float, p: CatenaryParams, alone: bool) -
     if p.windows:
         s["windows"] = window_statistics(res.t, x, res.force, ff, np.where(np.isfinite(up), up, 0.0), sx, dt, p,
                                          names, res.wires)
+    _insulators(s, res, ff, dt, p)
     return s, ff
+
+
+def _insulators(s: dict, res: CoupledResult, ff: np.ndarray, dt: float, p: CatenaryParams) -> None:
+    """The contact force at the line's section insulators (`stats.insulator_statistics`) in `s["insulators"]`, only
+    when the line has some on its contact wires."""
+    ins = insulator_statistics(res.t, res.x, res.force, ff, dt, p, res.wires)
+    if ins:
+        s["insulators"] = ins
 
 
 def simulate_train(p: CatenaryParams, speed_kmh: float, dt: float, pantographs: Sequence[str | Pantograph],

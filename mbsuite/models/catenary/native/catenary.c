@@ -562,11 +562,30 @@ static double beam_compliance(double a, double L, double T, double EI) {
   return s / T;
 }
 
-/* contact wire c's point-load defect at xi of element e (fe.PointCorrection.defect, same order of operations) */
+/* contact wire c's point-load defect at xi of element e (fe.PointCorrection.defect, same order of operations); an
+ * entry with L < 0 is tabulated (a wire stiffened by insulators): its 13 samples at xi = j/12 in its Q slots,
+ * Lagrange-interpolated (point_correction.lagrange, SAMPLES = 13) */
 static double point_defect(const cat_job* J, int c, int e, double xi) {
   const int k = J->esig[(long)(J->nnode - 1) * c + e];
   const double a0 = J->pref[3 * k], L = J->pref[3 * k + 1], h = J->pref[3 * k + 2];
   if (L == 0.0) return 0.0;
+  if (L < 0.0) {
+    enum { NS = 13 };
+    const double* s = J->pq + 16 * k;
+    const double t = xi * (NS - 1);
+    double q = 0.0;
+    for (int j = 0; j < NS; j++) {
+      double p = 1.0, den = 1.0;
+      for (int m = 0; m < NS; m++) {
+        if (m != j) {
+          p *= t - (double)m;
+          den *= (double)(j - m);
+        }
+      }
+      q += s[j] * (p / den);
+    }
+    return q;
+  }
   const double x2 = xi * xi, x3 = x2 * xi;
   const double N[4] = {1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)};
   const double* Q = J->pq + 16 * k;

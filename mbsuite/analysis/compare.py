@@ -44,6 +44,8 @@ AXES = ("x", "position", "t")
 #: the axes in words
 AXIS_WORDS = {"x": "position along the line", "position": "position along the line", "t": "time",
               "f": "forcing frequency"}
+#: a first value at most this fraction of its row's largest magnitude is zero: no relative difference to it
+NEAR_ZERO = 1e-9
 #: at most this many signal panels in one figure
 MAX_PANELS = 12
 
@@ -293,7 +295,8 @@ def compare(args: Sequence[str | Path], *, units_for: Callable[[str], Mapping[st
     table = comparison_text(summaries, heads, rows, only, plan, missing)
     data = {"kind": first.kind,
             "summaries": [{"label": s.label, "path": str(s.path), "command": s.command,
-                           "scene": f"{s.scene.get('model')}/{s.scene.get('name')}" if s.scene else None}
+                           "scene": f"{s.scene.get('model')}/{s.scene.get('name')}" if s.scene else None,
+                           "ran": scene_label(s.scene)}
                           for s in summaries],
             "scene_differences": scene_differences(summaries),
             "headlines": [{"name": r["name"], "unit": r["unit"], "values": r["values"],
@@ -308,14 +311,17 @@ def compare(args: Sequence[str | Path], *, units_for: Callable[[str], Mapping[st
 
 def headline_rows(summaries: Sequence[Summary], names: Sequence[str]) -> tuple[list[dict[str, Any]], list[str]]:
     """Each headline's values (None where a summary lacks it), its unit, its differences to the first and those
-    relative to the first's magnitude; and the table's column heads."""
+    relative to the first's magnitude (None where the first is near zero, |first| <= `NEAR_ZERO` x the largest
+    magnitude of the row: the difference alone tells); and the table's column heads."""
     rows = []
     for n in names:
         vals = [s.headlines[n][0] if n in s.headlines else None for s in summaries]
         unit = next(s.headlines[n][1] for s in summaries if n in s.headlines)
         a = vals[0]
         diffs = [None if a is None or v is None else v - a for v in vals[1:]]
-        rel = [None if d is None or a == 0 else d / abs(a) for d in diffs]
+        scale = max((abs(v) for v in vals if v is not None), default=0.0)
+        near_zero = a is not None and abs(a) <= NEAR_ZERO * scale  # 0, or rounding noise beside the others
+        rel = [None if d is None or near_zero else d / abs(a) for d in diffs]
         rows.append({"name": n, "unit": unit, "values": vals, "differences": diffs, "relative": rel})
     first = summaries[0].label
     heads = (["headline", "unit", *[s.label for s in summaries]]
@@ -324,11 +330,36 @@ def headline_rows(summaries: Sequence[Summary], names: Sequence[str]) -> tuple[l
     return rows, heads
 
 
+def scene_label(scene: Mapping[str, Any] | None) -> str:
+    """What a summary ran, in words: "scene MODEL/NAME"; a line file run on its own (the command given the file: a
+    scene named after its stem with `[line] file` naming it): "line file PATH (MODEL)"; a scene with a line file of
+    another name: "scene MODEL/NAME, line file PATH"; "no scene"."""
+    if not scene:
+        return "no scene"
+    line = scene.get("line")
+    named = f"scene {scene.get('model')}/{scene.get('name')}"
+    if isinstance(line, Mapping) and isinstance(line.get("file"), str):
+        if Path(line["file"]).stem == scene.get("name"):
+            return f"line file {line['file']} ({scene.get('model')})"
+        return f"{named}, line file {line['file']}"
+    return named
+
+
+def _informative(model: str | None) -> tuple[str, ...]:
+    """The scene keys `model` declares informative (`ModelSpec.extra["informative"]`); () for an unknown model."""
+    from ..registry import models
+
+    spec = models().get(model) if model else None
+    return tuple(spec.extra.get("informative", ())) if spec is not None else ()
+
+
 def scene_differences(summaries: Sequence[Summary]) -> dict[str, list[Any]]:
     """The scene entries (dotted keys) whose values differ between the summaries: what the runs were run with (a
-    parameter a scene leaves unset taken at its model's default; None where a scene has no such entry)."""
+    parameter a scene leaves unset taken at its model's default; None where a scene has no such entry); not the keys
+    a model declares informative (`ModelSpec.extra["informative"]`: a catenary passage's `solver.duration`)."""
     flat = [_flat_scene(s.scene or {}) for s in summaries]
-    keys = list(dict.fromkeys(k for f in flat for k in f))
+    skip = {k for s in summaries for k in _informative(s.scene.get("model") if s.scene else None)}
+    keys = [k for k in dict.fromkeys(k for f in flat for k in f) if k not in skip]
     for s, f in zip(summaries, flat, strict=True):
         defaults = _param_defaults(s.scene.get("model") if s.scene else None)
         for k in keys:
@@ -376,7 +407,7 @@ def comparison_text(summaries: Sequence[Summary], heads: list[str], rows: list[d
 
     lines = [f"compare: {len(summaries)} `{summaries[0].kind}` summaries, differences to {summaries[0].label}"]
     for s in summaries:
-        scene = f"scene {s.scene.get('model')}/{s.scene.get('name')}" if s.scene else "no scene"
+        scene = scene_label(s.scene)
         lines.append(textwrap.fill(f"{s.label} = {s.path}: {s.command or 'written from Python'} ({scene})", 100,
                                    subsequent_indent="    "))
     diff = scene_differences(summaries)

@@ -169,6 +169,40 @@ def headline_units(scene: Scene | None) -> dict[str, str]:
     return {h.name: h.unit for h in declared(scene)}
 
 
+def factor_unit(scene: Scene | None, factor: Factor) -> str:
+    """The SI unit the scene's model declares for the varied key (`key_unit`)."""
+    return key_unit(scene, factor.label)
+
+
+def key_unit(scene: Scene | None, label: str) -> str:
+    """The SI unit the scene's model declares for the scene key `label` = "section.key" (`param(..., unit=...)` of
+    its parameters, an input type's or the solver's `Limit`, a key of a model section's `schema.Section`, dotted into
+    it); "" where none is declared (no scene, an undeclared key, a dimensionless "-")."""
+    if scene is None:
+        return ""
+    import dataclasses
+
+    from ..limits import limit_of
+    from ..scene_schema import section_of
+    from ..settings import SOLVER_LIMITS
+
+    spec = scene.spec
+    section, _, key = label.partition(".")
+    lim: Any = None
+    if section == "params" and key in {f.name for f in dataclasses.fields(spec.params_cls)}:
+        lim = limit_of(spec.params_cls, key)
+    elif section == "input":
+        lim = (spec.inputs.get(scene.input.get("type"), {}) or {}).get(key)
+    elif section == "solver":
+        lim = SOLVER_LIMITS.get(key)
+    elif section in spec.sections:
+        lim = section_of(spec.sections[section])
+        for part in key.split("."):
+            lim = getattr(lim, "keys", {}).get(part) if lim is not None else None
+    unit = getattr(lim, "unit", "") or ""
+    return "" if unit == "-" else unit
+
+
 def evaluate(fn: Callable[[dict[str, Any]], Mapping[str, Any]], points: Sequence[dict[str, Any]], *,
              scene: Scene | None = None, workers: int = 0, options: SweepOptions | None = None,
              progress: bool | None = None, desc: str = "study") -> list[dict[str, float]]:

@@ -43,7 +43,7 @@ from ..engines.core import n_workers
 from ..errors import MbsuiteError
 from ..limits import Limit, real
 from ..progress import planned
-from .designspace import Factor, evaluate, factors_for, headline_units, point_scene, scene_evaluator
+from .designspace import Factor, evaluate, factors_for, headline_units, key_unit, point_scene, scene_evaluator
 
 if TYPE_CHECKING:
     from ..results import Report
@@ -164,6 +164,8 @@ class OptimiseResult:
     target: str = ""
     start: dict[str, Any] | None = None
     rerun: dict[str, Any] | None = None
+    #: factor or operating-point key ("section.key") -> the SI unit it declares (`designspace.key_unit`)
+    key_units: dict[str, str] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """Inputs, seed, settings, the optimum and every evaluation as JSON-able data."""
@@ -171,7 +173,8 @@ class OptimiseResult:
 
         return to_jsonable({
             "target": self.target, "objective": self.objective, "aggregate": self.aggregate, "seed": self.seed,
-            "factors": [{"name": f.label, "lo": f.lo, "hi": f.hi} for f in self.factors],
+            "factors": [{"name": f.label, "lo": f.lo, "hi": f.hi, "unit": self.key_units.get(f.label, "")}
+                        for f in self.factors],
             "constraints": [c.text() for c in self.constraints], "operating_points": self.contexts,
             "settings": self.settings, "best": self.best, "value": self.value, "feasible": self.feasible,
             "best_outputs": self.best_outputs, "start": self.start, "message": self.message,
@@ -189,8 +192,8 @@ class OptimiseResult:
         lines = [f"minimise {agg}{self.objective} of {self.target or 'the target'} over {len(self.factors)} factors; "
                  + (f"subject to {'; '.join(c.text() for c in self.constraints)}; " if self.constraints else "")
                  + f"{len(self.evaluations)} evaluations, seed {self.seed}",
-                 format_table(["factor", "lo", "hi", "optimum"] + (["start"] if self.start else []),
-                              [[f.label, f.lo, f.hi, self.best[f.label]]
+                 format_table(["factor", "unit", "lo", "hi", "optimum"] + (["start"] if self.start else []),
+                              [[f.label, self.key_units.get(f.label, "") or "-", f.lo, f.hi, self.best[f.label]]
                                + ([self.start["design"].get(f.label, "")] if self.start else [])
                                for f in self.factors], ".5g"),
                  f"objective {self.value:.5g}{u} ({'meets' if self.feasible else 'VIOLATES'} the constraints)"]
@@ -201,7 +204,9 @@ class OptimiseResult:
             rows.append([where, "optimum", *[self.best_outputs[i].get(h, float("nan")) for h in heads]])
             if self.start:
                 rows.append([where, "start", *[self.start["outputs"][i].get(h, float("nan")) for h in heads]])
-        lines.append(format_table(["operating point", "design", *heads], rows, ".5g"))
+        lines.append(format_table(["operating point", "design",
+                                   *(f"{h} [{self.units[h]}]" if self.units.get(h) else h for h in heads)], rows,
+                                  ".5g"))
         if self.rerun:
             lines.append(self.rerun.get("table", ""))
         return "\n\n".join(x for x in lines if x)
@@ -223,8 +228,8 @@ class OptimiseResult:
         keys = sorted({k for e in ev for k in e["outputs"]})
         ctx_keys = sorted({k for e in ev for k in e["context"]})
         cols = [("evaluation", "", list(range(len(ev))))]
-        cols += [(f.label, "", [e["design"][f.label] for e in ev]) for f in self.factors]
-        cols += [(k, "", [e["context"].get(k, "") for e in ev]) for k in ctx_keys]
+        cols += [(f.label, self.key_units.get(f.label, ""), [e["design"][f.label] for e in ev]) for f in self.factors]
+        cols += [(k, self.key_units.get(k, ""), [e["context"].get(k, "") for e in ev]) for k in ctx_keys]
         cols += [(k, self.units.get(k, ""), [e["outputs"].get(k, float("nan")) for e in ev]) for k in keys]
         cols += [("violation", "", [e["violation"] for e in ev]), ("penalised", "", [e["penalised"] for e in ev])]
         fig, axs = figure(1, 1, size=(7.0, 3.2), squeeze=False)
@@ -374,19 +379,28 @@ def plan(n_factors: int, n_contexts: int, maxiter: int, popsize: int, start: boo
          ) -> tuple[str, int, int]:
     """(what, runs at most, in parallel) of an optimisation (`levels` of them: a Pareto front), for
     `mbsuite.progress.planned`: scipy's population max(5, popsize x factors), maxiter + 1 generations, each design
-    at every operating point, plus the start design."""
+    at every operating point. The start design (`start`) adds none: it is a member of the first generation (scipy's
+    `x0`), run once, so the plan's count is the evaluations' count when no generation stops early."""
     npop = max(5, popsize * n_factors)
-    runs = levels * ((maxiter + 1) * npop + int(start)) * n_contexts
+    runs = levels * (maxiter + 1) * npop * n_contexts
     return ("optimise" if levels == 1 else f"pareto front ({levels} optimisations)"), runs, min(
         n_workers(workers), npop * n_contexts)
 
 
 def cheaper(n_factors: int, n_contexts: int, popsize: int, start: bool, levels: int = 1) -> Callable[[int], str | None]:
-    """The `--maxiter` of an optimisation that fits in a number of runs (None if not even one generation fits)."""
+    """The setting of an optimisation that fits in a number of runs (`plan`'s count; the budget's check computes
+    that number from the first run's measured time): a smaller `--maxiter` of the same population; where not even
+    `--maxiter 1` (two generations) fits, the largest `--popsize` (at least 2) whose two generations fit, with
+    `--maxiter 1`; None if not even that fits (`start` is in the first generation: no run of its own)."""
     def fit(runs: int) -> str | None:
         npop = max(5, popsize * n_factors)
-        k = runs // (levels * n_contexts) - int(start)
-        return f"--maxiter {k // npop - 1}" if k // npop - 1 >= 1 else None
+        k = runs // (levels * n_contexts)  # designs that fit
+        if k // npop - 1 >= 1:
+            return f"--maxiter {k // npop - 1}"
+        smaller = (k // 2) // n_factors
+        if smaller >= 2 and max(5, smaller * n_factors) * 2 <= k:
+            return f"--popsize {smaller} --maxiter 1"
+        return None
 
     return fit
 
@@ -415,7 +429,9 @@ def _minimise(prob: _Problem, facs: list[Factor], cons: list[Bound], ctxs: list[
                           {"method": "scipy.optimize.differential_evolution", "maxiter": maxiter,
                            "popsize": popsize, "tol": tol, "penalty": penalty, "generations": int(res.nit),
                            "polish": False, "updating": "deferred"},
-                          str(res.message), units, scene.name if scene is not None else _name(fn), start_rec)
+                          str(res.message), units, scene.name if scene is not None else _name(fn), start_rec,
+                          key_units={k: u for k in [*(f.label for f in facs), *{k for c in ctxs for k in c}]
+                                     if (u := key_unit(scene, k))})
 
 
 def _default(scene: Scene | None, what: str, value: str | None) -> str:
@@ -578,10 +594,12 @@ class ParetoResult:
         cols = [(self.against, self.units.get(self.against, ""), [p["outputs"][self.against] for p in self.front]),
                 (self.objective, self.units.get(self.objective, ""),
                  [p["outputs"][self.objective] for p in self.front])]
-        cols += [(k, "", [p["design"][k] for p in self.front]) for k in labels]
+        ku = self.runs[0].key_units
+        cols += [(k, ku.get(k, ""), [p["design"][k] for p in self.front]) for k in labels]
         ev = self.evaluations()
-        ecols = [(k, "", [e["design"][k] for e in ev]) for k in labels]
-        ecols += [(k, "", [e["context"].get(k, "") for e in ev]) for k in sorted({k for e in ev for k in e["context"]})]
+        ecols = [(k, ku.get(k, ""), [e["design"][k] for e in ev]) for k in labels]
+        ecols += [(k, ku.get(k, ""), [e["context"].get(k, "") for e in ev])
+                  for k in sorted({k for e in ev for k in e["context"]})]
         ecols += [(k, self.units.get(k, ""), [e["outputs"].get(k, float("nan")) for e in ev])
                   for k in sorted({k for e in ev for k in e["outputs"]})]
         ecols += [("violation", "", [e["violation"] for e in ev])]

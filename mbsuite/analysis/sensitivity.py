@@ -30,7 +30,15 @@ from ..engines.core import n_workers
 from ..errors import MbsuiteError
 from ..limits import Limit
 from ..progress import planned
-from .designspace import Factor, evaluate, factors_for, headline_units, output_names, scene_evaluator
+from .designspace import (
+    Factor,
+    evaluate,
+    factor_unit,
+    factors_for,
+    headline_units,
+    output_names,
+    scene_evaluator,
+)
 
 if TYPE_CHECKING:
     from ..results import Report
@@ -85,6 +93,8 @@ class SensitivityResult:
     indices: dict[str, dict[str, list[float]]]
     units: dict[str, str] = field(default_factory=dict)
     target: str = ""
+    #: factor label -> the SI unit its key declares (`designspace.factor_unit`; absent: none declared)
+    factor_units: dict[str, str] = field(default_factory=dict)
 
     @property
     def key(self) -> str:
@@ -103,7 +113,8 @@ class SensitivityResult:
         """Inputs, seed, indices, rankings and every evaluation as JSON-able data."""
         return {"method": self.method, "target": self.target, "n": self.n, "seed": self.seed, "levels": self.levels,
                 "conf_level": self.conf_level, "evaluations_count": len(self.evaluations),
-                "factors": [{"name": f.label, "lo": f.lo, "hi": f.hi} for f in self.factors],
+                "factors": [{"name": f.label, "lo": f.lo, "hi": f.hi, "unit": self.factor_units.get(f.label, "")}
+                            for f in self.factors],
                 "outputs": self.outputs, "units": self.units, "indices": self.indices,
                 "ranking": {o: self.ranking(o) for o in self.outputs},
                 "evaluations": [{"point": dict(zip([f.label for f in self.factors], map(float, x), strict=True)),
@@ -120,7 +131,7 @@ class SensitivityResult:
         for o in self.outputs:
             unit = self.units.get(o, "")
             if self.method == "morris":
-                head = ["rank", "factor", f"mu* [{unit}]" if unit else "mu*", "+-", "mu", "sigma"]
+                head = ["rank", "factor", *(f"{h} [{unit}]" if unit else h for h in ("mu*", "+-", "mu", "sigma"))]
                 rows = [[i + 1, r["factor"], r["mu_star"], r["mu_star_conf"], r["mu"], r["sigma"]]
                         for i, r in enumerate(self.ranking(o))]
             else:
@@ -138,18 +149,21 @@ class SensitivityResult:
         return Report(self.to_dict(), self.table(), self.write)
 
     def write(self, out: str | Path) -> list[Path]:
-        """`sensitivity.csv` (one row per output and factor, ranked), `evaluations.csv` (every point and its
-        outputs) and `sensitivity.png` under `out`."""
+        """`sensitivity.csv` (one row per output and factor, ranked; its `unit` the unit of the row's morris indices,
+        the output's, "-" for sobol's fractions of variance), `evaluations.csv` (every point and its outputs, the
+        header `name [unit]`) and `sensitivity.png` under `out`."""
         from ..plotting import save
         from ..results import write_csv
 
         out = Path(out)
         rows = [(o, i + 1, r) for o in self.outputs for i, r in enumerate(self.ranking(o))]
         names = list(self.indices[self.outputs[0]]) if self.outputs else []
-        cols = [("output", "", [o for o, _, _ in rows]), ("rank", "", [k for _, k, _ in rows]),
+        cols = [("output", "", [o for o, _, _ in rows]),
+                ("unit", "", [self.units.get(o, "") if self.method == "morris" else "-" for o, _, _ in rows]),
+                ("rank", "", [k for _, k, _ in rows]),
                 ("factor", "", [r["factor"] for _, _, r in rows])]
         cols += [(n, "", [r[n] for _, _, r in rows]) for n in names]
-        ev = [(f.label, "", self.samples[:, j]) for j, f in enumerate(self.factors)]
+        ev = [(f.label, self.factor_units.get(f.label, ""), self.samples[:, j]) for j, f in enumerate(self.factors)]
         ev += [(o, self.units.get(o, ""), [e.get(o, float("nan")) for e in self.evaluations])
                for o in sorted({k for e in self.evaluations for k in e})]
         return [write_csv(out / "sensitivity.csv", cols), write_csv(out / "evaluations.csv", ev),
@@ -284,7 +298,8 @@ def run(target: Scene | Callable[[dict[str, Any]], Mapping[str, Any]], factors: 
         indices[o] = analyse(method, facs, x, y, seed=seed, levels=levels, conf_level=conf_level)
     what = scene.name if scene is not None else getattr(fn, "__name__", None) or getattr(
         getattr(fn, "func", None), "__name__", "function")
-    return SensitivityResult(method, facs, n, seed, levels, conf_level, names, x, results, indices, units, what)
+    return SensitivityResult(method, facs, n, seed, levels, conf_level, names, x, results, indices, units, what,
+                             {f.label: u for f in facs if (u := factor_unit(scene, f))})
 
 
 __all__ = ["ISHIGAMI_FACTORS", "METHODS", "SensitivityResult", "analyse", "ishigami", "ishigami_indices", "run",

@@ -6,11 +6,15 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tomllib
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 
 import matplotlib
+import numpy as np
 import pytest
+from matplotlib.collections import PathCollection
 from matplotlib.figure import Figure
 
 from mbsuite.cli import main as cli_main
@@ -25,11 +29,20 @@ from mbsuite.models.catenary.marks import (
 )
 from mbsuite.models.catenary.mesh import line_of
 from mbsuite.models.catenary.params import CatenaryParams
-from mbsuite.models.catenary.plots import SUPPORT_STYLE, draw_line_marks
+from mbsuite.models.catenary.passage import CoupledResult
+from mbsuite.models.catenary.plots import (
+    SUPPORT_STYLE,
+    WIRE_COLOURS,
+    draw_line_marks,
+    force_uplift_figure,
+    marks_legend,
+    train_figure,
+)
 from mbsuite.scenes import load_scene, scene_from_dict
 
 matplotlib.use("Agg")
 LINES = Path(__file__).resolve().parents[2] / "mbsuite" / "models" / "catenary" / "lines"
+SCENES = LINES.parent / "scenes"
 SPAN, N = 55.0, 8
 DROPS = (5.0, 15.0, 27.5, 40.0, 50.0)
 
@@ -56,7 +69,7 @@ def test_marks_are_the_reference_lines_supports_and_droppers():
     m = line_marks(line_of(p), (p.x_start, p.x_end))
     assert m["supports"] == [60.0 * k for k in range(8)]
     assert m["droppers"] == [60.0 * s + d for s in range(7) for d in p.dropper_positions]
-    assert m["stitch"] == []
+    assert m["stitch"] == [] and m["overlaps"] == [] and m["anchors"] == []  # its ends at 0 and 420 m: the line's
     assert line_label(p) == REFERENCE_LINE
     assert line_label(CatenaryParams(n_spans=14)) == "EN 50318 line of 14 spans"
     assert line_label(CatenaryParams(span_length=55.0, n_spans=8, x_end=400, dropper_positions=list(DROPS))) == (
@@ -84,6 +97,89 @@ def test_marks_of_stitch_wires_are_the_lines_own():
     assert m["supports"] == [0.0, 55.0, 115.0, 178.0]
     assert m["stitch"] == [(47.0, 63.0), (107.0, 123.0), (170.0, 186.0)]
     assert m["droppers"] == sorted({d.x for d in line.droppers if d.x <= 200.0})
+
+
+def _overlap_scene() -> tuple[CatenaryParams, float, float, float]:
+    """The overlap scene's params and, from its declared geometry ([line.overlap] spans, overlap_spans; the spans of
+    [params] span_length, default 60 m), A's end, B's start and B's end (m)."""
+    o = tomllib.loads((SCENES / "en50318_overlap.toml").read_text())["line"]["overlap"]
+    p = load_scene("catenary/en50318_overlap").build_params()
+    L = p.span_length
+    a_end, b_start = o["spans"] * L, (o["spans"] - o["overlap_spans"]) * L
+    return p, a_end, b_start, b_start + o["spans"] * L
+
+
+def test_marks_of_an_overlap_are_its_shared_spans_and_anchors():
+    """The overlap scene: section A over `spans` spans from 0, B over as many from the start of A's last
+    `overlap_spans` (the scene's [line.overlap]): the overlap [300, 480] m where both contact wires are, the anchors
+    B's start (300 m) and A's end (480 m); the line's own ends (0, B's end) are none; a stretch clips them."""
+    p, a_end, b_start, b_end = _overlap_scene()
+    assert (b_start, a_end) == (300.0, 480.0)
+    line = line_of(p)
+    m = line_marks(line, (p.x_start, p.x_end))
+    assert m["overlaps"] == [(b_start, a_end)]
+    assert m["anchors"] == [(b_start, "contact_b"), (a_end, "contact_a")]
+    assert line_marks(line)["anchors"] == m["anchors"]  # not B's end at the line's end (780 m)
+    assert line.length == b_end
+    part = line_marks(line, (0.0, 400.0))
+    assert part["overlaps"] == [(b_start, 400.0)] and part["anchors"] == [(b_start, "contact_b")]
+    assert line_marks(line, (500.0, 700.0))["overlaps"] == []
+    assert marks_legend("x", m).replace("\n", " ") == (
+        "x [m] (grey lines: supports; brown ticks: droppers; cyan hatching: overlap of two contact wires; triangles: "
+        "anchors, contact_b at 300 m, contact_a at 480 m)")
+    # the legend names only the marks present: no stitch wires on the reference line
+    ref = line_marks(line_of(CatenaryParams()))
+    assert marks_legend("x", ref) == "x [m] (grey lines: supports; brown ticks: droppers)"
+
+
+def _route_run(p: CatenaryParams, law: str = "slack") -> SimpleNamespace:
+    """A made-up passage through the overlap scene's line (the figure needs only its records): a steady arm of
+    each contact wire at every support its x-range holds, named as `fe.arm_names` names them."""
+    line = line_of(p)
+    x = np.linspace(p.x_start, p.x_end, 721)
+    arms = [(s.x, w.name) for s in line.supports for w in line.contacts if w.x0 <= s.x <= w.x1]
+    names = [f"{xs:g}_{w}" if sum(a == xs for a, _ in arms) > 1 else f"{xs:g}" for xs, w in arms]
+    wires = {w.name: {"force": np.full_like(x, 50.0), "wire": np.full_like(x, 0.05),
+                      "on": (x >= w.x0) & (x <= w.x1)} for w in line.contacts}
+    z = np.zeros_like(x)
+    res = CoupledResult(t=x / 70.0, x=x, force=z + 100.0, head=z, wire=z + 0.05, uplift=np.zeros((x.size, len(arms))),
+                        n_slack=z, panto={}, support_x=np.array([a for a, _ in arms]), wires=wires,
+                        support_names=names)
+    return SimpleNamespace(params=p, result=res, filtered=res.force, dropper_law=law, is_reference=False,
+                           engine="reference", pantograph="reference2mass", speed_kmh=250.0)
+
+
+def test_the_force_figure_through_an_overlap_colours_each_wire_and_marks_the_overlap():
+    """Each contact wire in its own colour (its force, its height, the uplift at its steady arms), the head's summed
+    force in the dropper law's; the uplift legend "steady arm at 360 m (contact_a)"; no line at an anchor (pinned:
+    no uplift); the overlap hatched and labelled, the anchors as triangles, all named in the x-axis label."""
+    p, a_end, b_start, _ = _overlap_scene()
+    fig = force_uplift_figure([_route_run(p)])
+    ax_f, ax_h, ax_u = fig.axes
+    colour = {"contact_a": WIRE_COLOURS[0], "contact_b": WIRE_COLOURS[1]}
+    lines = {ln.get_label(): ln.get_color() for ax in fig.axes for ln in ax.lines
+             if not ln.get_label().startswith("_")}
+    assert lines["slack droppers: F on contact_a, unfiltered"] == colour["contact_a"]
+    assert lines["slack droppers: contact_b"] == colour["contact_b"]
+    assert lines["slack droppers: F (sum over the contact wires), 20 Hz low-pass"] == "tab:blue"
+    uplift = [ln.get_label() for ln in ax_u.lines if not ln.get_label().startswith("_")]
+    window = (300.0, 360.0, 420.0, 480.0)  # the supports of the window [300, 480] m
+    assert uplift == [f"slack droppers: steady arm at {xs:g} m ({w})" for xs in window
+                      for w in ("contact_a", "contact_b") if (xs, w) not in {(b_start, "contact_b"),
+                                                                             (a_end, "contact_a")}]
+    assert lines["slack droppers: steady arm at 360 m (contact_b)"] == colour["contact_b"]
+    assert "overlap" in [t.get_text() for t in ax_f.texts]
+    assert "triangles: anchors, contact_b at 300 m, contact_a at 480 m" in ax_u.get_xlabel().replace("\n", " ")
+    assert "stitch" not in ax_u.get_xlabel()
+    for ax in (ax_f, ax_h, ax_u):  # the overlap: one hatched span; the anchors: two triangles
+        assert [pt.get_hatch() for pt in ax.patches].count("//") == 1
+        assert sorted(float(c.get_offsets()[0][0]) for c in ax.collections if isinstance(c, PathCollection)) == [
+            b_start, a_end]
+    run = SimpleNamespace(params=p, results=[_route_run(p).result] * 2, filtered=[np.zeros(721)] * 2,
+                          names=["a", "b"], speed_kmh=250.0)
+    tf = train_figure(run, ["a", "b"])
+    assert "cyan hatching: overlap" in tf.axes[1].get_xlabel()
+    assert "overlap" in [t.get_text() for t in tf.axes[0].texts]
 
 
 def test_the_default_window_follows_the_lines_supports(tmp_path):

@@ -117,3 +117,31 @@ def test_summaries_of_different_kinds_or_without_common_headlines_are_refused(pa
     assert main(["compare", str(a), str(tmp_path / "nosuch")]) == 2 and "nosuch" in capsys.readouterr().err
     assert main(["compare", str(a), str(b), "--out", str(b)]) == 2
     assert "overwrite" in capsys.readouterr().err
+
+
+def test_informative_keys_near_zero_references_and_a_line_file_are_read_as_such(passages, tmp_path, capsys):
+    """A catenary passage's `solver.duration` (informative: it runs from x_start to x_end) is no scene difference; a
+    first value near zero (|A| <= 1e-9 of the row's magnitude) has the absolute difference and no relative one (no
+    huge %); a run of a line file alone reads "line file PATH", not "scene catenary/<stem>"."""
+    a, b = passages
+    copies = []
+    for src, name, loss in ((a, "ra", 1e-15), (b, "rb", 0.5)):
+        dst = tmp_path / name
+        shutil.copytree(src, dst)
+        s = json.loads((dst / "summary.json").read_text())
+        s["scene"]["solver"]["duration"] = 6.1 if name == "ra" else 10.4
+        s["results"]["runs"]["slack"]["statistics"]["loss_pct"] = loss
+        if name == "rb":
+            s["scene"]["name"] = "mine"
+            s["scene"]["line"] = {"file": "/lines/mine.toml", "kind": "file"}
+        (dst / "summary.json").write_text(json.dumps(s))
+        copies.append(dst)
+    assert main(["compare", *map(str, copies), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert "solver.duration" not in data["scene_differences"] and "input.speed" in data["scene_differences"]
+    loss = next(h for h in data["headlines"] if h["name"] == "slack.loss_pct")
+    assert loss["differences"] == [0.5 - 1e-15] and loss["relative"] == [None]
+    assert [s["ran"] for s in data["summaries"]] == ["scene catenary/en50318", "line file /lines/mine.toml (catenary)"]
+    assert main(["compare", *map(str, copies)]) == 0
+    text = capsys.readouterr().out
+    assert "(line file /lines/mine.toml (catenary))" in text and "solver.duration" not in text

@@ -155,3 +155,21 @@ def test_docstring_examples_run(module):
     res = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
                           verbose=False, report=True)
     assert res.attempted > 0 and res.failed == 0, f"{module}: {res.failed} of {res.attempted} examples failed"
+
+
+README_REF = re.compile(r"README ((?:'[^']+'(?:, )?)+)")
+
+
+def test_command_help_names_sections_of_its_model_readme():
+    """A command's help that points to its model README ("model README 'Lines of your own', 'A line in a file'")
+    names a heading (the start of a `#` line) or a bold paragraph title (`**...`) of that README."""
+    refs = 0
+    for cli in sorted((ROOT / "mbsuite" / "models").glob("*/cli.py")):
+        readme = (cli.parent / "README.md").read_text()
+        titles = [ln.lstrip("#").strip() for ln in readme.splitlines() if ln.startswith("#")]
+        titles += re.findall(r"^\*\*([^*]+)", readme, re.M)
+        for group in README_REF.findall(cli.read_text()):
+            for name in re.findall(r"'([^']+)'", group):
+                refs += 1
+                assert any(t.startswith(name) for t in titles), f"{cli.relative_to(ROOT)}: README section {name!r}"
+    assert refs

@@ -54,6 +54,33 @@ def test_optimise_plan_counts_scipy_generations_and_reports_every_evaluation():
     assert len(res.evaluations) <= runs
 
 
+def test_optimise_plan_counts_the_start_design_in_the_first_generation():
+    """A start design is scipy's x0, a member of the first generation run once: the plan's count is the evaluations'
+    (no "up to 13 runs" for 12 evaluations)."""
+    out = io.StringIO()
+    with progress.study("optimise", stream=out, bar=False):
+        res = optimise.run(_square, ["x.a=0:1", "x.b=0:1"], objective="y", maxiter=1, popsize=3, tol=1e-12,
+                           workers=1, start={"x.a": 0.5, "x.b": 0.5})
+    assert len(res.evaluations) == 12 == optimise.plan(2, 1, 1, 3, True, 1)[1]  # 2 generations of 6 designs
+    assert _lines(out)[0].startswith("mbsuite optimise: up to 12 runs")
+    assert res.table().splitlines()[0].endswith("12 evaluations, seed 0")
+
+
+def test_over_budget_in_the_first_generation_names_a_smaller_popsize():
+    """2 factors, popsize 20: 40 designs a generation, 80 for --maxiter 1; a budget of 24 runs (measured: the first
+    run 2.5 s, 60 s) fits two generations of 12 designs: --popsize 6 --maxiter 1."""
+    plan = progress.Plan("optimise", 840, 1, upto=True, cheaper=optimise.cheaper(2, 1, 20, True))
+    st = progress.Study("optimise", budget=60.0, stream=io.StringIO(), bar=False)
+    st.start(plan)
+    progress_time = plan.started + 2.5
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(progress.time, "perf_counter", lambda: progress_time)
+        with pytest.raises(progress.OverBudget) as exc:
+            st.update(1)
+    assert "a cheaper study: --popsize 6 --maxiter 1" in str(exc.value)
+    assert optimise.cheaper(2, 1, 20, True)(9) is None  # not even two generations of 5 designs
+
+
 def test_sensitivity_plan_is_the_sample_size():
     out = io.StringIO()
     with progress.study("sensitivity", stream=out, bar=False) as st:

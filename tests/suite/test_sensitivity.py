@@ -110,7 +110,7 @@ def test_catenary_morris_end_to_end_on_a_short_line(tmp_path):
     for name in ("sensitivity.csv", "evaluations.csv", "sensitivity.png"):
         assert (out / name).stat().st_size > 0
     head = (out / "evaluations.csv").read_text().splitlines()[0]
-    assert head.startswith("params.F0,params.c2,") and "Fm [N]" in head
+    assert head.startswith("params.F0 [N],params.c2 [N s/m],") and "Fm [N]" in head
 
 
 @pytest.mark.parametrize(("vary", "words"), [

@@ -197,7 +197,9 @@ def test_optimise_table_csv_and_json_equal_the_result_and_the_hand_numbers(tmp_p
     assert blocks[0].startswith("minimise the worst over 2 operating points of f of surface over 2 factors; "
                                 "subject to g <= 4; -1 <= h; ")
     assert blocks[0].endswith(f"{len(res.evaluations)} evaluations, seed 4")
-    design = {r[0]: [float(v) for v in r[1:]] for r in _rows(blocks[1])}
+    assert blocks[1].splitlines()[0].split()[:2] == ["factor", "unit"]
+    assert {r[1] for r in _rows(blocks[1])} == {"-"}  # a function's factors declare no unit
+    design = {r[0]: [float(v) for v in r[2:]] for r in _rows(blocks[1])}
     assert design["x.a"] == pytest.approx([0, 4, res.best["x.a"], 1.0], rel=5e-5)
     assert design["x.b"] == pytest.approx([0, 4, res.best["x.b"], 1.0], rel=5e-5)
     assert design["x.a"][2] == pytest.approx(2.0, abs=2e-3) and design["x.b"][2] == pytest.approx(1.0, abs=2e-3)
@@ -354,10 +356,11 @@ def test_robust_band_optimum_through_the_command_line(analytic_catenary, tmp_pat
     blocks = text.split("\n\n")
     assert "minimise the worst over 2 operating points of sigma of" in blocks[0]
     factor = blocks[1].splitlines()[2].split()
-    assert factor[0] == "params.F0" and float(factor[3]) == pytest.approx(f0, rel=5e-5) and factor[4] == "120"
+    assert factor[:2] == ["params.F0", "N"]  # its declared unit
+    assert float(factor[4]) == pytest.approx(f0, rel=5e-5) and factor[5] == "120"
     assert float(blocks[2].split()[1]) == pytest.approx(data["value"], rel=5e-5) and blocks[2].split()[2] == "N"
     rows = {(r[2].rstrip(","), r[3]): [float(r[4]), float(r[5])] for r in _rows(blocks[3].split("\nwrote")[0])}
-    assert blocks[3].splitlines()[0].split()[-2:] == ["Fm", "sigma"]
+    assert blocks[3].splitlines()[0].split()[-4:] == ["Fm", "[N]", "sigma", "[N]"]
     assert rows[("250", "optimum")] == pytest.approx([hand[0]["Fm"], hand[0]["sigma"]], rel=5e-5)
     assert rows[("300", "optimum")] == pytest.approx([hand[1]["Fm"], hand[1]["sigma"]], rel=5e-5)
     assert rows[("250", "start")] == pytest.approx([108.0, 29.5]) and rows[("300", "start")] == pytest.approx(
@@ -365,9 +368,9 @@ def test_robust_band_optimum_through_the_command_line(analytic_catenary, tmp_pat
     # evaluations.csv: every passage, its speed, the band violation at that speed and the penalised value
     with (out / "evaluations.csv").open() as fh:
         ev = list(csv.DictReader(fh))
-    assert len(ev) == data["evaluations_count"] and {float(r["input.speed"]) for r in ev} == {250.0, 300.0}
+    assert len(ev) == data["evaluations_count"] and {float(r["input.speed [km/h]"]) for r in ev} == {250.0, 300.0}
     for r in ev:
-        v, x = float(r["input.speed"]), float(r["params.F0"])
+        v, x = float(r["input.speed [km/h]"]), float(r["params.F0 [N]"])
         y = analytic_passage({"input": {"speed": v}}, {"params.F0": x})
         lo, hi = hand_band("AC", v)
         viol = max(lo - y["Fm"], 0.0, y["Fm"] - hi)

@@ -292,6 +292,12 @@ def test_sensitivity_command_prints_and_writes_the_hand_ranking(tmp_path, capsys
     for r in table:
         assert float(r["mu"]) == pytest.approx(hand[r["output"]][r["factor"]], abs=1e-9)
         assert float(r["mu_star"]) == pytest.approx(abs(hand[r["output"]][r["factor"]]), abs=1e-9)
+        assert r["unit"] == "N"  # the unit of the row's mu*, mu, sigma: the output's
+    # the units: of every index column in the table, of the factors (their declared keys) and outputs in the CSV
+    assert text.split("\n\n")[1].splitlines()[1].split()[2:] == ["mu*", "[N]", "+-", "[N]", "mu", "[N]", "sigma",
+                                                                 "[N]"]
+    with (out / "evaluations.csv").open() as fh:
+        assert next(csv.reader(fh)) == ["params.F0 [N]", "params.c2 [N s/m]", "Fm [N]", "sigma [N]"]
     data = json.loads((out / "summary.json").read_text())["results"]
     assert data["units"]["sigma"] == "N" and data["evaluations_count"] == 5 * 3
     for o in ("Fm", "sigma"):

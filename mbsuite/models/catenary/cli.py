@@ -28,7 +28,7 @@ def register(sub, add_common, emit) -> str:
     p = sub.add_parser(COMMAND, help=CLI_COMMANDS[COMMAND])
     p.add_argument("scene", nargs="?", default="catenary",
                    help="scene TOML path, 'catenary' (default scene), catenary/<scene>, or a line file (TOML with "
-                        "[[wires]]: run under the default scene, model README 'A line of your own')")
+                        "[[wires]]: run under the default scene; model README 'Lines of your own', 'A line in a file')")
     p.add_argument("--speed", type=float, default=None, help="train speed (km/h); default: the scene's input.speed")
     p.add_argument("--timestep", type=float, default=None, help="override solver.timestep (s)")
     p.add_argument("--element-length", type=float, default=None, help="override params.element_length (m)")

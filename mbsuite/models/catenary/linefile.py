@@ -1,6 +1,6 @@
 """A line described in a file (TOML, with CSV tables for long lists) and the scene's `[line]` section.
 
-Line file (model README, "A line of your own"; every length in m, mass in kg or kg/m, force in N, stiffness N/m)::
+Line file (model README, "Lines of your own"; every length in m, mass in kg or kg/m, force in N, stiffness N/m)::
 
     name = "my section"
     presag = 0.0005                      # mid-span presag / span length (parabolic), optional

@@ -1,6 +1,7 @@
 """What the catenary's figures and tables mark of the line a passage ran (`mesh.line_of(params)`): its supports,
-droppers and stitch-wire spans inside a stretch of track (`line_marks`), and the line's name for titles and table
-headers (`line_label`). Pure functions of the `Line` (and the parameters), nothing drawn here."""
+droppers, stitch-wire spans, the overlaps of its contact wires and their anchors inside a stretch of track
+(`line_marks`), and the line's name for titles and table headers (`line_label`). Pure functions of the `Line` (and
+the parameters), nothing drawn here."""
 
 from __future__ import annotations
 
@@ -21,15 +22,27 @@ _BUILT = ("stitched", "compound")
 
 
 def line_marks(line: Line, x_range: tuple[float, float] | None = None) -> dict[str, list]:
-    """The marks of `line` inside `x_range` = (a, b) (m, ends included; None: the whole line): `supports` (the
-    supports' x, m, sorted), `droppers` (the droppers' x, sorted, one per position) and `stitch` (the (x0, x1) of
-    every stitch wire that overlaps the range, clipped to it)."""
+    """The marks of `line` inside `x_range` = (a, b) (m, ends included; None: the whole line), each sorted:
+
+    - `supports`: the supports' x (m);
+    - `droppers`: the droppers' x, one per position;
+    - `stitch`: the (x0, x1) of every stitch wire that overlaps the range, clipped to it;
+    - `overlaps`: the (x0, x1) where two contact wires are both present (a route's overlap of two tension sections:
+      the common part of their x-ranges `Wire.x0`..`Wire.x1`), clipped to the range; none on one contact wire;
+    - `anchors`: (x, wire name) of every pinned end of a contact wire inside the line (the line's own ends at 0 and at
+      its length are not anchors), e.g. (300, "contact_b") and (480, "contact_a") on `catenary/en50318_overlap`."""
     a, b = (0.0, line.length) if x_range is None else (float(x_range[0]), float(x_range[1]))
     sup = [float(s.x) for s in line.supports if a <= s.x <= b]
     drop = sorted({float(d.x) for d in line.droppers if a <= d.x <= b})
     stitch = sorted((max(float(w.x0), a), min(float(w.x1), b)) for w in line.wires
                     if w.role == "stitch" and w.x1 > a and w.x0 < b)
-    return {"supports": sup, "droppers": drop, "stitch": stitch}
+    cws = line.contacts
+    both = {(max(float(u.x0), float(v.x0)), min(float(u.x1), float(v.x1)))
+            for i, u in enumerate(cws) for v in cws[i + 1:]}
+    overlaps = sorted((max(x0, a), min(x1, b)) for x0, x1 in both if x1 > x0 and x1 > a and x0 < b)
+    ends = {(float(x), w.name) for w in cws for x in (w.x0, w.x1)
+            if line.pinned_end(w, x) and 0.0 < x < line.length and a <= x <= b}
+    return {"supports": sup, "droppers": drop, "stitch": stitch, "overlaps": overlaps, "anchors": sorted(ends)}
 
 
 def line_label(p: CatenaryParams) -> str:

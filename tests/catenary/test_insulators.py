@@ -300,3 +300,22 @@ def test_a_line_without_insulators_is_unchanged_bit_for_bit():
     assert _digest(f0) == "fe642f7bfdc7f5e8dba224005ed0ba64343df902fe130819deb76cdc3c756397"
     ins = lines.with_insulators(lines.simple(p), [SectionInsulator(310.0, "contact", 2.0, 0.0, 0.0)])
     assert _digest(assemble(dataclasses.replace(p, line=ins))) == _digest(f0)
+
+
+def test_a_scenes_line_section_adds_insulators_to_a_route():
+    """`[[line.insulators]]` (and `[[line.masses]]`) in a scene's `[line]` section join the line of any kind: the
+    shipped route with its section insulator in B's middle span carries it on B's contact wire, its ends nodes of the
+    mesh; a row naming no wire of the line, or with an unknown key, is a SceneError naming it."""
+    from mbsuite.scenes import load_scene
+
+    scene = load_scene("catenary/en50318_route_insulator")
+    p = scene.build_params()
+    assert p.line.insulators == (SectionInsulator(x=750.0, wire="contact_b", length=2.0, mass=8.0, EI=2000.0),)
+    keys = p.line.key_points()
+    assert np.any(np.isclose(keys, 749.0)) and np.any(np.isclose(keys, 751.0))
+    line = dict(scene.sections["line"])
+    row = {"x": 750.0, "wire": "contact_x", "length": 2.0, "mass": 8.0, "EI": 2000.0}
+    with pytest.raises(SceneError, match="contact_x"):
+        scene.replace(line={**line, "insulators": [row]}).build_params()
+    with pytest.raises(SceneError, match="colour"):
+        scene.replace(line={**line, "insulators": [{**row, "wire": "contact_b", "colour": 1}]})

@@ -262,6 +262,9 @@ LINE_SECTION = Section("[line]", {
     "stitch": of_dataclass(StitchParams, "[line.stitch]", doc="the stitch wires of kind = 'stitched'"),
     "compound": of_dataclass(CompoundParams, "[line.compound]", doc="the auxiliary wire of kind = 'compound'"),
     "overlap": of_dataclass(OverlapParams, "[line.overlap]", doc="the sections and overlaps of kind = 'overlap'"),
+    "masses": Items(MASS, max=MAX_ROWS, doc="point masses added to the line, any kind ([[line.masses]] tables)"),
+    "insulators": Items(INSULATOR, max=MAX_ROWS, doc="section insulators added to the line, any kind "
+                                                     "([[line.insulators]] tables)"),
     "irregularity": IRREGULARITY,
 }, rules=(Rule("kind = 'file' with file, and [line.stitch] / [line.compound] / [line.overlap] only with their kind",
                _kind_matches,
@@ -333,6 +336,14 @@ def build_line(section: Mapping[str, Any] | None, p, set_params: Iterable[str] =
         builder, cls = BUILDERS[kind]
         sub = section.get({"stitched": "stitch"}.get(kind, kind), {})
         line = builder(p, cls(**sub), presag=presag) if cls is not None else builder(p, presag=presag)
+    added = {"masses": [PointMass(**r) for r in section.get("masses", ())],
+             "insulators": [SectionInsulator(**r) for r in section.get("insulators", ())]}
+    if added["masses"] or added["insulators"]:  # checked with the line they join (on its wires, not overlapping)
+        try:
+            line = dataclasses.replace(line, masses=(*line.masses, *added["masses"]),
+                                       insulators=(*line.insulators, *added["insulators"]))
+        except MbsuiteError as exc:
+            raise SceneError(f"[line] masses / insulators: {exc}") from None
     irr = section.get("irregularity", irr)
     if irr is not None:
         line = dataclasses.replace(line, irregularity=irregularity.build(irr, line.length, "[line.irregularity]"))

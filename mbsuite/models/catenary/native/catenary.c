@@ -481,8 +481,10 @@ void mbs_cat_solve(cat_job* J, double* x) {
 
 /* ----------------------------------------------------------------------------------------- contacts */
 /* G e_d into col (n), zero for a pinned DOF */
+/* G e_d into col on the stepped range [ld0, ld1) (zero there for a pinned DOF; the entries outside are never read:
+ * update_live drops every cached column when the range changes) */
 static void unit_column(const cat_job* J, int d, double* col) {
-  memset(col, 0, sizeof(double) * J->n);
+  memset(col + J->ld0, 0, sizeof(double) * (J->ld1 - J->ld0));
   if (d < 0) return;
   col[d] = 1.0;
   band_solve(J, col, d);
@@ -490,16 +492,18 @@ static void unit_column(const cat_job* J, int d, double* col) {
   for (int i = J->ld0; i < J->ld1; i++) col[i] *= hh;
 }
 
-/* [lo, hi) of the m columns of length n at col (contiguous) outside which every entry is below RANGE_EPS of the
- * largest (lo = hi = 0 if all are zero) */
-static void col_range(const double* col, int n, int m, int* rng) {
+/* [lo, hi) of the m columns of length n at col (contiguous), read on [d0, d1), outside which every entry is below
+ * RANGE_EPS of the largest (lo = hi = 0 if all are zero) */
+static void col_range(const double* col, int n, int m, int* rng, int d0, int d1) {
   double big = 0.0;
-  for (long i = 0; i < (long)m * n; i++) big = fmax(big, fabs(col[i]));
+  for (int c = 0; c < m; c++) {
+    for (int i = d0; i < d1; i++) big = fmax(big, fabs(col[(long)c * n + i]));
+  }
   const double eps = big * RANGE_EPS;
   int lo = n, hi = 0;
   for (int c = 0; c < m; c++) {
     const double* v = col + (long)c * n;
-    int a = 0, b = n;
+    int a = d0, b = d1;
     while (a < b && !(fabs(v[a]) > eps)) a++;
     while (b > a && !(fabs(v[b - 1]) > eps)) b--;
     if (a < b) {
@@ -513,7 +517,7 @@ static void col_range(const double* col, int n, int m, int* rng) {
 
 /* the ranges of the droppers' G B_j (zrng), once Zg is set */
 void mbs_cat_dropper_ranges(cat_job* J) {
-  for (int j = 0; j < J->nd; j++) col_range(J->Zg + (long)j * J->n, J->n, 1, J->zrng + 2 * j);
+  for (int j = 0; j < J->nd; j++) col_range(J->Zg + (long)j * J->n, J->n, 1, J->zrng + 2 * j, 0, J->n);
 }
 
 static void set_element(cat_job* J, int k, int e) {
@@ -524,14 +528,16 @@ static void set_element(cat_job* J, int k, int e) {
   const int old = J->elem[k];
   if (old == e) return;
   if (old >= 0 && e == old + 1) {
-    memmove(cols, cols + 2 * (long)n, sizeof(double) * 2 * n);
+    const int d0 = J->ld0, nl = J->ld1 - J->ld0;
+    memmove(cols + d0, cols + 2 * (long)n + d0, sizeof(double) * nl);
+    memmove(cols + (long)n + d0, cols + 3 * (long)n + d0, sizeof(double) * nl);
   } else {
     unit_column(J, cwdof[2 * e], cols);
     unit_column(J, cwdof[2 * e + 1], cols + n);
   }
   unit_column(J, cwdof[2 * (e + 1)], cols + 2 * (long)n);
   unit_column(J, cwdof[2 * (e + 1) + 1], cols + 3 * (long)n);
-  col_range(cols, n, 4, J->crng + 2 * k);
+  col_range(cols, n, 4, J->crng + 2 * k, J->ld0, J->ld1);
   for (int m = 0; m < 4; m++) {
     const int d = cwdof[2 * e + m];
     J->dofs[4 * k + m] = d >= 0 ? d : 0;
@@ -680,12 +686,16 @@ static void update_live(cat_job* J, double t_new) {
     if (lo < 0) lo = c;
     hi = c;
   }
+  const int b0 = J->lb0, b1 = J->lb1;
   if (lo < 0) {
     full_range(J);
-    return;
+  } else {
+    J->lb0 = J->cmpb[2 * lo], J->lb1 = J->cmpb[2 * hi + 1];
+    J->ld0 = J->cmpd[2 * lo], J->ld1 = J->cmpd[2 * hi + 1];
   }
-  J->lb0 = J->cmpb[2 * lo], J->lb1 = J->cmpb[2 * hi + 1];
-  J->ld0 = J->cmpd[2 * lo], J->ld1 = J->cmpd[2 * hi + 1];
+  if (J->lb0 != b0 || J->lb1 != b1) { /* the cached columns hold the old range only: computed anew on the new one */
+    for (int k = 0; k < J->ncon; k++) J->elem[k] = -1;
+  }
   int c = 0;
   for (int b = 0; b < J->nslack; b++) {
     if (!dropper_live(J, J->slk[b])) continue;

@@ -122,6 +122,11 @@ GALLERY: list[tuple[str, str, list[str], str]] = [
      "The 2-mass pantograph under the stitched EN 50318 line at 300 km/h: force, wire height and uplift; quality."),
     ("A line of your own", "mbsuite catenary catenary/example_line", ["force_uplift_reference2mass_250kmh.png"],
      "A tension section from a line file: varying spans, stitch wires, masses, presag and a height profile."),
+    ("A route through two overlaps", "mbsuite catenary catenary/en50318_route --speed 300",
+     ["force_uplift_reference2mass_300kmh.png"],
+     "Three EN 50318 tension sections joined by two overlaps at 300 km/h: the head's force and each contact wire's, "
+     "the wire it meets, the steady arms' uplift (each section's until the pantograph has left it), overlaps and "
+     "anchors marked."),
     ("Sensitivity of the Eppinger pantograph under the wire",
      "mbsuite sensitivity catenary/en50318_eppinger --set solver.engine=mujoco --vary pantograph.params.mh=10:17 "
      "--vary pantograph.params.kh=1500:3000 --vary pantograph.params.bh=5:20 --vary pantograph.params.b2=100:220 "

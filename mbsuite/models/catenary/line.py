@@ -299,6 +299,21 @@ class Irregularity:
     __hash__ = None  # type: ignore[assignment]
 
 
+def joined(n: int, pairs: list[tuple[int, int]]) -> list[int]:
+    """The representative of each of `n` items joined by the index `pairs` (union-find): items joined directly or
+    through others share one."""
+    parent = list(range(n))
+
+    def root(a: int) -> int:
+        while parent[a] != a:
+            a = parent[a]
+        return a
+
+    for a, b in pairs:
+        parent[root(a)] = root(b)
+    return [root(k) for k in range(n)]
+
+
 @dataclass(frozen=True)
 class Line:
     """A tension section, or several chained into a route (module docstring). `supports` sorted by x; the contact
@@ -475,18 +490,8 @@ class Line:
         through other wires, share one (numbered 0, 1, ... in the order of their first wire). The sections of a route
         are its components: nothing but a pantograph joins them."""
         wi = {w.name: k for k, w in enumerate(self.wires)}
-        parent = list(range(len(self.wires)))
-
-        def root(a: int) -> int:
-            while parent[a] != a:
-                a = parent[a]
-            return a
-
-        for a, b in [(d.upper, d.lower) for d in self.droppers] + [(c.a, c.b) for c in self.clamps]:
-            ra, rb = root(wi[a]), root(wi[b])
-            if ra != rb:
-                parent[max(ra, rb)] = min(ra, rb)
-        roots = [root(k) for k in range(len(self.wires))]
+        roots = joined(len(self.wires), [(wi[d.upper], wi[d.lower]) for d in self.droppers]
+                       + [(wi[c.a], wi[c.b]) for c in self.clamps])
         number = {r: i for i, r in enumerate(dict.fromkeys(roots))}
         return [number[r] for r in roots]
 

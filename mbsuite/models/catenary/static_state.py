@@ -13,7 +13,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 from ...errors import ParameterError
-from .line import Line
+from .line import Line, joined
 
 
 def check_compression(line: Line, T0: np.ndarray, slack: np.ndarray) -> None:
@@ -100,16 +100,7 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
 def wire_groups(line: Line) -> list[int]:
     """The group of each wire: wires joined by clamps share one (its representative wire's index)."""
     wi = {w.name: k for k, w in enumerate(line.wires)}
-    parent = list(range(len(line.wires)))
-
-    def root(a: int) -> int:
-        while parent[a] != a:
-            a = parent[a]
-        return a
-
-    for c in line.clamps:
-        parent[root(wi[c.a])] = root(wi[c.b])
-    return [root(k) for k in range(len(line.wires))]
+    return joined(len(line.wires), [(wi[c.a], wi[c.b]) for c in line.clamps])
 
 
 def _holds(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarray, pinned: list[int], pos: np.ndarray,

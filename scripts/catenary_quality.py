@@ -16,7 +16,8 @@ from mbsuite.models.catenary.quality import CRITERIA, criteria_from
 from mbsuite.models.catenary.reports import quality_of, train_assessments
 from mbsuite.results import format_table
 
-SCENES = ("en50318", "en50318_linear", "en50318_eppinger", "eppinger_lab", "en50318_two_pantographs", "en50318_aero")
+SCENES = ("en50318", "en50318_linear", "en50318_eppinger", "eppinger_lab", "en50318_two_pantographs", "en50318_aero",
+          "en50318_route", "en50318_route_two_pantographs")
 
 
 def main() -> None:

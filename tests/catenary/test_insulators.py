@@ -319,3 +319,33 @@ def test_a_scenes_line_section_adds_insulators_to_a_route():
         scene.replace(line={**line, "insulators": [row]}).build_params()
     with pytest.raises(SceneError, match="colour"):
         scene.replace(line={**line, "insulators": [{**row, "wire": "contact_b", "colour": 1}]})
+
+
+def test_marks_and_a_partial_run_of_an_insulator():
+    """The figures' marks hold each insulator on a contact wire by its extent (`marks.line_marks`), and the report
+    says when the run starts or ends on an insulator (its numbers then cover the part run only)."""
+    from mbsuite.models.catenary.marks import line_marks
+    from mbsuite.scenes import load_scene
+
+    p = load_scene("catenary/en50318_route_insulator").build_params()
+    assert line_marks(p.line)["insulators"] == [(749.0, 751.0, "contact_b")]
+    assert line_marks(p.line, (0.0, 700.0))["insulators"] == []
+    from mbsuite.models.catenary.stats import insulator_statistics
+
+    x = np.linspace(700.0, 750.0, 501)
+    f = np.full_like(x, 100.0)
+    st = insulator_statistics(x / 69.4, x, f, f, 1e-3, p)
+    assert st["contact_b@750"]["whole"] is False and st["contact_b@750"]["n_samples"] == 11
+
+
+def test_a_dropper_hung_upside_down_is_named():
+    """One dropper of the simple line hung the wrong way round (the messenger from the contact wire): the static
+    state cannot order the wires, and the error names that dropper and the others' direction."""
+    p = CatenaryParams(n_spans=2, x_end=100.0, window_start=20.0, window_end=100.0)
+    line = lines.simple(p)
+    d = line.droppers[3]
+    bad = dataclasses.replace(line, droppers=(*line.droppers[:3], dataclasses.replace(d, upper=d.lower, lower=d.upper),
+                                              *line.droppers[4:]))
+    with pytest.raises(ParameterError, match=rf"dropper\(s\) at x = {d.x:g} m hang wire 'messenger' from 'contact'.*"
+                                             "upside down"):
+        assemble(dataclasses.replace(p, line=bad))

@@ -144,9 +144,9 @@ def test_overlapping_contact_wires_must_not_touch_and_new_inputs_are_checked():
     naming it."""
     p = dataclasses.replace(P_SHORT)
     good = overlap(p, SHORT)
-    with pytest.raises(ParameterError, match="joined by droppers or clamps"):
+    with pytest.raises(ParameterError, match="joined by droppers or clamps through other wires"):
         dataclasses.replace(good, droppers=(*good.droppers, Dropper(100.0, "messenger_a", "contact_b", 1e5)))
-    with pytest.raises(ParameterError, match="joined by droppers or clamps"):
+    with pytest.raises(ParameterError, match=r"joined by the dropper\(s\) or clamp\(s\) at x = 100 m"):
         dataclasses.replace(good, clamps=(Clamp(100.0, "contact_a", "contact_b", 1e5),))
     flat = tuple(dataclasses.replace(w, heights=()) if w.role == "contact" else w for w in good.wires)
     with pytest.raises(ParameterError, match="same design height from x = 60 to 65 m"):

@@ -473,9 +473,13 @@ class Line:
                 if not lo < hi:
                     continue
                 if group[wi[a.name]] == group[wi[b.name]]:
+                    direct = [f"{d.x:g}" for d in self.droppers if {d.upper, d.lower} == {a.name, b.name}]
+                    direct += [f"{c.x:g}" for c in self.clamps if {c.a, c.b} == {a.name, b.name}]
+                    which = (f"by the dropper(s) or clamp(s) at x = {', '.join(direct[:4])} m" if direct else
+                             "by droppers or clamps through other wires")
                     raise ParameterError(f"line {self.name!r}: the contact wires {a.name!r} and {b.name!r} overlap on "
-                                         f"[{lo}, {hi}] m and are joined by droppers or clamps: overlapping contact "
-                                         "wires must not touch (each section hangs from its own wires)")
+                                         f"[{lo}, {hi}] m and are joined {which}: overlapping contact wires must not "
+                                         "touch (each section hangs from its own wires)")
                 xs = keys[(keys >= lo - 1e-9) & (keys <= hi + 1e-9)]
                 near = np.abs(self.design_height(xs, a) - self.design_height(xs, b)) < TOUCH
                 both = np.nonzero(near[:-1] & near[1:])[0]

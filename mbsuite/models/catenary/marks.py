@@ -30,7 +30,9 @@ def line_marks(line: Line, x_range: tuple[float, float] | None = None) -> dict[s
     - `overlaps`: the (x0, x1) where two contact wires are both present (a route's overlap of two tension sections:
       the common part of their x-ranges `Wire.x0`..`Wire.x1`), clipped to the range; none on one contact wire;
     - `anchors`: (x, wire name) of every pinned end of a contact wire inside the line (the line's own ends at 0 and at
-      its length are not anchors), e.g. (300, "contact_b") and (480, "contact_a") on `catenary/en50318_overlap`."""
+      its length are not anchors), e.g. (300, "contact_b") and (480, "contact_a") on `catenary/en50318_overlap`;
+    - `insulators`: (x_a, x_b, wire name) of every section insulator on a contact wire that overlaps the range (its
+      own extent, `SectionInsulator.x_a`..`x_b`)."""
     a, b = (0.0, line.length) if x_range is None else (float(x_range[0]), float(x_range[1]))
     sup = [float(s.x) for s in line.supports if a <= s.x <= b]
     drop = sorted({float(d.x) for d in line.droppers if a <= d.x <= b})
@@ -42,7 +44,11 @@ def line_marks(line: Line, x_range: tuple[float, float] | None = None) -> dict[s
     overlaps = sorted((max(x0, a), min(x1, b)) for x0, x1 in both if x1 > x0 and x1 > a and x0 < b)
     ends = {(float(x), w.name) for w in cws for x in (w.x0, w.x1)
             if line.pinned_end(w, x) and 0.0 < x < line.length and a <= x <= b}
-    return {"supports": sup, "droppers": drop, "stitch": stitch, "overlaps": overlaps, "anchors": sorted(ends)}
+    names = {w.name for w in cws}
+    ins = sorted((float(i.x - i.length / 2), float(i.x + i.length / 2), i.wire) for i in line.insulators
+                 if i.wire in names and i.x + i.length / 2 > a and i.x - i.length / 2 < b)
+    return {"supports": sup, "droppers": drop, "stitch": stitch, "overlaps": overlaps, "anchors": sorted(ends),
+            "insulators": ins}
 
 
 def line_label(p: CatenaryParams) -> str:

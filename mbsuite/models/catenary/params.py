@@ -104,8 +104,11 @@ class CatenaryParams:
         object.__setattr__(self, "dropper_positions", dp)
         for i, x in enumerate(dp):
             if not (math.isfinite(x) and 0.0 < x < self.span_length):
+                default = dp == list(EN50318_DROPPERS)
                 raise ParameterError(
                     f"dropper_positions[{i}] = {x!r} m lies outside its span (0, {self.span_length}) m"
+                    + (f" (the EN 50318 line's nine positions in its 60 m span, the default: set [params] "
+                       f"dropper_positions for spans of {self.span_length:g} m)" if default else "")
                 )
         for i in range(1, len(dp)):
             if not dp[i] > dp[i - 1]:

@@ -25,6 +25,9 @@ DROPPER_STYLE = {"color": "tab:brown", "lw": 0.5, "alpha": 0.6}
 STITCH_STYLE = {"color": "tab:orange", "alpha": 0.12, "zorder": -2}
 OVERLAP_STYLE = {"facecolor": "none", "edgecolor": "tab:cyan", "hatch": "//", "lw": 0.0, "alpha": 0.35, "zorder": -2}
 ANCHOR_STYLE = {"marker": "v", "s": 36, "zorder": 4, "clip_on": False}
+INSULATOR_STYLE = {"color": "tab:red", "alpha": 0.35, "lw": 0.0, "zorder": -1}
+#: the further statistics windows (`params.windows`) at their edges
+WINDOW_EDGE_STYLE = {"color": "0.35", "lw": 0.8, "ls": (0, (4, 3)), "zorder": -1}
 ANCHOR_COLOUR = "k"
 #: the colours of the lines: per dropper law (others: `OTHER_LAW`), per contact wire of a route (in the line's order,
 #: `Line.contacts`), per pantograph of a train; none of them a mark's colour (grey, brown, orange, cyan)
@@ -35,7 +38,8 @@ PANTO_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:olive", 
 #: the x-axis label's text for each kind of mark (`marks_legend` names those a figure shows)
 MARKS_LEGEND = {"supports": "grey lines: supports", "droppers": "brown ticks: droppers",
                 "stitch": "orange spans: stitch wires", "overlaps": "cyan hatching: overlap of two contact wires",
-                "anchors": "triangles: anchors, {}"}
+                "anchors": "triangles: anchors, {}", "insulators": "red bands: section insulators",
+                "windows": "dashed lines: the edges of the further statistics windows"}
 #: the x-axis label's width (characters) before it wraps
 WRAP = 140
 
@@ -43,7 +47,8 @@ WRAP = 140
 def marks_legend(x: str, m: dict[str, list]) -> str:
     """The x-axis label "`x` [m] (...)" naming the marks `m` (`marks.line_marks`) present, from `MARKS_LEGEND`: the
     anchors by wire and position ("triangles: anchors, contact_b at 300 m, contact_a at 480 m")."""
-    parts = [MARKS_LEGEND[k] for k in ("supports", "droppers", "stitch", "overlaps") if m.get(k)]
+    parts = [MARKS_LEGEND[k] for k in ("supports", "droppers", "stitch", "overlaps", "insulators", "windows")
+             if m.get(k)]
     if m.get("anchors"):
         parts.append(MARKS_LEGEND["anchors"].format(", ".join(f"{w} at {xa:g} m" for xa, w in m["anchors"])))
     if not parts:
@@ -59,6 +64,7 @@ def draw_line_marks(axes, p: CatenaryParams, wire_colours: dict[str, str] | None
     from .mesh import line_of
 
     m = line_marks(line_of(p), (p.x_start, p.x_end))
+    m["windows"] = sorted({float(e) for w in p.windows for e in w} - {p.window_start, p.window_end})
     colours = wire_colours or {}
     for k, ax in enumerate(axes):
         for xs in m["supports"]:
@@ -75,6 +81,10 @@ def draw_line_marks(axes, p: CatenaryParams, wire_colours: dict[str, str] | None
         for xa, w in m["anchors"]:
             ax.scatter([xa], [0.94], transform=ax.get_xaxis_transform(), color=colours.get(w, ANCHOR_COLOUR),
                        **ANCHOR_STYLE)
+        for a, b, _ in m["insulators"]:
+            ax.axvspan(a, b, **INSULATOR_STYLE)
+        for xe in m["windows"]:
+            ax.axvline(xe, **WINDOW_EDGE_STYLE)
     return m
 
 

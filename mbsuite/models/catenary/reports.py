@@ -253,9 +253,10 @@ def insulator_lines(runs: list[tuple[str, dict]]) -> list[str]:
             if not d["n_samples"]:
                 rows.append([label, name, f"{a:g} .. {b:g}", "0", *["-"] * 6])
                 continue
-            rows.append([label, name, f"{a:g} .. {b:g}", str(d["n_samples"]), f"{d['Fm']:.2f}", f"{d['max']:.2f}",
-                         f"{d['min']:.2f}", f"{d['raw_max']:.2f} / {d['raw_min']:.2f}", f"{d['loss_pct']:.1f}",
-                         str(d["n_losses"])])
+            part = "" if d.get("whole", True) else " (part: the run starts or ends on it)"
+            rows.append([label, name + part, f"{a:g} .. {b:g}", str(d["n_samples"]), f"{d['Fm']:.2f}",
+                         f"{d['max']:.2f}", f"{d['min']:.2f}", f"{d['raw_max']:.2f} / {d['raw_min']:.2f}",
+                         f"{d['loss_pct']:.1f}", str(d["n_losses"])])
     return ["insulators: the contact force while the head is on each one (filtered at 20 Hz; raw: unfiltered):",
             format_table(["run", "insulator", "x (m)", "samples", "Fm (N)", "max (N)", "min (N)",
                                               "raw max / min (N)", "loss (%)", "losses"], rows)]

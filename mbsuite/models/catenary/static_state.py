@@ -61,8 +61,7 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
     while todo:
         ready = [g for g in todo if not np.any(np.isnan(T0[d_up == g]))]
         if not ready:
-            raise ParameterError(f"line {line.name!r}: its droppers form a loop (a wire hangs from a wire that hangs "
-                                 "from it)")
+            raise ParameterError(_loop_text(line, d_up, d_low, np.isnan(T0)))
         g = ready[0]
         todo.remove(g)
         ks = [k for k in range(len(line.wires)) if group[k] == g]
@@ -95,6 +94,24 @@ def static_state(line: Line, x: np.ndarray, slot: np.ndarray, supports: np.ndarr
             here = np.where(arm, r[pos[np.maximum(slot[c, supports], 0)]], 0.0)
             preload = here if c == 0 else preload + here
     return u, T0, preload
+
+
+def _loop_text(line: Line, d_up: np.ndarray, d_low: np.ndarray, pending: np.ndarray) -> str:
+    """Why the static state cannot order the wires: droppers hanging two wires from each other (the fewer of the two
+    directions named: a dropper upside down), else the droppers that hang in the loop."""
+    dr = line.droppers
+    for j in np.nonzero(pending)[0]:
+        back = np.nonzero(pending & (d_up == d_low[j]) & (d_low == d_up[j]))[0]
+        if back.size:
+            same = np.nonzero(pending & (d_up == d_up[j]) & (d_low == d_low[j]))[0]
+            few, many = (same, back) if same.size <= back.size else (back, same)
+            d, e = dr[few[0]], dr[many[0]]
+            xs = ", ".join(f"{dr[k].x:g}" for k in few[:4]) + (" ..." if few.size > 4 else "")
+            return (f"line {line.name!r}: the dropper(s) at x = {xs} m hang wire {d.lower!r} from {d.upper!r}, while "
+                    f"{many.size} other(s) (e.g. at x = {e.x:g} m) hang {e.lower!r} from {e.upper!r}: a dropper upside "
+                    "down? (upper = the wire it hangs from, lower = the wire it holds)")
+    xs = ", ".join(f"{dr[k].x:g} m ({dr[k].upper} -> {dr[k].lower})" for k in np.nonzero(pending)[0][:4])
+    return f"line {line.name!r}: its droppers form a loop (a wire hangs from a wire that hangs from it): {xs}"
 
 
 def wire_groups(line: Line) -> list[int]:

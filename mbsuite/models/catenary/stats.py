@@ -194,8 +194,9 @@ def insulator_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, ff: np
     insulators and point masses"), keyed "<wire>@<x>" (x its centre, "%g" m): over the samples whose head position x
     lies on [x_a, x_b] (`x_range`), the mean, max and min of the 20 Hz filtered force `ff` (`Fm`, `max`, `min`), the
     max and min of the unfiltered force (`raw_max`, `raw_min`), the share of those samples with zero unfiltered force
-    (`loss_pct`), the loss events there (`n_losses`) and `n_samples` (0, and None values, where the run does not pass
-    it). On a route (`wires`: each contact wire's own record) the insulator's own wire's force, filtered as the head's.
+    (`loss_pct`), the loss events there (`n_losses`), `n_samples` (0, and None values, where the run does not pass
+    it) and `whole` (False where the run starts or ends on it: the numbers then cover only the part run). On a route
+    (`wires`: each contact wire's own record) the insulator's own wire's force, filtered as the head's.
     Empty for a line without insulators on its contact wires."""
     line = line_of(p)
     contact = {w.name for w in line.contacts}
@@ -208,7 +209,8 @@ def insulator_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, ff: np
             f = wires[s.wire]["force"]
             fl = lowpass(f, dt, p.filter_cutoff, p.filter_order)
         on = (x >= s.xa) & (x <= s.xb)
-        d: dict = {"wire": s.wire, "x": s.x, "x_range": [s.xa, s.xb], "n_samples": int(on.sum())}
+        passed = bool(x.size and x[0] <= s.xa and x[-1] >= s.xb)  # the run covers the whole insulator
+        d: dict = {"wire": s.wire, "x": s.x, "x_range": [s.xa, s.xb], "n_samples": int(on.sum()), "whole": passed}
         if on.any():
             fo = fl[on]
             events = loss_events(t[on], x[on], f[on], dt)

@@ -9,6 +9,7 @@ input section (`docs/inputs.md`), all from the declarations the loaders check wi
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -33,6 +34,11 @@ TOML: put `#:schema <path>/catenary.scene.json` on the first line of a scene), a
 """
 
 
+def _default(f: dataclasses.Field) -> str:
+    """A declared list field's default as the tables show it."""
+    return repr(f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default)
+
+
 def files() -> dict[Path, str]:
     """Every generated file and its text."""
     out: dict[Path, str] = {}
@@ -42,6 +48,8 @@ def files() -> dict[Path, str]:
         rows = limits_table(spec.params_cls)
         table = ["| key | default | valid | unit | meaning |", "|---|---|---|---|---|"]
         table += [f"| `{k}` | {d} | {v} | {u} | {doc} |" for k, d, v, u, doc in rows]
+        table += [f"| `{f.name}` | {_default(f)} | {f.metadata['valid']} | {f.metadata.get('unit', '')} | "
+                  f"{f.metadata['doc']} |" for f in dataclasses.fields(spec.params_cls) if "valid" in f.metadata]
         pages.append(f"## {name}\n\n**[params]** ({spec.params_cls.__name__})\n\n" + "\n".join(table))
         for key, validator in spec.sections.items():
             sec = section_of(validator)

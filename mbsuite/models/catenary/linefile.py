@@ -389,20 +389,25 @@ def _provisional_window(given: Mapping[str, Any]) -> dict[str, Any]:
 
 def _windowed(line: Line, given: Mapping[str, Any], make: Any) -> Any:
     """The parameters `make(**window)` with the statistics window: the scene's (a `WindowOffSupportWarning` where an
-    edge is off the supports of `line`), else `marks.default_window(line)` (on the EN 50318 line the parameters'
-    own default, [240, 360] m); a default window outside the run is a ParameterError naming the rule and the keys
-    to set."""
+    edge of it, or of a further window `windows`, is off the supports of `line`), else `marks.default_window(line)`
+    (on the EN 50318 line the parameters' own default, [240, 360] m); a default window outside the run is a
+    ParameterError naming the rule and the keys to set."""
     from .marks import WindowOffSupportWarning, default_window, window_off_supports
+
+    def warned(p: Any, windows: list) -> Any:
+        for a, b in windows:  # the headline window (when the scene gives it) and every further one
+            msg = window_off_supports(line, a, b)
+            if msg is not None:
+                warnings.warn(msg, WindowOffSupportWarning, stacklevel=5)
+        return p
 
     if "window_start" in given or "window_end" in given:
         p = make()
-        msg = window_off_supports(line, p.window_start, p.window_end)
-        if msg is not None:
-            warnings.warn(msg, WindowOffSupportWarning, stacklevel=4)
-        return p
+        return warned(p, [(p.window_start, p.window_end), *p.windows])
     a, b = default_window(line)
     try:
-        return make(window_start=a, window_end=b)
+        p = make(window_start=a, window_end=b)
+        return warned(p, p.windows)
     except ParameterError as exc:
         if "statistics window" not in str(exc):
             raise

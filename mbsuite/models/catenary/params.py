@@ -38,7 +38,9 @@ class CatenaryParams:
     mw_tension: float = param(16000.0, lo=0.0, lo_open=True, hi=1e6, unit="N", doc="messenger wire tension")
     mw_EI: float = param(131.7, lo=0.0, hi=1e6, unit="N m^2", doc="messenger wire bending stiffness")
     #: dropper positions from the span's first support (m); checked below (inside the span, increasing)
-    dropper_positions: list[float] = field(default_factory=lambda: list(EN50318_DROPPERS))
+    dropper_positions: list[float] = field(default_factory=lambda: list(EN50318_DROPPERS), metadata={
+        "valid": "increasing, each inside (0, span_length)", "unit": "m",
+        "doc": "dropper positions from each span's first support (default: the EN 50318 line's nine in its 60 m span)"})
     k_dropper: float = param(1.0e5, lo=0.0, lo_open=True, hi=1e10, unit="N/m", doc="dropper axial stiffness "
                                                                                        "(massless)")
     k_steady_arm: float = param(300.0, lo=0.0, hi=1e10, unit="N/m", doc="steady arm: CW to ground at each support")
@@ -71,7 +73,9 @@ class CatenaryParams:
     window_end: float = param(360.0, lo=0.0, hi=1e6, unit="m", doc="end of the statistics window", draw=POSITION)
     #: further statistics windows [[start, end], ...] (m), each inside the run; checked below. Each gets the
     #: statistics of the window above (`stats.window_statistics`; a route's contact wires their own too)
-    windows: list[list[float]] = field(default_factory=list)
+    windows: list[list[float]] = field(default_factory=list, metadata={
+        "valid": f"[[start, end], ...], each inside the run, start < end (at most {MAX_WINDOWS})", "unit": "m",
+        "doc": "further statistics windows (a route's sections and overlaps), each with the eight statistics"})
     filter_cutoff: float = param(20.0, lo=0.0, lo_open=True, hi=1e4, unit="Hz",
                                  doc="low-pass cut-off of the contact force")
     filter_order: int = param(4, lo=1, hi=10, kind=int, unit="-", doc="Butterworth order (forwards and backwards)")

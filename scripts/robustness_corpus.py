@@ -464,6 +464,10 @@ def input_attempts() -> Iterator[Attempt]:
                        'overlap_spans = 3\n\n[params]\n')
     yield scene("catenary-route-overlaps-cross", a, "three sections whose inner one's two overlaps would cross", route,
                 culprit="overlap_spans")
+    yield scene("catenary-route-insulator-unknown-wire", a, "a scene's section insulator on a wire the route has not",
+                route.replace("spans = 5\noverlap", "spans = 8\noverlap")
+                + '\n[[line.insulators]]\nx = 400.0\nwire = "contact_x"\nlength = 2.0\nmass = 8.0\nEI = 2000.0\n',
+                culprit="contact_x")
     from mbsuite.models.catenary.linefile import EXAMPLE  # a line file with a section insulator on [69, 71] m
 
     for tag, what, change, culprit in (

@@ -45,8 +45,8 @@ def line_marks(line: Line, x_range: tuple[float, float] | None = None) -> dict[s
     ends = {(float(x), w.name) for w in cws for x in (w.x0, w.x1)
             if line.pinned_end(w, x) and 0.0 < x < line.length and a <= x <= b}
     names = {w.name for w in cws}
-    ins = sorted((float(i.x - i.length / 2), float(i.x + i.length / 2), i.wire) for i in line.insulators
-                 if i.wire in names and i.x + i.length / 2 > a and i.x - i.length / 2 < b)
+    ins = sorted((float(i.xa), float(i.xb), i.wire) for i in line.insulators
+                 if i.wire in names and i.xb > a and i.xa < b)
     return {"supports": sup, "droppers": drop, "stitch": stitch, "overlaps": overlaps, "anchors": sorted(ends),
             "insulators": ins}
 

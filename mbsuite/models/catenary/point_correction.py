@@ -190,13 +190,9 @@ def _stiffness(h: np.ndarray, T: float, EI: np.ndarray) -> np.ndarray:
     `scipy.linalg.solveh_banded` (3 superdiagonals)."""
     ne = h.size
     n = 2 * (ne + 1)
-    h, EI = np.asarray(h, float)[:, None, None], np.asarray(EI, float)[:, None, None]
-    one = np.ones_like(h)
-    kb = EI / h**3 * np.block([[12 * one, 6 * h, -12 * one, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
-                               [-12 * one, -6 * h, 12 * one, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]])
-    kg = T / (30 * h) * np.block([[36 * one, 3 * h, -36 * one, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
-                                  [-36 * one, -3 * h, 36 * one, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]])
-    ke = kb + kg
+    pairs = list(zip(np.asarray(h, float).tolist(), np.broadcast_to(EI, (ne,)).tolist(), strict=True))
+    one = {(hi, Ei): beam_stiffness(Ei, T, hi) for hi, Ei in set(pairs)}  # the element matrices, once each
+    ke = np.array([one[q] for q in pairs])
     ab = np.zeros((4, n))
     for r in range(4):
         for c in range(r, 4):  # K[i, j] (i <= j) at ab[3 + i - j, j]

@@ -177,17 +177,12 @@ def report(run: CatenaryRun, scene_dict: dict | None = None, extra_runs: list[Ca
 
 
 def overlaps(p) -> list[list[float]]:
-    """The overlaps of the line of `p` (m): where two or more contact wires are under the pantograph."""
+    """The overlaps of the line of `p` (m): where two or more contact wires are under the pantograph
+    (`marks.line_marks`)."""
+    from .marks import line_marks
     from .mesh import line_of
 
-    cws = line_of(p).contacts
-    out = []
-    for i, a in enumerate(cws):
-        for b in cws[i + 1:]:
-            lo, hi = max(a.x0, b.x0), min(a.x1, b.x1)
-            if lo < hi:
-                out.append([float(lo), float(hi)])
-    return sorted(out)
+    return [[a, b] for a, b in line_marks(line_of(p))["overlaps"]]
 
 
 def _overlap_of(p, a: float, b: float) -> bool:

@@ -158,24 +158,25 @@ def window_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, ff: np.nd
     import dataclasses
 
     out = {}
+    wff = {n: lowpass(w["force"], dt, p.filter_cutoff, p.filter_order) for n, w in (wires or {}).items()}  # once
     for a, b in p.windows:
         q = dataclasses.replace(p, window_start=float(a), window_end=float(b), windows=())
         s, _ = en50318_statistics(t, x, force, uplift, support_x, dt, q, names, ff)
         if wires:
-            s["wires"] = {n: wire_statistics(t, x, w["force"], w["on"], dt, q) for n, w in wires.items()
+            s["wires"] = {n: wire_statistics(t, x, w["force"], w["on"], dt, q, wff[n]) for n, w in wires.items()
                           if np.sum(w["on"] & in_window(x, q)) > 1}  # a wire whose end is the window's edge: not
         out[f"{a:g}-{b:g}"] = s
     return out
 
 
 def wire_statistics(t: np.ndarray, x: np.ndarray, force: np.ndarray, on: np.ndarray, dt: float,
-                    p: CatenaryParams) -> dict:
+                    p: CatenaryParams, ff: np.ndarray | None = None) -> dict:
     """One contact wire's own contact force in the window of `p` (a route's wire through an overlap): its force
     filtered as the head's (zero off its x-range), Fm, sigma, max, min of that filtered force over the window's
     samples on the wire, `contact_pct` (share of those samples with force > 0, unfiltered), the loss events where the
     wire had carried force before (its contact ends), where its contact starts and ends (`x_first_contact`,
-    `x_last_contact`, m) and its impulse over the window (N s)."""
-    ff = lowpass(force, dt, p.filter_cutoff, p.filter_order)
+    `x_last_contact`, m) and its impulse over the window (N s). `ff`: that filtered force if already at hand."""
+    ff = lowpass(force, dt, p.filter_cutoff, p.filter_order) if ff is None else ff
     w = in_window(x, p) & on
     fw = ff[w]
     touched = np.maximum.accumulate(force > 0.0)  # contact losses count once the wire has carried the head

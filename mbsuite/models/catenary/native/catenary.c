@@ -693,11 +693,10 @@ static void update_live(cat_job* J, double t_new) {
     J->lb0 = J->cmpb[2 * lo], J->lb1 = J->cmpb[2 * hi + 1];
     J->ld0 = J->cmpd[2 * lo], J->ld1 = J->cmpd[2 * hi + 1];
   }
-  if (J->lb0 != b0 || J->lb1 != b1) { /* the cached columns hold the old range only: computed anew on the new one */
-    for (int k = 0; k < J->ncon; k++) J->elem[k] = -1;
-  }
+  if (J->lb0 == b0 && J->lb1 == b1) return;
+  for (int k = 0; k < J->ncon; k++) J->elem[k] = -1; /* the cached columns hold the old range only: anew */
   int c = 0;
-  for (int b = 0; b < J->nslack; b++) {
+  for (int b = 0; b < J->nslack; b++) { /* a slack dropper left outside the range leaves the slack set */
     if (!dropper_live(J, J->slk[b])) continue;
     J->slk[c] = J->slk[b];
     J->sS[c++] = J->sS[b];
